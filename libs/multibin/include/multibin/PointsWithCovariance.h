@@ -1,0 +1,43 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace multibin {
+
+/** Upper triangle of a symmetric 3x3 covariance [m^2]. */
+struct SymmetricCov3 {
+    float xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+
+    Eigen::Matrix3d toMatrix() const {
+        Eigen::Matrix3d m;
+        m << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+        return m;
+    }
+    /** Takes the upper triangle of `m` (assumed symmetric). */
+    static SymmetricCov3 fromMatrix(const Eigen::Matrix3d& m) {
+        return {float(m(0, 0)), float(m(0, 1)), float(m(0, 2)),
+                float(m(1, 1)), float(m(1, 2)), float(m(2, 2))};
+    }
+};
+
+/** One 3D point [m] with its full covariance [m^2]. */
+struct PointWithCov {
+    Eigen::Vector3f point_m;
+    SymmetricCov3 cov_m2;
+};
+
+/** A batch of points, all in one frame (a sensor frame, or the map frame). */
+using PointsWithCov = std::vector<PointWithCov>;
+
+/** Covariance [m^2] of a point measured along the unit ray `dir` with range standard deviation
+ * `sigmaRange_m` and perfectly known bearing: sigma^2 * dir * dir^T (eq 3's J_S C_S J_S^T). */
+inline SymmetricCov3 rangeOnlyCovariance(const Eigen::Vector3f& dir, float sigmaRange_m) {
+    const float s2 = sigmaRange_m * sigmaRange_m;
+    return {s2 * dir.x() * dir.x(), s2 * dir.x() * dir.y(), s2 * dir.x() * dir.z(),
+            s2 * dir.y() * dir.y(), s2 * dir.y() * dir.z(), s2 * dir.z() * dir.z()};
+}
+
+}  // namespace multibin
