@@ -1,0 +1,61 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <set>
+#include <string>
+#include <vector>
+
+namespace multibin {
+
+/** Strict reader of one ini section.
+ *
+ * MRPT's read_double()/read_int() turn a malformed value into 0 without a word. This reader parses
+ * every value strictly and, in finish(), refuses any key of the section that nobody read, so a typo
+ * in an ini file is an error naming the section and the key instead of a silently ignored option.
+ *
+ * Use: one reader per section; each options struct reads its keys with read(); keys that belong
+ * to MRPT itself are declared with allow(); then finish(). Keys absent from the section leave the
+ * destination untouched (its default). All errors are std::invalid_argument. */
+class StrictConfigSection {
+public:
+    StrictConfigSection(const mrpt::config::CConfigFileBase& source, std::string section);
+
+    const std::string& section() const { return m_section; }
+    bool has(const std::string& key) const;
+
+    void read(const std::string& key, double& value);
+    void read(const std::string& key, float& value);
+    void read(const std::string& key, int& value);
+    void read(const std::string& key, unsigned& value);
+    void read(const std::string& key, bool& value);  //!< true/false/1/0/yes/no
+    void read(const std::string& key, std::string& value);
+    /** Comma- or space-separated numbers; the count must equal `expected_size` when non-zero. */
+    void read(const std::string& key, std::vector<double>& value, size_t expected_size = 0);
+    /** Comma- or space-separated words. */
+    void read(const std::string& key, std::vector<std::string>& value);
+
+    /** Reads a double and checks lo <= value <= hi (inclusive). */
+    void readInRange(const std::string& key, double& value, double lo, double hi);
+
+    /** Declares keys that may appear without being read (MRPT's generic map keys). */
+    void allow(const std::vector<std::string>& keys);
+
+    /** Throws if the section holds a key that was neither read nor allowed. */
+    void finish() const;
+
+    /** Throws an error that names the section and `key`. */
+    [[noreturn]] void fail(const std::string& key, const std::string& problem) const;
+
+private:
+    const std::string* raw(const std::string& key);
+
+    const mrpt::config::CConfigFileBase& m_source;
+    std::string m_section;
+    std::vector<std::string> m_keys;
+    std::vector<std::string> m_values;
+    std::set<std::string> m_used;
+};
+
+}  // namespace multibin

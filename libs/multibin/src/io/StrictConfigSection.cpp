@@ -1,0 +1,173 @@
+/* Part of the multibin elevation-mapping library. */
+#include "multibin/StrictConfigSection.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace multibin {
+
+namespace {
+std::string trim(const std::string& s) {
+    const auto b = s.find_first_not_of(" \t\r\n");
+    if (b == std::string::npos) return {};
+    const auto e = s.find_last_not_of(" \t\r\n");
+    std::string out = s.substr(b, e - b + 1);
+    // Strip a trailing comment ("value  // note" or "value # note").
+    for (const char* mark : {"//", "#", ";"}) {
+        const auto c = out.find(mark);
+        if (c != std::string::npos) out = out.substr(0, c);
+    }
+    const auto e2 = out.find_last_not_of(" \t");
+    return e2 == std::string::npos ? std::string() : out.substr(0, e2 + 1);
+}
+
+std::string lower(std::string s) {
+    for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : s) {
+        if (c == ',' || std::isspace(static_cast<unsigned char>(c))) {
+            if (!cur.empty()) out.push_back(cur);
+            cur.clear();
+        } else {
+            cur += c;
+        }
+    }
+    if (!cur.empty()) out.push_back(cur);
+    return out;
+}
+
+bool parseDouble(const std::string& s, double& v) {
+    if (s.empty()) return false;
+    char* end = nullptr;
+    v = std::strtod(s.c_str(), &end);
+    return end == s.c_str() + s.size() && std::isfinite(v);
+}
+}  // namespace
+
+StrictConfigSection::StrictConfigSection(const mrpt::config::CConfigFileBase& source,
+                                         std::string section)
+    : m_source(source), m_section(std::move(section)) {
+    if (m_source.sectionExists(m_section)) {
+        m_source.getAllKeys(m_section, m_keys);
+        for (const auto& k : m_keys) m_values.push_back(trim(m_source.read_string(m_section, k, "")));
+    }
+}
+
+bool StrictConfigSection::has(const std::string& key) const {
+    return std::find(m_keys.begin(), m_keys.end(), key) != m_keys.end();
+}
+
+const std::string* StrictConfigSection::raw(const std::string& key) {
+    const auto it = std::find(m_keys.begin(), m_keys.end(), key);
+    if (it == m_keys.end()) return nullptr;
+    m_used.insert(key);
+    return &m_values[static_cast<size_t>(it - m_keys.begin())];
+}
+
+void StrictConfigSection::fail(const std::string& key, const std::string& problem) const {
+    throw std::invalid_argument("ini section [" + m_section + "], key '" + key + "': " + problem);
+}
+
+void StrictConfigSection::read(const std::string& key, double& value) {
+    const std::string* s = raw(key);
+    if (!s) return;
+    double v;
+    if (!parseDouble(*s, v)) fail(key, "expected a finite number, got '" + *s + "'");
+    value = v;
+}
+
+void StrictConfigSection::read(const std::string& key, float& value) {
+    double v = value;
+    read(key, v);
+    if (std::abs(v) > std::numeric_limits<float>::max()) fail(key, "value out of float range");
+    value = static_cast<float>(v);
+}
+
+void StrictConfigSection::read(const std::string& key, int& value) {
+    const std::string* s = raw(key);
+    if (!s) return;
+    char* end = nullptr;
+    const long v = s->empty() ? 0 : std::strtol(s->c_str(), &end, 10);
+    if (s->empty() || end != s->c_str() + s->size() || v < std::numeric_limits<int>::min() ||
+        v > std::numeric_limits<int>::max())
+        fail(key, "expected a whole number, got '" + *s + "'");
+    value = static_cast<int>(v);
+}
+
+void StrictConfigSection::read(const std::string& key, unsigned& value) {
+    int v = static_cast<int>(value);
+    read(key, v);
+    if (v < 0) fail(key, "expected a non-negative whole number, got " + std::to_string(v));
+    value = static_cast<unsigned>(v);
+}
+
+void StrictConfigSection::read(const std::string& key, bool& value) {
+    const std::string* s = raw(key);
+    if (!s) return;
+    const std::string l = lower(*s);
+    if (l == "true" || l == "1" || l == "yes" || l == "on")
+        value = true;
+    else if (l == "false" || l == "0" || l == "no" || l == "off")
+        value = false;
+    else
+        fail(key, "expected true or false, got '" + *s + "'");
+}
+
+void StrictConfigSection::read(const std::string& key, std::string& value) {
+    const std::string* s = raw(key);
+    if (s) value = *s;
+}
+
+void StrictConfigSection::read(const std::string& key, std::vector<double>& value,
+                               size_t expected_size) {
+    const std::string* s = raw(key);
+    if (!s) return;
+    std::vector<double> out;
+    for (const auto& tok : splitList(*s)) {
+        double v;
+        if (!parseDouble(tok, v)) fail(key, "expected a list of numbers, got '" + tok + "'");
+        out.push_back(v);
+    }
+    if (expected_size && out.size() != expected_size)
+        fail(key, "expected " + std::to_string(expected_size) + " numbers, got " +
+                      std::to_string(out.size()));
+    value = std::move(out);
+}
+
+void StrictConfigSection::read(const std::string& key, std::vector<std::string>& value) {
+    const std::string* s = raw(key);
+    if (s) value = splitList(*s);
+}
+
+void StrictConfigSection::readInRange(const std::string& key, double& value, double lo, double hi) {
+    double v = value;
+    read(key, v);
+    if (!(v >= lo && v <= hi)) {
+        std::ostringstream os;
+        os << "value " << v << " outside [" << lo << ", " << hi << "]";
+        fail(key, os.str());
+    }
+    value = v;
+}
+
+void StrictConfigSection::allow(const std::vector<std::string>& keys) {
+    for (const auto& k : keys)
+        if (has(k)) m_used.insert(k);
+}
+
+void StrictConfigSection::finish() const {
+    for (const auto& k : m_keys)
+        if (!m_used.count(k)) fail(k, "unknown key");
+}
+
+}  // namespace multibin
