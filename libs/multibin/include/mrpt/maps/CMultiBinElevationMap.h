@@ -1,0 +1,208 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <mrpt/config/CLoadableOptions.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/img/color_maps.h>
+#include <mrpt/maps/CHeightGridMap2D_Base.h>
+#include <mrpt/maps/CMetricMap.h>
+#include <mrpt/obs/obs_frwds.h>
+#include <mrpt/poses/CPose3DPDFGaussian.h>
+#include <mrpt/serialization/CSerializable.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "multibin/BinGrid.h"
+#include "multibin/EsriAsciiGrid.h"
+
+namespace mrpt::maps {
+
+/** Multi-bin terrain elevation map (Belter, Labecki, Skrzypczynski, ROBIO 2012).
+ *
+ * A 2.5D grid whose cells hold vertical bins (default 50 mm). Each bin keeps a certainty counter
+ * and a Kalman height with its variance; the cell's elevation is its most certain bin. Every
+ * sensor path ends in one insertion core fed with map-frame points that carry full 3x3
+ * covariances, propagated from the sensor model and the robot's 6-DoF pose PDF:
+ * C = J_R C_R J_R^T + J_S C_S J_S^T.
+ *
+ * Observations accepted by insertObservation():
+ * - mrpt::obs::CObservation2DRangeScan (laser; eq 14 continuity gate between consecutive scans),
+ * - mrpt::obs::CObservation3DRangeScan (its points, or its depth image unprojected),
+ * - mrpt::obs::CObservationPointCloud,
+ * - mrpt::obs::CObservationRobotPose: not inserted; the map keeps it and uses its covariance for
+ *   the observations that follow while it is younger than TInsertionOptions::robot_pose_max_dt_s.
+ *
+ * Pose uncertainty: insertObservation(obs, CPose3DPDFGaussian) uses the given PDF; a plain
+ * insertObservation(obs, pose) uses the latest CObservationRobotPose's covariance, or else
+ * TInsertionOptions::default_pose_sigmas (and counts a warning, see poseFallbackCount()).
+ *
+ * Extent: by default one grid that grows to cover the data it receives, up to
+ * TCreationOptions::max_size_m per axis; points beyond are counted and dropped. With
+ * `grow = false` the extent is fixed by min_x .. max_y.
+ *
+ * In a CMultiMetricMap ini file:
+ * \code
+ * [map]
+ * multiBinElevationMap_count = 1
+ * [map_multiBinElevationMap_00_creationOpts]
+ * resolution = 0.02      ; all keys optional
+ * [map_multiBinElevationMap_00_insertOpts]
+ * max_elevation_uncertainty = 0.1
+ * \endcode
+ * Unknown keys and malformed values are errors that name the section and the key.
+ *
+ * Observation likelihood is not implemented: canComputeObservationLikelihood() returns false.
+ */
+class CMultiBinElevationMap : public CMetricMap, public CHeightGridMap2D_Base {
+    DEFINE_SERIALIZABLE(CMultiBinElevationMap, mrpt::maps)
+
+public:
+    /** Grid geometry, fixed at creation (ini section `..._creationOpts`). */
+    struct TCreationOptions : public mrpt::config::CLoadableOptions {
+        double resolution_m = 0.02;  //!< cell size [m] (key `resolution`)
+        double bin_height_m = 0.05;  //!< vertical bin size [m] (key `bin_height`)
+        bool grow = true;            //!< grow to cover the data (key `grow`)
+        double max_size_m = 40.0;    //!< growth limit per axis [m] (key `max_size_m`)
+        /** Initial extent [m] (keys `min_x`, `max_x`, `min_y`, `max_y`); the fixed extent when
+         * grow = false. An empty range starts with no cells. */
+        double min_x = 0, max_x = 0, min_y = 0, max_y = 0;
+
+        void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
+                                const std::string& section) override;
+        void saveToConfigFile(mrpt::config::CConfigFileBase& target,
+                              const std::string& section) const override;
+        /** Throws std::invalid_argument if a value is out of range or the map would be too big. */
+        void validate() const;
+    } creationOptions;
+
+    /** How observations update the map (ini section `..._insertOpts`). */
+    struct TInsertionOptions : public mrpt::config::CLoadableOptions {
+        float certainty_increment = 1.0f;         //!< `a` of eqs 13-14
+        double max_elevation_uncertainty_m = 0.1; //!< Delta_max [m]: a point counts if 3 sigma_z <= it
+        double height_sigma_floor_m = 0.002;      //!< a bin's sigma never falls below this [m]
+        /** Pose sigmas (x, y, z [m], yaw, pitch, roll [rad]) used when no pose PDF is known. */
+        std::vector<double> default_pose_sigmas{0.01, 0.01, 0.01, 0.005, 0.005, 0.005};
+        double robot_pose_max_dt_s = 0.5;  //!< a CObservationRobotPose stays valid this long [s]
+        double range_sigma_m = 0.01;       //!< range noise of depth cameras and point clouds [m]
+        double min_range_m = 0.02, max_range_m = 20.0;  //!< accepted ranges [m]
+        /** Only observations with these sensor labels are inserted; empty = all. */
+        std::vector<std::string> sensor_labels;
+        mrpt::img::TColormap colormap = mrpt::img::cmJET;
+        bool color_by_sigma = false;  //!< 3D view coloured by sigma instead of height
+
+        void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
+                                const std::string& section) override;
+        void saveToConfigFile(mrpt::config::CConfigFileBase& target,
+                              const std::string& section) const override;
+        void validate() const;
+        /** The default pose covariance built from default_pose_sigmas. */
+        mrpt::math::CMatrixDouble66 defaultPoseCovariance() const;
+    } insertionOptions;
+
+    CMultiBinElevationMap();
+    explicit CMultiBinElevationMap(const TCreationOptions& creation);
+
+    /** Rebuilds an empty grid with new creation options. */
+    void setCreationOptions(const TCreationOptions& creation);
+
+    using CMetricMap::insertObservation;
+    /** Inserts an observation taken at a robot pose known with uncertainty. Publishes MRPT's
+     * insertion event like the base insertObservation(). */
+    bool insertObservation(const mrpt::obs::CObservation& obs,
+                           const mrpt::poses::CPose3DPDFGaussian& robotPose);
+
+    /** Inserts points already in the map frame with their covariance (the shared insertion core,
+     * for sensors the map does not model). `continuityBound_m` is eq 14's Delta_zmax. */
+    multibin::InsertStats insertPoints(
+        const multibin::PointsWithCov& mapPoints,
+        double continuityBound_m = std::numeric_limits<double>::infinity());
+
+    /** @name Queries @{ */
+    const multibin::BinGrid& grid() const { return m_grid; }
+    multibin::BinUpdateParams binUpdateParams() const;
+    /** Height [m] and sigma [m] of the cell at (x, y) from its winning bin; false if unobserved. */
+    bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
+    /** Winning-bin heights (or sigmas) of the window as a raster [m], NaN where unobserved;
+     * row 0 is the southernmost row. */
+    multibin::EsriAsciiGrid toRaster(bool sigma = false) const;
+    /** Colour image of the heights (or sigmas) with insertionOptions.colormap, north up; black
+     * where unobserved. */
+    void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
+    /** Sums of what every insertion did with its points. */
+    const multibin::InsertStats& insertStats() const { return m_stats; }
+    /** Observations inserted with the default pose covariance because no valid pose PDF was known. */
+    size_t poseFallbackCount() const { return m_poseFallbacks; }
+    /** Observations skipped because their sensor label is not in insertionOptions.sensor_labels. */
+    size_t skippedByLabelCount() const { return m_skippedByLabel; }
+    /** @} */
+
+    /** @name CMetricMap @{ */
+    bool isEmpty() const override;
+    std::string asString() const override;
+    void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
+    /** Writes PREFIX_height.png (height image, north up) and PREFIX.3Dscene. */
+    void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
+    float compute3DMatchingRatio(const mrpt::maps::CMetricMap* otherMap,
+                                 const mrpt::poses::CPose3D& otherMapPose,
+                                 const TMatchingRatioParams& params) const override;
+    /** @} */
+
+    /** @name CHeightGridMap2D_Base (DEM interface). Cell (cx, cy) counts from the window's
+     * lower-left corner. @{ */
+    bool insertIndividualPoint(const double x, const double y, const double z,
+                               const TPointInsertParams& params = TPointInsertParams()) override;
+    double dem_get_resolution() const override;
+    size_t dem_get_size_x() const override;
+    size_t dem_get_size_y() const override;
+    bool dem_get_z_by_cell(const size_t cx, const size_t cy, double& z_out) const override;
+    bool dem_get_z(const double x, const double y, double& z_out) const override;
+    void dem_update_map() override;
+    /** @} */
+
+    /** Window extent [m]. */
+    double getXMin() const;
+    double getXMax() const;
+    double getYMin() const;
+    double getYMax() const;
+
+    MAP_DEFINITION_START(CMultiBinElevationMap)
+    TCreationOptions creationOpts;
+    TInsertionOptions insertionOpts;
+    MAP_DEFINITION_END(CMultiBinElevationMap)
+
+private:
+    void internal_clear() override;
+    bool internal_insertObservation(
+        const mrpt::obs::CObservation& obs,
+        const std::optional<const mrpt::poses::CPose3D>& robotPose = std::nullopt) override;
+    double internal_computeObservationLikelihood(
+        const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const override;
+    bool internal_canComputeObservationLikelihood(
+        const mrpt::obs::CObservation& obs) const override;
+
+    /** Observation -> sensor-frame points -> map frame -> grid. */
+    bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
+                           const mrpt::poses::CPose3DPDFGaussian& robotPose);
+    /** Grows the window (if allowed) to cover map-frame points near the sensor. */
+    void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m);
+    bool acceptsLabel(const std::string& label) const;
+
+    multibin::BinGrid m_grid;
+    multibin::InsertStats m_stats;
+    size_t m_poseFallbacks = 0;
+    size_t m_skippedByLabel = 0;
+    /** The latest CObservationRobotPose: its PDF and timestamp. */
+    std::optional<mrpt::poses::CPose3DPDFGaussian> m_lastRobotPose;
+    mrpt::Clock::time_point m_lastRobotPoseTime;
+};
+
+}  // namespace mrpt::maps
+
+namespace multibin {
+/** Makes sure the library is linked and its map class registered with MRPT. Only needed by a
+ * program that names the map in an ini file only and links without the exported CMake target
+ * (which already keeps the library linked). */
+void registerMultiBinElevationMap();
+}  // namespace multibin

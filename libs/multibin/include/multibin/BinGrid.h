@@ -1,0 +1,204 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "multibin/PointsWithCovariance.h"
+
+namespace multibin {
+
+/** One vertical bin of a cell: a certainty counter and a 1-D Kalman height estimate (eq 15).
+ * 24 bytes; bins live in a pool shared by all cells, chained per cell. */
+struct Bin {
+    float height_m = 0;     //!< Kalman height estimate [m]
+    float variance_m2 = 0;  //!< Kalman variance, without the floor [m^2]
+    float certainty = 0;    //!< certainty counter c (eqs 13-14)
+    uint32_t pointCount = 0;
+    int16_t index = 0;      //!< vertical bin index n: covers [n, n+1) * binHeight [m]
+    uint16_t reserved = 0;
+    uint32_t next = 0;      //!< next bin of the same cell in the pool, or BinGrid::kNoBin
+};
+static_assert(sizeof(Bin) == 24, "a bin must stay within 24 bytes");
+
+/** Parameters of the per-point bin update (eqs 13-15). */
+struct BinUpdateParams {
+    double binHeight_m = 0.05;               //!< vertical bin size [m]
+    float certaintyIncrement = 1.0f;         //!< `a` of eqs 13-14
+    double maxElevationUncertainty_m = 0.1;  //!< Delta_max: a point counts if 3 sigma_z <= this [m]
+    double varianceFloor_m2 = 0.002 * 0.002; //!< reported variance never falls below this [m^2]
+};
+
+/** What happened to the points of one insertion. */
+struct InsertStats {
+    size_t accepted = 0;            //!< fused into a bin
+    size_t notFinite = 0;           //!< NaN/inf coordinates or covariance
+    size_t badCovariance = 0;       //!< covariance not symmetric positive-definite
+    size_t outsideMap = 0;          //!< (x, y) outside the grid window (after any growth)
+    size_t outsideBinRange = 0;     //!< height beyond the representable bin indices
+    size_t tooUncertain = 0;        //!< eq 13 gate: 3 sigma_z > Delta_max
+    size_t continuityRejected = 0;  //!< eq 14 gate: |h_m - h| > Delta_zmax on a certain bin
+    size_t rejected() const {
+        return notFinite + badCovariance + outsideMap + outsideBinRange + tooUncertain +
+               continuityRejected;
+    }
+    InsertStats& operator+=(const InsertStats& o);
+};
+
+/** Cell window in integer cell indices: cells ix0 .. ix0+nx-1, iy0 .. iy0+ny-1. Cell (ix, iy)
+ * covers [ix, ix+1) x [iy, iy+1) * cellSize [m]: the lattice is anchored to the map origin, so
+ * moving or growing the window never resamples a cell. */
+struct CellWindow {
+    int ix0 = 0, iy0 = 0;
+    int nx = 0, ny = 0;
+    bool contains(int ix, int iy) const {
+        return ix >= ix0 && iy >= iy0 && ix < ix0 + nx && iy < iy0 + ny;
+    }
+    size_t cellCount() const { return size_t(nx) * size_t(ny); }
+    bool operator==(const CellWindow& o) const {
+        return ix0 == o.ix0 && iy0 == o.iy0 && nx == o.nx && ny == o.ny;
+    }
+};
+
+/** The 2.5D grid of multi-bin cells with the shared insertion core.
+ *
+ * Storage is a circular buffer over the cell window (grid_map style): cell (ix, iy) lives in slot
+ * (ix mod nx) + (iy mod ny) nx, so moving the window only clears the slots of the cells that enter,
+ * and growing it re-slots the cell heads without touching any bin. */
+class BinGrid {
+public:
+    static constexpr uint32_t kNoBin = std::numeric_limits<uint32_t>::max();
+
+    explicit BinGrid(double cellSize_m = 0.02);
+
+    double cellSize_m() const { return m_cellSize_m; }
+    const CellWindow& window() const { return m_window; }
+    /** Index of the cell containing a coordinate [m]; clamped far outside any window, so
+     * absurd coordinates never overflow. */
+    int cellIndex(double coord_m) const {
+        constexpr double kLimit = std::numeric_limits<int>::max() / 4;
+        const double f = std::floor(coord_m / m_cellSize_m);
+        if (std::isnan(f)) return static_cast<int>(kLimit);
+        return static_cast<int>(f < -kLimit ? -kLimit : (f > kLimit ? kLimit : f));
+    }
+    double cellCenter_m(int index) const { return (index + 0.5) * m_cellSize_m; }
+
+    /** Drops all bins and sets an empty window; the cell size may change. */
+    void reset(double cellSize_m, const CellWindow& window);
+    /** Enlarges the window to include `w` (union), keeping every bin. */
+    void growToInclude(const CellWindow& w);
+    /** Translates the window to a new origin, same size. Cells that leave are passed to
+     * `onLeave(ix, iy)` (while still readable) and then cleared; cells still inside are untouched.
+     * Cost: proportional to the cells that enter. */
+    template <typename OnLeave>
+    void moveWindowTo(int ix0, int iy0, OnLeave&& onLeave);
+    void moveWindowTo(int ix0, int iy0) {
+        moveWindowTo(ix0, iy0, [](int, int) {});
+    }
+
+    /** Fuses points given in the map frame (eqs 13-15). `continuityBound_m` is Delta_zmax of eq 14
+     * for a laser scan, or infinity (stereo, depth: eq 13 only). */
+    InsertStats insertPoints(const PointsWithCov& mapPoints, const BinUpdateParams& params,
+                             double continuityBound_m = std::numeric_limits<double>::infinity());
+
+    /** Fuses one height measurement into cell (ix, iy), which must be inside the window.
+     * Returns false if a gate refused it (counted in `stats`). */
+    bool insertHeight(int ix, int iy, double height_m, double variance_m2,
+                      const BinUpdateParams& params, double continuityBound_m, InsertStats& stats);
+
+    /** The cell's winning bin: most certain, ties broken by the lower variance; nullptr if the cell
+     * has no bin with certainty > 0 or is outside the window. */
+    const Bin* winningBin(int ix, int iy) const;
+
+    /** Calls f(const Bin&) for every bin of the cell (any certainty). */
+    template <typename F>
+    void forEachBin(int ix, int iy, F&& f) const {
+        if (!m_window.contains(ix, iy)) return;
+        for (uint32_t b = m_heads[slot(ix, iy)]; b != kNoBin; b = m_pool[b].next) f(m_pool[b]);
+    }
+
+    /** Removes every bin of one cell. */
+    void clearCell(int ix, int iy);
+    /** Appends a bin as stored elsewhere (deserialization, grid-to-grid copies). */
+    void appendBin(int ix, int iy, const Bin& bin);
+
+    /** Number of bins in use, over all cells. */
+    size_t binCount() const { return m_pool.size() - m_freeCount; }
+    /** Memory held by the grid [bytes]: cell heads plus the bin pool. */
+    size_t memoryBytes() const {
+        return m_heads.capacity() * sizeof(uint32_t) + m_pool.capacity() * sizeof(Bin);
+    }
+    bool empty() const { return binCount() == 0; }
+
+    /** Reported standard deviation of a bin: sqrt(max(variance, floor)) [m]. */
+    static double sigma_m(const Bin& b, const BinUpdateParams& p) {
+        return std::sqrt(std::max<double>(b.variance_m2, p.varianceFloor_m2));
+    }
+
+private:
+    size_t slot(int ix, int iy) const {
+        int sx = ix % m_window.nx, sy = iy % m_window.ny;
+        if (sx < 0) sx += m_window.nx;
+        if (sy < 0) sy += m_window.ny;
+        return size_t(sx) + size_t(sy) * size_t(m_window.nx);
+    }
+    uint32_t allocateBin();
+    void releaseChain(uint32_t head);
+
+    double m_cellSize_m;
+    CellWindow m_window;
+    std::vector<uint32_t> m_heads;  //!< per slot: first bin of the cell or kNoBin
+    std::vector<Bin> m_pool;        //!< all bins; free ones are chained from m_freeHead
+    uint32_t m_freeHead = kNoBin;
+    size_t m_freeCount = 0;
+};
+
+template <typename OnLeave>
+void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
+    const CellWindow oldW = m_window;
+    CellWindow newW = oldW;
+    newW.ix0 = ix0;
+    newW.iy0 = iy0;
+    if (oldW.nx == 0 || oldW.ny == 0) {
+        m_window = newW;
+        return;
+    }
+    // Slots are keyed by (ix mod nx, iy mod ny): a cell that stays keeps its slot. Each entering
+    // cell reuses the slot of exactly one leaving cell, so visiting the entering cells (in the new
+    // window, not in the old one) and clearing the leaver stored there does all the work.
+    const bool disjoint = ix0 >= oldW.ix0 + oldW.nx || ix0 + oldW.nx <= oldW.ix0 ||
+                          iy0 >= oldW.iy0 + oldW.ny || iy0 + oldW.ny <= oldW.iy0;
+    auto leaverOf = [&](int ix, int iy, int& lx, int& ly) {
+        // The old-window cell sharing this slot.
+        lx = oldW.ix0 + (((ix - oldW.ix0) % oldW.nx) + oldW.nx) % oldW.nx;
+        ly = oldW.iy0 + (((iy - oldW.iy0) % oldW.ny) + oldW.ny) % oldW.ny;
+    };
+    auto handleEntering = [&](int ix, int iy) {
+        int lx, ly;
+        leaverOf(ix, iy, lx, ly);
+        if (m_heads[slot(lx, ly)] != kNoBin) {
+            onLeave(lx, ly);
+            clearCell(lx, ly);
+        }
+    };
+    if (disjoint) {
+        for (int iy = iy0; iy < iy0 + oldW.ny; iy++)
+            for (int ix = ix0; ix < ix0 + oldW.nx; ix++) handleEntering(ix, iy);
+    } else {
+        for (int iy = iy0; iy < iy0 + oldW.ny; iy++) {
+            const bool rowInOld = iy >= oldW.iy0 && iy < oldW.iy0 + oldW.ny;
+            for (int ix = ix0; ix < ix0 + oldW.nx; ix++) {
+                if (rowInOld && ix >= oldW.ix0 && ix < oldW.ix0 + oldW.nx) {
+                    ix = std::min(ix0 + oldW.nx, oldW.ix0 + oldW.nx) - 1;  // skip kept run
+                    continue;
+                }
+                handleEntering(ix, iy);
+            }
+        }
+    }
+    m_window = newW;
+}
+
+}  // namespace multibin

@@ -1,0 +1,324 @@
+/* Part of the multibin elevation-mapping library. */
+#include <mrpt/core/initializer.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/TMetricMapTypesRegistry.h>
+#include <mrpt/rtti/CObject.h>
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "multibin/StrictConfigSection.h"
+
+using namespace mrpt::maps;
+
+// "multiBinElevationMap" is the name used in CMultiMetricMap ini files (multiBinElevationMap_count).
+MAP_DEFINITION_REGISTER("mrpt::maps::CMultiBinElevationMap,multiBinElevationMap",
+                        mrpt::maps::CMultiBinElevationMap)
+
+IMPLEMENTS_SERIALIZABLE(CMultiBinElevationMap, CMetricMap, mrpt::maps)
+
+// Register with MRPT's class registry when the library loads, so polymorphic deserialization
+// (CArchive::ReadObject) finds the class in any program that loads the library.
+MRPT_INITIALIZER(registerMultiBinElevationMapClass) {
+    mrpt::rtti::registerClass(CLASS_ID(CMultiBinElevationMap));
+}
+
+namespace multibin {
+void registerMultiBinElevationMap() {
+    // Registration happens at load time; naming this function forces the library to be linked.
+    mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CMultiBinElevationMap));
+}
+}  // namespace multibin
+
+namespace {
+// Keys MRPT itself puts in every `_creationOpts` section (TMapGenericParams).
+const std::vector<std::string> kGenericMapKeys = {
+    "enableSaveAs3DObject", "enableObservationLikelihood", "enableObservationInsertion"};
+
+const char* colormapName(mrpt::img::TColormap c) {
+    switch (c) {
+        case mrpt::img::cmGRAYSCALE: return "grayscale";
+        case mrpt::img::cmJET: return "jet";
+        case mrpt::img::cmHOT: return "hot";
+        default: return "jet";
+    }
+}
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Options
+// ---------------------------------------------------------------------------------------------
+void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
+    const mrpt::config::CConfigFileBase& source, const std::string& section) {
+    multibin::StrictConfigSection s(source, section);
+    s.read("resolution", resolution_m);
+    s.read("bin_height", bin_height_m);
+    s.read("grow", grow);
+    s.read("max_size_m", max_size_m);
+    s.read("min_x", min_x);
+    s.read("max_x", max_x);
+    s.read("min_y", min_y);
+    s.read("max_y", max_y);
+    s.allow(kGenericMapKeys);
+    s.finish();
+    validate();
+}
+
+void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(
+    mrpt::config::CConfigFileBase& c, const std::string& section) const {
+    c.write(section, "resolution", resolution_m);
+    c.write(section, "bin_height", bin_height_m);
+    c.write(section, "grow", grow);
+    c.write(section, "max_size_m", max_size_m);
+    c.write(section, "min_x", min_x);
+    c.write(section, "max_x", max_x);
+    c.write(section, "min_y", min_y);
+    c.write(section, "max_y", max_y);
+}
+
+void CMultiBinElevationMap::TCreationOptions::validate() const {
+    auto bad = [](const std::string& key, const std::string& what) {
+        throw std::invalid_argument("CMultiBinElevationMap creation option '" + key + "': " + what);
+    };
+    if (!(resolution_m > 0) || !std::isfinite(resolution_m))
+        bad("resolution", "must be a positive cell size [m]");
+    if (!(bin_height_m > 0) || !std::isfinite(bin_height_m))
+        bad("bin_height", "must be a positive bin height [m]");
+    if (!(max_size_m > 0) || !std::isfinite(max_size_m))
+        bad("max_size_m", "must be a positive size [m]");
+    if (max_x < min_x || max_y < min_y) bad("min_x/max_x/min_y/max_y", "max must not be below min");
+    if (!grow && (max_x <= min_x || max_y <= min_y))
+        bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
+    // Refuse before allocating: the cell heads alone take 4 bytes per cell.
+    const double side_cells = std::max({max_size_m, max_x - min_x, max_y - min_y}) / resolution_m;
+    constexpr double kMaxCells = 2.0e8;  // 800 MB of cell heads
+    if (side_cells * side_cells > kMaxCells) {
+        std::ostringstream os;
+        os << "a map of " << side_cells << " x " << side_cells << " cells (" << resolution_m
+           << " m cells) would need " << side_cells * side_cells * 4 / 1e9
+           << " GB for cell heads alone; use a coarser resolution or a smaller max_size_m";
+        bad("max_size_m", os.str());
+    }
+}
+
+void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
+    const mrpt::config::CConfigFileBase& source, const std::string& section) {
+    multibin::StrictConfigSection s(source, section);
+    s.read("certainty_increment", certainty_increment);
+    s.read("max_elevation_uncertainty", max_elevation_uncertainty_m);
+    s.read("height_sigma_floor", height_sigma_floor_m);
+    s.read("default_pose_sigmas", default_pose_sigmas, 6);
+    s.read("robot_pose_max_dt", robot_pose_max_dt_s);
+    s.read("range_sigma", range_sigma_m);
+    s.read("min_range", min_range_m);
+    s.read("max_range", max_range_m);
+    s.read("sensor_labels", sensor_labels);
+    std::string cmap = colormapName(colormap);
+    s.read("colormap", cmap);
+    if (cmap == "jet")
+        colormap = mrpt::img::cmJET;
+    else if (cmap == "hot")
+        colormap = mrpt::img::cmHOT;
+    else if (cmap == "grayscale")
+        colormap = mrpt::img::cmGRAYSCALE;
+    else
+        s.fail("colormap", "expected jet, hot or grayscale, got '" + cmap + "'");
+    s.read("color_by_sigma", color_by_sigma);
+    s.finish();
+    validate();
+}
+
+void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(
+    mrpt::config::CConfigFileBase& c, const std::string& section) const {
+    c.write(section, "certainty_increment", certainty_increment);
+    c.write(section, "max_elevation_uncertainty", max_elevation_uncertainty_m);
+    c.write(section, "height_sigma_floor", height_sigma_floor_m);
+    std::ostringstream sig;
+    sig.precision(17);
+    for (size_t i = 0; i < default_pose_sigmas.size(); i++)
+        sig << (i ? " " : "") << default_pose_sigmas[i];
+    c.write(section, "default_pose_sigmas", sig.str());
+    c.write(section, "robot_pose_max_dt", robot_pose_max_dt_s);
+    c.write(section, "range_sigma", range_sigma_m);
+    c.write(section, "min_range", min_range_m);
+    c.write(section, "max_range", max_range_m);
+    std::string labels;
+    for (const auto& l : sensor_labels) labels += (labels.empty() ? "" : ",") + l;
+    c.write(section, "sensor_labels", labels);
+    c.write(section, "colormap", std::string(colormapName(colormap)));
+    c.write(section, "color_by_sigma", color_by_sigma);
+}
+
+void CMultiBinElevationMap::TInsertionOptions::validate() const {
+    auto bad = [](const std::string& key, const std::string& what) {
+        throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key + "': " +
+                                    what);
+    };
+    if (!(certainty_increment > 0)) bad("certainty_increment", "must be positive");
+    if (!(max_elevation_uncertainty_m > 0)) bad("max_elevation_uncertainty", "must be positive [m]");
+    if (!(height_sigma_floor_m >= 0)) bad("height_sigma_floor", "must be >= 0 [m]");
+    if (default_pose_sigmas.size() != 6) bad("default_pose_sigmas", "needs 6 values");
+    for (double v : default_pose_sigmas)
+        if (!(v >= 0)) bad("default_pose_sigmas", "values must be >= 0");
+    if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt", "must be >= 0 [s]");
+    if (!(range_sigma_m > 0)) bad("range_sigma", "must be positive [m]");
+    if (!(min_range_m >= 0 && max_range_m > min_range_m))
+        bad("min_range/max_range", "need 0 <= min_range < max_range [m]");
+}
+
+mrpt::math::CMatrixDouble66 CMultiBinElevationMap::TInsertionOptions::defaultPoseCovariance()
+    const {
+    mrpt::math::CMatrixDouble66 C;
+    C.setZero();
+    for (int i = 0; i < 6; i++) C(i, i) = default_pose_sigmas[size_t(i)] * default_pose_sigmas[size_t(i)];
+    return C;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Map definition (CMultiMetricMap ini files)
+// ---------------------------------------------------------------------------------------------
+CMultiBinElevationMap::TMapDefinition::TMapDefinition() = default;
+
+void CMultiBinElevationMap::TMapDefinition::loadFromConfigFile_map_specific(
+    const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix) {
+    creationOpts.loadFromConfigFile(source, sectionNamePrefix + "_creationOpts");
+    insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
+}
+
+void CMultiBinElevationMap::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const {
+    creationOpts.dumpToTextStream(out);
+    insertionOpts.dumpToTextStream(out);
+}
+
+mrpt::maps::CMetricMap* CMultiBinElevationMap::internal_CreateFromMapDefinition(
+    const mrpt::maps::TMetricMapInitializer& _def) {
+    const auto& def = dynamic_cast<const CMultiBinElevationMap::TMapDefinition&>(_def);
+    auto* obj = new CMultiBinElevationMap(def.creationOpts);
+    obj->insertionOptions = def.insertionOpts;
+    return obj;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Construction, queries
+// ---------------------------------------------------------------------------------------------
+CMultiBinElevationMap::CMultiBinElevationMap() { setCreationOptions(TCreationOptions()); }
+
+CMultiBinElevationMap::CMultiBinElevationMap(const TCreationOptions& creation) {
+    setCreationOptions(creation);
+}
+
+void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation) {
+    creation.validate();
+    creationOptions = creation;
+    internal_clear();
+}
+
+void CMultiBinElevationMap::internal_clear() {
+    const auto& c = creationOptions;
+    multibin::CellWindow w;
+    const double res = c.resolution_m;
+    if (c.max_x > c.min_x && c.max_y > c.min_y) {
+        w.ix0 = static_cast<int>(std::floor(c.min_x / res));
+        w.iy0 = static_cast<int>(std::floor(c.min_y / res));
+        w.nx = static_cast<int>(std::ceil(c.max_x / res)) - w.ix0;
+        w.ny = static_cast<int>(std::ceil(c.max_y / res)) - w.iy0;
+    }
+    m_grid.reset(res, w);
+    m_stats = {};
+    m_poseFallbacks = 0;
+    m_skippedByLabel = 0;
+    m_lastRobotPose.reset();
+}
+
+multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
+    multibin::BinUpdateParams p;
+    p.binHeight_m = creationOptions.bin_height_m;
+    p.certaintyIncrement = insertionOptions.certainty_increment;
+    p.maxElevationUncertainty_m = insertionOptions.max_elevation_uncertainty_m;
+    p.varianceFloor_m2 = insertionOptions.height_sigma_floor_m * insertionOptions.height_sigma_floor_m;
+    return p;
+}
+
+bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
+                                      double& sigma_m) const {
+    const multibin::Bin* b = m_grid.winningBin(m_grid.cellIndex(x_m), m_grid.cellIndex(y_m));
+    if (!b) return false;
+    height_m = b->height_m;
+    sigma_m = multibin::BinGrid::sigma_m(*b, binUpdateParams());
+    return true;
+}
+
+bool CMultiBinElevationMap::isEmpty() const { return m_grid.empty(); }
+
+std::string CMultiBinElevationMap::asString() const {
+    std::ostringstream os;
+    os << "CMultiBinElevationMap: " << m_grid.window().nx << " x " << m_grid.window().ny
+       << " cells of " << m_grid.cellSize_m() << " m, x in [" << getXMin() << ", " << getXMax()
+       << "], y in [" << getYMin() << ", " << getYMax() << "] m, " << m_grid.binCount()
+       << " bins of " << creationOptions.bin_height_m << " m";
+    return os.str();
+}
+
+double CMultiBinElevationMap::getXMin() const { return m_grid.window().ix0 * m_grid.cellSize_m(); }
+double CMultiBinElevationMap::getXMax() const {
+    return (m_grid.window().ix0 + m_grid.window().nx) * m_grid.cellSize_m();
+}
+double CMultiBinElevationMap::getYMin() const { return m_grid.window().iy0 * m_grid.cellSize_m(); }
+double CMultiBinElevationMap::getYMax() const {
+    return (m_grid.window().iy0 + m_grid.window().ny) * m_grid.cellSize_m();
+}
+
+float CMultiBinElevationMap::compute3DMatchingRatio(const mrpt::maps::CMetricMap*,
+                                                    const mrpt::poses::CPose3D&,
+                                                    const TMatchingRatioParams&) const {
+    return 0;  // not a map used for registration
+}
+
+double CMultiBinElevationMap::internal_computeObservationLikelihood(
+    const mrpt::obs::CObservation&, const mrpt::poses::CPose3D&) const {
+    return 0;  // see internal_canComputeObservationLikelihood()
+}
+
+bool CMultiBinElevationMap::internal_canComputeObservationLikelihood(
+    const mrpt::obs::CObservation&) const {
+    return false;  // a terrain map, not a localisation map: no likelihood model
+}
+
+// ---------------------------------------------------------------------------------------------
+// DEM interface
+// ---------------------------------------------------------------------------------------------
+bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y, const double z,
+                                                  const TPointInsertParams& params) {
+    const double sigma = params.pt_z_std > 0 ? params.pt_z_std : insertionOptions.range_sigma_m;
+    multibin::PointsWithCov pts(1);
+    pts[0].point_m = Eigen::Vector3f(float(x), float(y), float(z));
+    // Horizontal position taken as exact to the cell; only the height variance matters here.
+    const float tiny = static_cast<float>(1e-12);
+    pts[0].cov_m2 = {tiny, 0, 0, tiny, 0, float(sigma * sigma)};
+    growToCover(pts, Eigen::Vector3d(x, y, z));
+    return insertPoints(pts).accepted == 1;
+}
+
+double CMultiBinElevationMap::dem_get_resolution() const { return m_grid.cellSize_m(); }
+size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_grid.window().nx); }
+size_t CMultiBinElevationMap::dem_get_size_y() const { return size_t(m_grid.window().ny); }
+
+bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
+                                              double& z_out) const {
+    if (cx >= dem_get_size_x() || cy >= dem_get_size_y()) return false;
+    const multibin::Bin* b =
+        m_grid.winningBin(m_grid.window().ix0 + int(cx), m_grid.window().iy0 + int(cy));
+    if (!b) return false;
+    z_out = b->height_m;
+    return true;
+}
+
+bool CMultiBinElevationMap::dem_get_z(const double x, const double y, double& z_out) const {
+    double sigma;
+    return getHeight(x, y, z_out, sigma);
+}
+
+void CMultiBinElevationMap::dem_update_map() {
+    // Every insertion updates the bins at once; nothing is deferred yet.
+}

@@ -1,0 +1,216 @@
+/* Part of the multibin elevation-mapping library.
+ * CMultiBinElevationMap: observation dispatch, pose PDFs and the insertion core. */
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRobotPose.h>
+#include <mrpt/system/datetime.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "multibin/PosePropagation.h"
+#include "multibin/sensors/RangeSigmaCurve.h"
+
+using namespace mrpt::maps;
+using multibin::PointsWithCov;
+using multibin::PointWithCov;
+
+namespace {
+
+/** Points of a laser scan in its sensor frame, with range-only covariance (bearing exact). */
+void laserScanPoints(const mrpt::obs::CObservation2DRangeScan& scan, double minRange_m,
+                     PointsWithCov& out) {
+    const multibin::sensors::RangeSigmaCurve sigmaOfRange;
+    out.clear();
+    out.reserve(scan.getScanSize());
+    for (size_t i = 0; i < scan.getScanSize(); i++) {
+        if (!scan.getScanRangeValidity(i)) continue;
+        const float r = scan.getScanRange(i);
+        if (!std::isfinite(r) || r < minRange_m || r >= scan.maxRange) continue;
+        const float a = scan.getScanAngle(i);
+        const Eigen::Vector3f dir(std::cos(a), std::sin(a), 0.f);
+        out.push_back({dir * r, multibin::rangeOnlyCovariance(dir, float(sigmaOfRange(r)))});
+    }
+}
+
+/** Appends a sensor-frame point measured along its ray with range noise sigma_m. */
+void appendRangePoint(float x, float y, float z, double minRange_m, double maxRange_m,
+                      double sigma_m, PointsWithCov& out) {
+    const Eigen::Vector3f p(x, y, z);
+    const float r = p.norm();
+    if (!std::isfinite(r) || r < minRange_m || r > maxRange_m) return;
+    const Eigen::Vector3f dir = p / r;
+    // A tiny isotropic term keeps the covariance positive-definite (bearing is nearly exact).
+    multibin::SymmetricCov3 c = multibin::rangeOnlyCovariance(dir, float(sigma_m));
+    const float lateral2 = float(1e-6 * r * r);  // ~1 mrad bearing noise
+    c.xx += lateral2;
+    c.yy += lateral2;
+    c.zz += lateral2;
+    out.push_back({p, c});
+}
+
+}  // namespace
+
+bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
+    const auto& labels = insertionOptions.sensor_labels;
+    return labels.empty() || std::find(labels.begin(), labels.end(), label) != labels.end();
+}
+
+bool CMultiBinElevationMap::internal_insertObservation(
+    const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose) {
+    if (const auto* rp = dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs)) {
+        // Not inserted: kept as the pose PDF of the observations that follow.
+        m_lastRobotPose = rp->pose;
+        m_lastRobotPoseTime = rp->timestamp;
+        return false;
+    }
+    mrpt::poses::CPose3DPDFGaussian pdf;
+    bool haveCov = false;
+    if (m_lastRobotPose) {
+        const bool timesKnown = obs.timestamp != INVALID_TIMESTAMP &&
+                                m_lastRobotPoseTime != INVALID_TIMESTAMP;
+        const double dt =
+            timesKnown ? std::abs(mrpt::system::timeDifference(m_lastRobotPoseTime, obs.timestamp))
+                       : std::numeric_limits<double>::infinity();
+        if (dt <= insertionOptions.robot_pose_max_dt_s) {
+            pdf = *m_lastRobotPose;
+            haveCov = true;
+        }
+    }
+    if (!haveCov) {
+        pdf.cov = insertionOptions.defaultPoseCovariance();
+        m_poseFallbacks++;
+    }
+    if (robotPose)
+        pdf.mean = *robotPose;  // the caller's mean wins; the covariance comes from the PDF
+    else if (!haveCov)
+        pdf.mean = mrpt::poses::CPose3D();
+    return insertWithPosePdf(obs, pdf);
+}
+
+bool CMultiBinElevationMap::insertObservation(const mrpt::obs::CObservation& obs,
+                                              const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    const bool done = insertWithPosePdf(obs, robotPose);
+    if (done) {
+        publishEvent(mrptEventMetricMapInsert(this, &obs, robotPose.mean));
+    }
+    return done;
+}
+
+bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
+                                              const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    if (!acceptsLabel(obs.sensorLabel)) {
+        m_skippedByLabel++;
+        return false;
+    }
+    for (int i = 0; i < 6; i++)
+        if (!std::isfinite(robotPose.mean[i]))
+            throw std::invalid_argument("CMultiBinElevationMap: robot pose of observation '" +
+                                        obs.sensorLabel + "' has a NaN or infinite component");
+    obs.load();  // externally stored observations
+
+    PointsWithCov sensorPoints;
+    mrpt::poses::CPose3D sensorPose;
+    double continuityBound_m = std::numeric_limits<double>::infinity();
+    const auto& io = insertionOptions;
+    if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
+        laserScanPoints(*scan, io.min_range_m, sensorPoints);
+        sensorPose = scan->sensorPose;
+    } else if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
+        sensorPose = depth->sensorPose;
+        if (depth->hasPoints3D) {
+            for (size_t i = 0; i < depth->points3D_x.size(); i++)
+                appendRangePoint(depth->points3D_x[i], depth->points3D_y[i], depth->points3D_z[i],
+                                 io.min_range_m, io.max_range_m, io.range_sigma_m, sensorPoints);
+        } else if (depth->hasRangeImage) {
+            mrpt::maps::CSimplePointsMap local;
+            mrpt::obs::T3DPointsProjectionParams pp;
+            pp.takeIntoAccountSensorPoseOnRobot = false;  // sensor frame (+x forward)
+            const_cast<mrpt::obs::CObservation3DRangeScan*>(depth)->unprojectInto(local, pp);
+            const auto& xs = local.getPointsBufferRef_x();
+            const auto& ys = local.getPointsBufferRef_y();
+            const auto& zs = local.getPointsBufferRef_z();
+            for (size_t i = 0; i < xs.size(); i++)
+                appendRangePoint(xs[i], ys[i], zs[i], io.min_range_m, io.max_range_m,
+                                 io.range_sigma_m, sensorPoints);
+        }
+    } else if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
+        sensorPose = cloud->sensorPose;
+        if (cloud->pointcloud) {
+            const auto& xs = cloud->pointcloud->getPointsBufferRef_x();
+            const auto& ys = cloud->pointcloud->getPointsBufferRef_y();
+            const auto& zs = cloud->pointcloud->getPointsBufferRef_z();
+            for (size_t i = 0; i < xs.size(); i++)
+                appendRangePoint(xs[i], ys[i], zs[i], io.min_range_m, io.max_range_m,
+                                 io.range_sigma_m, sensorPoints);
+        }
+    } else {
+        return false;  // not an observation this map models
+    }
+    if (sensorPoints.empty()) return false;
+
+    const multibin::PosePropagator propagator(robotPose, sensorPose);
+    PointsWithCov mapPoints;
+    propagator.apply(sensorPoints, mapPoints);
+    growToCover(mapPoints, propagator.sensorOriginInMap_m());
+    return insertPoints(mapPoints, continuityBound_m).accepted > 0;
+}
+
+multibin::InsertStats CMultiBinElevationMap::insertPoints(const PointsWithCov& mapPoints,
+                                                          double continuityBound_m) {
+    const multibin::InsertStats s = m_grid.insertPoints(mapPoints, binUpdateParams(), continuityBound_m);
+    m_stats += s;
+    return s;
+}
+
+void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
+                                        const Eigen::Vector3d& sensor_m) {
+    const auto& c = creationOptions;
+    if (!c.grow || mapPoints.empty()) return;
+    // Only points within max_size_m/2 of the sensor can make the grid grow: a stray far return
+    // must not stretch the map.
+    const double half = 0.5 * c.max_size_m;
+    double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
+    for (const PointWithCov& p : mapPoints) {
+        const double x = p.point_m.x(), y = p.point_m.y();
+        if (!(std::abs(x - sensor_m.x()) <= half && std::abs(y - sensor_m.y()) <= half)) continue;
+        xmin = std::min(xmin, x);
+        xmax = std::max(xmax, x);
+        ymin = std::min(ymin, y);
+        ymax = std::max(ymax, y);
+    }
+    if (!(xmin <= xmax)) return;
+    const multibin::CellWindow& cur = m_grid.window();
+    int ixLo = m_grid.cellIndex(xmin), ixHi = m_grid.cellIndex(xmax);
+    int iyLo = m_grid.cellIndex(ymin), iyHi = m_grid.cellIndex(ymax);
+    const bool haveWindow = cur.nx > 0 && cur.ny > 0;
+    if (haveWindow && cur.contains(ixLo, iyLo) && cur.contains(ixHi, iyHi)) return;
+
+    // Grow with a margin, so a moving sensor does not re-slot the grid at every scan.
+    const int margin = std::max(1, static_cast<int>(std::ceil(1.0 / m_grid.cellSize_m())));
+    const int maxCells = std::max(1, static_cast<int>(std::floor(c.max_size_m / m_grid.cellSize_m())));
+    auto clampAxis = [&](int curLo, int curN, int lo, int hi, int& outLo, int& outN) {
+        lo -= margin;
+        hi += margin;
+        if (haveWindow) {
+            lo = std::min(lo, curLo);
+            hi = std::max(hi, curLo + curN - 1);
+        }
+        if (hi - lo + 1 > maxCells) {
+            // Keep the current window and extend towards the new data only up to the limit.
+            const int keepLo = haveWindow ? curLo : lo, keepHi = haveWindow ? curLo + curN - 1 : hi;
+            if (lo < keepLo) lo = std::max(lo, keepHi - maxCells + 1);
+            if (hi > keepHi) hi = std::min(hi, lo + maxCells - 1);
+            if (hi - lo + 1 > maxCells) hi = lo + maxCells - 1;
+        }
+        outLo = lo;
+        outN = hi - lo + 1;
+    };
+    multibin::CellWindow want;
+    clampAxis(cur.ix0, cur.nx, ixLo, ixHi, want.ix0, want.nx);
+    clampAxis(cur.iy0, cur.ny, iyLo, iyHi, want.iy0, want.ny);
+    m_grid.growToInclude(want);
+}

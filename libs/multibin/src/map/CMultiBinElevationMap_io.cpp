@@ -1,0 +1,159 @@
+/* Part of the multibin elevation-mapping library.
+ * CMultiBinElevationMap: serialization, rasters, images and files. */
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cmath>
+#include <stdexcept>
+
+using namespace mrpt::maps;
+
+namespace {
+constexpr const char* kCreationSection = "creation";
+constexpr const char* kInsertionSection = "insertion";
+// A serialized window larger than this is corrupt (the options refuse such maps anyway).
+constexpr double kMaxSerializedCells = 2.0e8;
+}  // namespace
+
+uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 0; }
+
+void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) const {
+    // Options travel as ini text: readable, and keys can be added without a new version.
+    mrpt::config::CConfigFileMemory ini;
+    creationOptions.saveToConfigFile(ini, kCreationSection);
+    insertionOptions.saveToConfigFile(ini, kInsertionSection);
+    std::string iniText;
+    ini.getContent(iniText);
+    out << iniText;
+
+    const multibin::CellWindow& w = m_grid.window();
+    out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
+    uint64_t nonEmpty = 0;
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            bool any = false;
+            m_grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
+            nonEmpty += any;
+        }
+    out << nonEmpty;
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            uint16_t n = 0;
+            m_grid.forEachBin(ix, iy, [&](const multibin::Bin&) { n++; });
+            if (!n) continue;
+            out << int32_t(ix) << int32_t(iy) << n;
+            m_grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+                out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
+            });
+        }
+}
+
+void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version) {
+    switch (version) {
+        case 0: {
+            std::string iniText;
+            in >> iniText;
+            mrpt::config::CConfigFileMemory ini(iniText);
+            TCreationOptions creation;
+            TInsertionOptions insertion;
+            creation.loadFromConfigFile(ini, kCreationSection);
+            insertion.loadFromConfigFile(ini, kInsertionSection);
+
+            int32_t ix0, iy0, nx, ny;
+            in >> ix0 >> iy0 >> nx >> ny;
+            if (nx < 0 || ny < 0 || double(nx) * double(ny) > kMaxSerializedCells)
+                throw std::runtime_error(
+                    "CMultiBinElevationMap: corrupt serialized map (window of " +
+                    std::to_string(nx) + " x " + std::to_string(ny) + " cells)");
+            creationOptions = creation;
+            insertionOptions = insertion;
+            internal_clear();
+            m_grid.reset(creation.resolution_m, multibin::CellWindow{ix0, iy0, nx, ny});
+
+            uint64_t nonEmpty;
+            in >> nonEmpty;
+            if (nonEmpty > uint64_t(nx) * uint64_t(ny))
+                throw std::runtime_error("CMultiBinElevationMap: corrupt serialized map (" +
+                                         std::to_string(nonEmpty) + " cells in a window of " +
+                                         std::to_string(uint64_t(nx) * uint64_t(ny)) + ")");
+            for (uint64_t c = 0; c < nonEmpty; c++) {
+                int32_t ix, iy;
+                uint16_t n;
+                in >> ix >> iy >> n;
+                if (!m_grid.window().contains(ix, iy))
+                    throw std::runtime_error(
+                        "CMultiBinElevationMap: corrupt serialized map (cell outside window)");
+                for (uint16_t k = 0; k < n; k++) {
+                    multibin::Bin b;
+                    in >> b.height_m >> b.variance_m2 >> b.certainty >> b.pointCount >> b.index;
+                    if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) ||
+                        !(b.certainty >= 0))
+                        throw std::runtime_error(
+                            "CMultiBinElevationMap: corrupt serialized map (invalid bin)");
+                    m_grid.appendBin(ix, iy, b);
+                }
+            }
+        } break;
+        default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+    }
+}
+
+multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(bool sigma) const {
+    const multibin::CellWindow& w = m_grid.window();
+    multibin::EsriAsciiGrid g;
+    g.cellsize_m = m_grid.cellSize_m();
+    g.xllcenter_m = m_grid.cellCenter_m(w.ix0);
+    g.yllcenter_m = m_grid.cellCenter_m(w.iy0);
+    g.heights_m.setConstant(w.ny, w.nx, NAN);
+    const multibin::BinUpdateParams p = binUpdateParams();
+    for (int r = 0; r < w.ny; r++)
+        for (int c = 0; c < w.nx; c++) {
+            const multibin::Bin* b = m_grid.winningBin(w.ix0 + c, w.iy0 + r);
+            if (b) g.heights_m(r, c) = sigma ? float(multibin::BinGrid::sigma_m(*b, p)) : b->height_m;
+        }
+    return g;
+}
+
+void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
+    const multibin::EsriAsciiGrid g = toRaster(sigma);
+    const int rows = g.rows(), cols = g.cols();
+    img.resize(std::max(cols, 1), std::max(rows, 1), mrpt::img::CH_RGB);
+    img.filledRectangle(0, 0, std::max(cols, 1) - 1, std::max(rows, 1) - 1,
+                        mrpt::img::TColor(0, 0, 0));
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (int r = 0; r < rows; r++)
+        for (int c = 0; c < cols; c++) {
+            const float v = g.heights_m(r, c);
+            if (std::isnan(v)) continue;
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+        }
+    if (!(lo <= hi)) return;
+    const float span = hi > lo ? hi - lo : 1.f;
+    for (int r = 0; r < rows; r++)
+        for (int c = 0; c < cols; c++) {
+            const float v = g.heights_m(r, c);
+            if (std::isnan(v)) continue;
+            float R, G, B;
+            mrpt::img::colormap(insertionOptions.colormap, (v - lo) / span, R, G, B);
+            img.setPixel(c, rows - 1 - r,
+                         mrpt::img::TColor(uint8_t(255 * R), uint8_t(255 * G), uint8_t(255 * B)));
+        }
+}
+
+void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
+    const std::string& filNamePrefix) const {
+    mrpt::img::CImage img;
+    getAsImage(img);
+    img.saveToFile(filNamePrefix + "_height.png");
+    toRaster().save(filNamePrefix + "_height.asc");
+    mrpt::opengl::COpenGLScene scene;
+    auto obj = mrpt::opengl::CSetOfObjects::Create();
+    getVisualizationInto(*obj);
+    scene.insert(obj);
+    if (!scene.saveToFile(filNamePrefix + ".3Dscene"))
+        throw std::runtime_error("CMultiBinElevationMap: cannot write " + filNamePrefix +
+                                 ".3Dscene");
+}
