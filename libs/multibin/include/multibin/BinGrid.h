@@ -17,9 +17,9 @@ struct Bin {
     float variance_m2 = 0;  //!< Kalman variance, without the floor [m^2]
     float certainty = 0;    //!< certainty counter c (eqs 13-14)
     uint32_t pointCount = 0;
-    int16_t index = 0;      //!< vertical bin index n: covers [n, n+1) * binHeight [m]
+    int16_t index = 0;  //!< vertical bin index n: covers [n, n+1) * binHeight [m]
     uint16_t reserved = 0;
-    uint32_t next = 0;      //!< next bin of the same cell in the pool, or BinGrid::kNoBin
+    uint32_t next = 0;  //!< next bin of the same cell in the pool, or BinGrid::kNoBin
 };
 static_assert(sizeof(Bin) == 24, "a bin must stay within 24 bytes");
 
@@ -28,12 +28,13 @@ struct BinUpdateParams {
     double binHeight_m = 0.05;               //!< vertical bin size [m]
     float certaintyIncrement = 1.0f;         //!< `a` of eqs 13-14
     double maxElevationUncertainty_m = 0.1;  //!< Delta_max: a point counts if 3 sigma_z <= this [m]
-    double varianceFloor_m2 = 0.002 * 0.002; //!< reported variance never falls below this [m^2]
+    double varianceFloor_m2 = 0.002 * 0.002;  //!< reported variance never falls below this [m^2]
 };
 
 /** What happened to the points of one insertion. */
 struct InsertStats {
     size_t accepted = 0;            //!< fused into a bin
+    size_t outOfRange = 0;          //!< sensor reading invalid or outside the accepted range
     size_t notFinite = 0;           //!< NaN/inf coordinates or covariance
     size_t badCovariance = 0;       //!< covariance not symmetric positive-definite
     size_t outsideMap = 0;          //!< (x, y) outside the grid window (after any growth)
@@ -41,8 +42,8 @@ struct InsertStats {
     size_t tooUncertain = 0;        //!< eq 13 gate: 3 sigma_z > Delta_max
     size_t continuityRejected = 0;  //!< eq 14 gate: |h_m - h| > Delta_zmax on a certain bin
     size_t rejected() const {
-        return notFinite + badCovariance + outsideMap + outsideBinRange + tooUncertain +
-               continuityRejected;
+        return outOfRange + notFinite + badCovariance + outsideMap + outsideBinRange +
+               tooUncertain + continuityRejected;
     }
     InsertStats& operator+=(const InsertStats& o);
 };

@@ -12,11 +12,11 @@ namespace multibin {
  * the largest y: `heights_m(row, col)` is the sample centred at
  * (xllcenter + col * cellsize, yllcenter + row * cellsize). NODATA samples are NaN in memory. */
 struct EsriAsciiGrid {
-    Eigen::MatrixXf heights_m;   //!< [m], rows = y (south to north), cols = x
-    double xllcenter_m = 0;      //!< x of the centre of the lower-left sample [m]
-    double yllcenter_m = 0;      //!< y of the centre of the lower-left sample [m]
-    double cellsize_m = 1;       //!< sample spacing [m]
-    double nodata_value = -9999; //!< written for NaN samples
+    Eigen::MatrixXf heights_m;    //!< [m], rows = y (south to north), cols = x
+    double xllcenter_m = 0;       //!< x of the centre of the lower-left sample [m]
+    double yllcenter_m = 0;       //!< y of the centre of the lower-left sample [m]
+    double cellsize_m = 1;        //!< sample spacing [m]
+    double nodata_value = -9999;  //!< written for NaN samples
 
     int cols() const { return static_cast<int>(heights_m.cols()); }
     int rows() const { return static_cast<int>(heights_m.rows()); }

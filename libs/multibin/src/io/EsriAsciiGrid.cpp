@@ -88,8 +88,8 @@ EsriAsciiGrid EsriAsciiGrid::load(const std::string& path) {
 void EsriAsciiGrid::save(const std::string& path) const {
     std::FILE* f = std::fopen(path.c_str(), "w");
     if (!f) throw std::runtime_error("ESRI ASCII grid '" + path + "': cannot open for writing");
-    std::fprintf(f, "ncols %d\nnrows %d\nxllcenter %.6f\nyllcenter %.6f\ncellsize %.9f\n",
-                 cols(), rows(), xllcenter_m, yllcenter_m, cellsize_m);
+    std::fprintf(f, "ncols %d\nnrows %d\nxllcenter %.6f\nyllcenter %.6f\ncellsize %.9f\n", cols(),
+                 rows(), xllcenter_m, yllcenter_m, cellsize_m);
     std::fprintf(f, "NODATA_value %g\n", nodata_value);
     for (int r = rows() - 1; r >= 0; r--) {
         for (int c = 0; c < cols(); c++) {

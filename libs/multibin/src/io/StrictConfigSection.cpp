@@ -59,7 +59,8 @@ StrictConfigSection::StrictConfigSection(const mrpt::config::CConfigFileBase& so
     : m_source(source), m_section(std::move(section)) {
     if (m_source.sectionExists(m_section)) {
         m_source.getAllKeys(m_section, m_keys);
-        for (const auto& k : m_keys) m_values.push_back(trim(m_source.read_string(m_section, k, "")));
+        for (const auto& k : m_keys)
+            m_values.push_back(trim(m_source.read_string(m_section, k, "")));
     }
 }
 

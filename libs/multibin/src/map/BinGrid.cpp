@@ -9,6 +9,7 @@ namespace multibin {
 
 InsertStats& InsertStats::operator+=(const InsertStats& o) {
     accepted += o.accepted;
+    outOfRange += o.outOfRange;
     notFinite += o.notFinite;
     badCovariance += o.badCovariance;
     outsideMap += o.outsideMap;
@@ -94,12 +95,17 @@ void BinGrid::clearCell(int ix, int iy) {
 void BinGrid::appendBin(int ix, int iy, const Bin& bin) {
     if (!m_window.contains(ix, iy))
         throw std::out_of_range("BinGrid::appendBin: cell outside the window");
-    const uint32_t b = allocateBin();
+    const uint32_t b = allocateBin();  // may reallocate the pool: hold indices, not pointers
     m_pool[b] = bin;
     m_pool[b].next = kNoBin;
-    uint32_t* link = &m_heads[slot(ix, iy)];
-    while (*link != kNoBin) link = &m_pool[*link].next;
-    *link = b;
+    const size_t s = slot(ix, iy);
+    uint32_t last = m_heads[s];
+    if (last == kNoBin) {
+        m_heads[s] = b;
+        return;
+    }
+    while (m_pool[last].next != kNoBin) last = m_pool[last].next;
+    m_pool[last].next = b;
 }
 
 const Bin* BinGrid::winningBin(int ix, int iy) const {
@@ -131,15 +137,19 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
     }
     const auto n = static_cast<int16_t>(binPos);
 
-    uint32_t* link = &m_heads[slot(ix, iy)];
-    while (*link != kNoBin && m_pool[*link].index != n) link = &m_pool[*link].next;
-    if (*link == kNoBin) {
-        const uint32_t b = allocateBin();  // may reallocate the pool, not the heads
+    const size_t s = slot(ix, iy);
+    uint32_t prev = kNoBin, b = m_heads[s];
+    while (b != kNoBin && m_pool[b].index != n) {
+        prev = b;
+        b = m_pool[b].next;
+    }
+    if (b == kNoBin) {
+        b = allocateBin();  // may reallocate the pool: hold indices, not pointers
         m_pool[b].index = n;
         m_pool[b].next = kNoBin;
-        *link = b;
+        (prev == kNoBin ? m_heads[s] : m_pool[prev].next) = b;
     }
-    Bin& bin = m_pool[*link];
+    Bin& bin = m_pool[b];
 
     // Eq 14: a laser point must agree with a bin that is already certain (c > 0); a bin without
     // certainty has no height to compare against and accepts the point.

@@ -12,7 +12,8 @@
 
 using namespace mrpt::maps;
 
-// "multiBinElevationMap" is the name used in CMultiMetricMap ini files (multiBinElevationMap_count).
+// "multiBinElevationMap" is the name used in CMultiMetricMap ini files
+// (multiBinElevationMap_count).
 MAP_DEFINITION_REGISTER("mrpt::maps::CMultiBinElevationMap,multiBinElevationMap",
                         mrpt::maps::CMultiBinElevationMap)
 
@@ -38,10 +39,14 @@ const std::vector<std::string> kGenericMapKeys = {
 
 const char* colormapName(mrpt::img::TColormap c) {
     switch (c) {
-        case mrpt::img::cmGRAYSCALE: return "grayscale";
-        case mrpt::img::cmJET: return "jet";
-        case mrpt::img::cmHOT: return "hot";
-        default: return "jet";
+        case mrpt::img::cmGRAYSCALE:
+            return "grayscale";
+        case mrpt::img::cmJET:
+            return "jet";
+        case mrpt::img::cmHOT:
+            return "hot";
+        default:
+            return "jet";
     }
 }
 }  // namespace
@@ -65,8 +70,8 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     validate();
 }
 
-void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(
-    mrpt::config::CConfigFileBase& c, const std::string& section) const {
+void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
+                                                               const std::string& section) const {
     c.write(section, "resolution", resolution_m);
     c.write(section, "bin_height", bin_height_m);
     c.write(section, "grow", grow);
@@ -129,8 +134,8 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     validate();
 }
 
-void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(
-    mrpt::config::CConfigFileBase& c, const std::string& section) const {
+void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
+                                                                const std::string& section) const {
     c.write(section, "certainty_increment", certainty_increment);
     c.write(section, "max_elevation_uncertainty", max_elevation_uncertainty_m);
     c.write(section, "height_sigma_floor", height_sigma_floor_m);
@@ -152,11 +157,12 @@ void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(
 
 void CMultiBinElevationMap::TInsertionOptions::validate() const {
     auto bad = [](const std::string& key, const std::string& what) {
-        throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key + "': " +
-                                    what);
+        throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key +
+                                    "': " + what);
     };
     if (!(certainty_increment > 0)) bad("certainty_increment", "must be positive");
-    if (!(max_elevation_uncertainty_m > 0)) bad("max_elevation_uncertainty", "must be positive [m]");
+    if (!(max_elevation_uncertainty_m > 0))
+        bad("max_elevation_uncertainty", "must be positive [m]");
     if (!(height_sigma_floor_m >= 0)) bad("height_sigma_floor", "must be >= 0 [m]");
     if (default_pose_sigmas.size() != 6) bad("default_pose_sigmas", "needs 6 values");
     for (double v : default_pose_sigmas)
@@ -171,7 +177,8 @@ mrpt::math::CMatrixDouble66 CMultiBinElevationMap::TInsertionOptions::defaultPos
     const {
     mrpt::math::CMatrixDouble66 C;
     C.setZero();
-    for (int i = 0; i < 6; i++) C(i, i) = default_pose_sigmas[size_t(i)] * default_pose_sigmas[size_t(i)];
+    for (int i = 0; i < 6; i++)
+        C(i, i) = default_pose_sigmas[size_t(i)] * default_pose_sigmas[size_t(i)];
     return C;
 }
 
@@ -236,7 +243,8 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
     p.binHeight_m = creationOptions.bin_height_m;
     p.certaintyIncrement = insertionOptions.certainty_increment;
     p.maxElevationUncertainty_m = insertionOptions.max_elevation_uncertainty_m;
-    p.varianceFloor_m2 = insertionOptions.height_sigma_floor_m * insertionOptions.height_sigma_floor_m;
+    p.varianceFloor_m2 =
+        insertionOptions.height_sigma_floor_m * insertionOptions.height_sigma_floor_m;
     return p;
 }
 

@@ -22,14 +22,17 @@ namespace {
 
 /** Points of a laser scan in its sensor frame, with range-only covariance (bearing exact). */
 void laserScanPoints(const mrpt::obs::CObservation2DRangeScan& scan, double minRange_m,
-                     PointsWithCov& out) {
+                     PointsWithCov& out, size_t& outOfRange) {
     const multibin::sensors::RangeSigmaCurve sigmaOfRange;
     out.clear();
     out.reserve(scan.getScanSize());
     for (size_t i = 0; i < scan.getScanSize(); i++) {
-        if (!scan.getScanRangeValidity(i)) continue;
         const float r = scan.getScanRange(i);
-        if (!std::isfinite(r) || r < minRange_m || r >= scan.maxRange) continue;
+        if (!scan.getScanRangeValidity(i) || !std::isfinite(r) || r < minRange_m ||
+            r >= scan.maxRange) {
+            outOfRange++;
+            continue;
+        }
         const float a = scan.getScanAngle(i);
         const Eigen::Vector3f dir(std::cos(a), std::sin(a), 0.f);
         out.push_back({dir * r, multibin::rangeOnlyCovariance(dir, float(sigmaOfRange(r)))});
@@ -38,10 +41,13 @@ void laserScanPoints(const mrpt::obs::CObservation2DRangeScan& scan, double minR
 
 /** Appends a sensor-frame point measured along its ray with range noise sigma_m. */
 void appendRangePoint(float x, float y, float z, double minRange_m, double maxRange_m,
-                      double sigma_m, PointsWithCov& out) {
+                      double sigma_m, PointsWithCov& out, size_t& outOfRange) {
     const Eigen::Vector3f p(x, y, z);
     const float r = p.norm();
-    if (!std::isfinite(r) || r < minRange_m || r > maxRange_m) return;
+    if (!std::isfinite(r) || r < minRange_m || r > maxRange_m) {
+        outOfRange++;
+        return;
+    }
     const Eigen::Vector3f dir = p / r;
     // A tiny isotropic term keeps the covariance positive-definite (bearing is nearly exact).
     multibin::SymmetricCov3 c = multibin::rangeOnlyCovariance(dir, float(sigma_m));
@@ -60,7 +66,8 @@ bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
 }
 
 bool CMultiBinElevationMap::internal_insertObservation(
-    const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose) {
+    const mrpt::obs::CObservation& obs,
+    const std::optional<const mrpt::poses::CPose3D>& robotPose) {
     if (const auto* rp = dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs)) {
         // Not inserted: kept as the pose PDF of the observations that follow.
         m_lastRobotPose = rp->pose;
@@ -70,8 +77,8 @@ bool CMultiBinElevationMap::internal_insertObservation(
     mrpt::poses::CPose3DPDFGaussian pdf;
     bool haveCov = false;
     if (m_lastRobotPose) {
-        const bool timesKnown = obs.timestamp != INVALID_TIMESTAMP &&
-                                m_lastRobotPoseTime != INVALID_TIMESTAMP;
+        const bool timesKnown =
+            obs.timestamp != INVALID_TIMESTAMP && m_lastRobotPoseTime != INVALID_TIMESTAMP;
         const double dt =
             timesKnown ? std::abs(mrpt::system::timeDifference(m_lastRobotPoseTime, obs.timestamp))
                        : std::numeric_limits<double>::infinity();
@@ -100,6 +107,21 @@ bool CMultiBinElevationMap::insertObservation(const mrpt::obs::CObservation& obs
     return done;
 }
 
+size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(const mrpt::maps::CSimpleMap& simplemap) {
+    size_t inserted = 0;
+    for (size_t i = 0; i < simplemap.size(); i++) {
+        const auto& [posePdf, sf] = simplemap.get(i);
+        if (!posePdf || !sf) continue;
+        mrpt::poses::CPose3DPDFGaussian pdf;
+        const auto [cov, mean] = posePdf->getCovarianceAndMean();
+        pdf.mean = mean;
+        pdf.cov = cov;
+        for (const auto& obs : *sf)
+            if (obs && insertObservation(*obs, pdf)) inserted++;
+    }
+    return inserted;
+}
+
 bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
                                               const mrpt::poses::CPose3DPDFGaussian& robotPose) {
     if (!acceptsLabel(obs.sensorLabel)) {
@@ -113,18 +135,20 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     obs.load();  // externally stored observations
 
     PointsWithCov sensorPoints;
+    multibin::InsertStats sensorStats;  // rejections before the insertion core
     mrpt::poses::CPose3D sensorPose;
     double continuityBound_m = std::numeric_limits<double>::infinity();
     const auto& io = insertionOptions;
     if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
-        laserScanPoints(*scan, io.min_range_m, sensorPoints);
+        laserScanPoints(*scan, io.min_range_m, sensorPoints, sensorStats.outOfRange);
         sensorPose = scan->sensorPose;
     } else if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
         sensorPose = depth->sensorPose;
         if (depth->hasPoints3D) {
             for (size_t i = 0; i < depth->points3D_x.size(); i++)
                 appendRangePoint(depth->points3D_x[i], depth->points3D_y[i], depth->points3D_z[i],
-                                 io.min_range_m, io.max_range_m, io.range_sigma_m, sensorPoints);
+                                 io.min_range_m, io.max_range_m, io.range_sigma_m, sensorPoints,
+                                 sensorStats.outOfRange);
         } else if (depth->hasRangeImage) {
             mrpt::maps::CSimplePointsMap local;
             mrpt::obs::T3DPointsProjectionParams pp;
@@ -135,7 +159,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
             const auto& zs = local.getPointsBufferRef_z();
             for (size_t i = 0; i < xs.size(); i++)
                 appendRangePoint(xs[i], ys[i], zs[i], io.min_range_m, io.max_range_m,
-                                 io.range_sigma_m, sensorPoints);
+                                 io.range_sigma_m, sensorPoints, sensorStats.outOfRange);
         }
     } else if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
         sensorPose = cloud->sensorPose;
@@ -145,11 +169,12 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
             const auto& zs = cloud->pointcloud->getPointsBufferRef_z();
             for (size_t i = 0; i < xs.size(); i++)
                 appendRangePoint(xs[i], ys[i], zs[i], io.min_range_m, io.max_range_m,
-                                 io.range_sigma_m, sensorPoints);
+                                 io.range_sigma_m, sensorPoints, sensorStats.outOfRange);
         }
     } else {
         return false;  // not an observation this map models
     }
+    m_stats += sensorStats;
     if (sensorPoints.empty()) return false;
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
@@ -161,7 +186,8 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
 
 multibin::InsertStats CMultiBinElevationMap::insertPoints(const PointsWithCov& mapPoints,
                                                           double continuityBound_m) {
-    const multibin::InsertStats s = m_grid.insertPoints(mapPoints, binUpdateParams(), continuityBound_m);
+    const multibin::InsertStats s =
+        m_grid.insertPoints(mapPoints, binUpdateParams(), continuityBound_m);
     m_stats += s;
     return s;
 }
@@ -191,7 +217,8 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
 
     // Grow with a margin, so a moving sensor does not re-slot the grid at every scan.
     const int margin = std::max(1, static_cast<int>(std::ceil(1.0 / m_grid.cellSize_m())));
-    const int maxCells = std::max(1, static_cast<int>(std::floor(c.max_size_m / m_grid.cellSize_m())));
+    const int maxCells =
+        std::max(1, static_cast<int>(std::floor(c.max_size_m / m_grid.cellSize_m())));
     auto clampAxis = [&](int curLo, int curN, int lo, int hi, int& outLo, int& outN) {
         lo -= margin;
         hi += margin;

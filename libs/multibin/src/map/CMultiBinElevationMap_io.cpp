@@ -88,15 +88,15 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
                 for (uint16_t k = 0; k < n; k++) {
                     multibin::Bin b;
                     in >> b.height_m >> b.variance_m2 >> b.certainty >> b.pointCount >> b.index;
-                    if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) ||
-                        !(b.certainty >= 0))
+                    if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) || !(b.certainty >= 0))
                         throw std::runtime_error(
                             "CMultiBinElevationMap: corrupt serialized map (invalid bin)");
                     m_grid.appendBin(ix, iy, b);
                 }
             }
         } break;
-        default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+        default:
+            MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
     }
 }
 
@@ -111,7 +111,8 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(bool sigma) const {
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             const multibin::Bin* b = m_grid.winningBin(w.ix0 + c, w.iy0 + r);
-            if (b) g.heights_m(r, c) = sigma ? float(multibin::BinGrid::sigma_m(*b, p)) : b->height_m;
+            if (b)
+                g.heights_m(r, c) = sigma ? float(multibin::BinGrid::sigma_m(*b, p)) : b->height_m;
         }
     return g;
 }

@@ -6,6 +6,7 @@
 #include <mrpt/img/color_maps.h>
 #include <mrpt/maps/CHeightGridMap2D_Base.h>
 #include <mrpt/maps/CMetricMap.h>
+#include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/obs_frwds.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 #include <mrpt/serialization/CSerializable.h>
@@ -79,9 +80,10 @@ public:
 
     /** How observations update the map (ini section `..._insertOpts`). */
     struct TInsertionOptions : public mrpt::config::CLoadableOptions {
-        float certainty_increment = 1.0f;         //!< `a` of eqs 13-14
-        double max_elevation_uncertainty_m = 0.1; //!< Delta_max [m]: a point counts if 3 sigma_z <= it
-        double height_sigma_floor_m = 0.002;      //!< a bin's sigma never falls below this [m]
+        float certainty_increment = 1.0f;  //!< `a` of eqs 13-14
+        double max_elevation_uncertainty_m =
+            0.1;                              //!< Delta_max [m]: a point counts if 3 sigma_z <= it
+        double height_sigma_floor_m = 0.002;  //!< a bin's sigma never falls below this [m]
         /** Pose sigmas (x, y, z [m], yaw, pitch, roll [rad]) used when no pose PDF is known. */
         std::vector<double> default_pose_sigmas{0.01, 0.01, 0.01, 0.005, 0.005, 0.005};
         double robot_pose_max_dt_s = 0.5;  //!< a CObservationRobotPose stays valid this long [s]
@@ -113,6 +115,11 @@ public:
     bool insertObservation(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);
 
+    /** Inserts every observation of a simplemap with its keyframe's own pose PDF (mean and 6x6
+     * covariance from getCovarianceAndMean()). MRPT's stock loadFromSimpleMap() passes only the
+     * mean pose. Returns the number of observations inserted. Does not clear the map. */
+    size_t insertSimpleMapWithPosePdfs(const mrpt::maps::CSimpleMap& simplemap);
+
     /** Inserts points already in the map frame with their covariance (the shared insertion core,
      * for sensors the map does not model). `continuityBound_m` is eq 14's Delta_zmax. */
     multibin::InsertStats insertPoints(
@@ -132,7 +139,8 @@ public:
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
     /** Sums of what every insertion did with its points. */
     const multibin::InsertStats& insertStats() const { return m_stats; }
-    /** Observations inserted with the default pose covariance because no valid pose PDF was known. */
+    /** Observations inserted with the default pose covariance because no valid pose PDF was known.
+     */
     size_t poseFallbackCount() const { return m_poseFallbacks; }
     /** Observations skipped because their sensor label is not in insertionOptions.sensor_labels. */
     size_t skippedByLabelCount() const { return m_skippedByLabel; }

@@ -1,0 +1,172 @@
+/* Tests of the insertion core: Kalman fusion, winning bin, gates, window moves. */
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "multibin/BinGrid.h"
+
+using namespace multibin;
+
+namespace {
+PointWithCov pointAt(double x, double y, double z, double sigmaZ_m) {
+    PointWithCov p;
+    p.point_m = Eigen::Vector3f(float(x), float(y), float(z));
+    p.cov_m2 = {1e-6f, 0, 0, 1e-6f, 0, float(sigmaZ_m * sigmaZ_m)};
+    return p;
+}
+BinGrid gridAroundOrigin(double cell_m = 0.1) {
+    BinGrid g(cell_m);
+    g.reset(cell_m, CellWindow{-10, -10, 20, 20});
+    return g;
+}
+}  // namespace
+
+TEST(BinGrid, KalmanFusionOfEqualVariancesGivesMeanAndVarianceOverN) {
+    const double sigma = 0.01;
+    const int N = 25;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.010, 0.040);  // all in bin 0 (0..50 mm)
+    for (double floorSigma : {0.0005, 0.004}) {  // floor below and above sigma/sqrt(N) = 2 mm
+        BinGrid g = gridAroundOrigin();
+        BinUpdateParams p;
+        p.varianceFloor_m2 = floorSigma * floorSigma;
+        double sum = 0;
+        PointsWithCov pts;
+        for (int i = 0; i < N; i++) {
+            const double z = u(rng);
+            sum += z;
+            pts.push_back(pointAt(0.05, 0.05, z, sigma));
+        }
+        const InsertStats s = g.insertPoints(pts, p);
+        EXPECT_EQ(s.accepted, size_t(N));
+        const Bin* b = g.winningBin(0, 0);
+        ASSERT_NE(b, nullptr);
+        EXPECT_NEAR(b->height_m, sum / N, 1e-6);
+        EXPECT_EQ(b->pointCount, unsigned(N));
+        EXPECT_FLOAT_EQ(b->certainty, float(N) * p.certaintyIncrement);
+        const double expectedVar = std::max(sigma * sigma / N, floorSigma * floorSigma);
+        EXPECT_NEAR(BinGrid::sigma_m(*b, p) * BinGrid::sigma_m(*b, p), expectedVar,
+                    1e-6 * expectedVar + 1e-12);
+    }
+}
+
+TEST(BinGrid, KalmanWeightsByInverseVariance) {
+    BinGrid g = gridAroundOrigin();
+    BinUpdateParams p;
+    p.varianceFloor_m2 = 0;
+    // Two heights in one bin: 10 mm with sigma 1 mm, 30 mm with sigma 2 mm.
+    g.insertPoints({pointAt(0.05, 0.05, 0.010, 0.001), pointAt(0.05, 0.05, 0.030, 0.002)}, p);
+    const double w1 = 1 / 1e-6, w2 = 1 / 4e-6;
+    const Bin* b = g.winningBin(0, 0);
+    ASSERT_NE(b, nullptr);
+    EXPECT_NEAR(b->height_m, (w1 * 0.010 + w2 * 0.030) / (w1 + w2), 1e-7);
+    EXPECT_NEAR(b->variance_m2, 1 / (w1 + w2), 1e-12);
+}
+
+TEST(BinGrid, WinningBinFollowsCertaintyThenVariance) {
+    BinGrid g = gridAroundOrigin();
+    BinUpdateParams p;
+    // Two points at 20 mm (bin 0), three at 120 mm (bin 2): bin 2 wins.
+    PointsWithCov pts{pointAt(0.05, 0.05, 0.02, 0.005), pointAt(0.05, 0.05, 0.02, 0.005)};
+    for (int i = 0; i < 3; i++) pts.push_back(pointAt(0.05, 0.05, 0.12, 0.005));
+    g.insertPoints(pts, p);
+    ASSERT_NE(g.winningBin(0, 0), nullptr);
+    EXPECT_EQ(g.winningBin(0, 0)->index, 2);
+    // Two more at 20 mm: bin 0 now has 4 > 3.
+    g.insertPoints({pointAt(0.05, 0.05, 0.02, 0.005), pointAt(0.05, 0.05, 0.02, 0.005)}, p);
+    EXPECT_EQ(g.winningBin(0, 0)->index, 0);
+    EXPECT_NEAR(g.winningBin(0, 0)->height_m, 0.02, 1e-6);
+    // Tie on certainty (1 each) in another cell: the lower variance wins.
+    g.insertPoints({pointAt(0.15, 0.05, 0.02, 0.010), pointAt(0.15, 0.05, 0.12, 0.003)}, p);
+    EXPECT_EQ(g.winningBin(1, 0)->index, 2);
+    size_t bins = 0;
+    g.forEachBin(1, 0, [&](const Bin&) { bins++; });
+    EXPECT_EQ(bins, 2u);  // the other hypothesis is kept
+}
+
+TEST(BinGrid, Eq13GateRejectsPointsWithThreeSigmaAboveDeltaMax) {
+    BinGrid g = gridAroundOrigin();
+    BinUpdateParams p;
+    p.maxElevationUncertainty_m = 0.03;
+    // 3 sigma = 0.0303 > 0.03: rejected; 3 sigma = 0.0297: accepted.
+    InsertStats s = g.insertPoints({pointAt(0.05, 0.05, 0.02, 0.0101)}, p);
+    EXPECT_EQ(s.tooUncertain, 1u);
+    EXPECT_EQ(s.accepted, 0u);
+    EXPECT_EQ(g.winningBin(0, 0), nullptr);
+    s = g.insertPoints({pointAt(0.05, 0.05, 0.02, 0.0099)}, p);
+    EXPECT_EQ(s.accepted, 1u);
+    EXPECT_NE(g.winningBin(0, 0), nullptr);
+}
+
+TEST(BinGrid, Eq14ContinuityGateAppliesOnlyToCertainBins) {
+    BinGrid g = gridAroundOrigin();
+    BinUpdateParams p;
+    p.binHeight_m = 0.5;  // one bin for all heights below
+    const double bound = 0.01;
+    // First point: c == 0, accepted whatever the bound.
+    EXPECT_EQ(g.insertPoints({pointAt(0.05, 0.05, 0.100, 0.002)}, p, bound).accepted, 1u);
+    // 25 mm away from the bin height: rejected; 5 mm away: accepted.
+    InsertStats s = g.insertPoints({pointAt(0.05, 0.05, 0.125, 0.002)}, p, bound);
+    EXPECT_EQ(s.continuityRejected, 1u);
+    s = g.insertPoints({pointAt(0.05, 0.05, 0.105, 0.002)}, p, bound);
+    EXPECT_EQ(s.accepted, 1u);
+    EXPECT_FLOAT_EQ(g.winningBin(0, 0)->certainty, 2.f);
+}
+
+TEST(BinGrid, RejectsBadPointsAndCountsThem) {
+    BinGrid g = gridAroundOrigin();
+    BinUpdateParams p;
+    PointWithCov nan = pointAt(0.05, 0.05, NAN, 0.01);
+    PointWithCov notPd = pointAt(0.05, 0.05, 0.02, 0.01);
+    notPd.cov_m2.xy = 1.0f;  // |xy| > sqrt(xx yy)
+    PointWithCov far = pointAt(1e9, 0.05, 0.02, 0.01);
+    PointWithCov high = pointAt(0.05, 0.05, 1e6, 0.01);
+    const InsertStats s = g.insertPoints({nan, notPd, far, high}, p);
+    EXPECT_EQ(s.notFinite, 1u);
+    EXPECT_EQ(s.badCovariance, 1u);
+    EXPECT_EQ(s.outsideMap, 1u);
+    EXPECT_EQ(s.outsideBinRange, 1u);
+    EXPECT_EQ(s.accepted, 0u);
+    EXPECT_TRUE(g.empty());
+}
+
+TEST(BinGrid, GrowingKeepsEveryBin) {
+    BinGrid g(0.1);
+    g.reset(0.1, CellWindow{0, 0, 4, 4});
+    BinUpdateParams p;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            g.insertPoints({pointAt(0.1 * i + 0.05, 0.1 * j + 0.05, 0.01 * (i + 4 * j), 0.005)}, p);
+    g.growToInclude(CellWindow{-7, 2, 3, 9});
+    EXPECT_EQ(g.window(), (CellWindow{-7, 0, 11, 11}));
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            ASSERT_NE(g.winningBin(i, j), nullptr);
+            EXPECT_FLOAT_EQ(g.winningBin(i, j)->height_m, float(0.01 * (i + 4 * j)));
+        }
+    EXPECT_EQ(g.binCount(), 16u);
+}
+
+TEST(BinGrid, MovingTheWindowKeepsCellsInsideAndReportsLeavers) {
+    BinGrid g(0.1);
+    g.reset(0.1, CellWindow{0, 0, 10, 10});
+    BinUpdateParams p;
+    for (int i = 0; i < 10; i++)
+        for (int j = 0; j < 10; j++)
+            g.insertPoints({pointAt(0.1 * i + 0.05, 0.1 * j + 0.05, 0.001 * (i + 10 * j), 0.005)},
+                           p);
+    size_t left = 0;
+    g.moveWindowTo(3, -2, [&](int ix, int iy) {
+        EXPECT_TRUE(ix < 3 || iy >= 8);
+        left++;
+    });
+    EXPECT_EQ(left, 100u - 7u * 8u);
+    for (int i = 3; i < 10; i++)
+        for (int j = 0; j < 8; j++) {
+            ASSERT_NE(g.winningBin(i, j), nullptr);
+            EXPECT_FLOAT_EQ(g.winningBin(i, j)->height_m, float(0.001 * (i + 10 * j)));
+        }
+    for (int i = 10; i < 13; i++) EXPECT_EQ(g.winningBin(i, 0), nullptr);
+    EXPECT_EQ(g.winningBin(5, -1), nullptr);
+    EXPECT_EQ(g.binCount(), 56u);
+}

@@ -1,0 +1,340 @@
+/* Tests of CMultiBinElevationMap as an MRPT map: pose propagation, options, serialization,
+ * CMultiMetricMap creation, pose PDFs from CObservationRobotPose. */
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CMultiMetricMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRobotPose.h>
+#include <mrpt/poses/CPose3DPDFGaussian.h>
+#include <mrpt/random/RandomGenerators.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "multibin/PosePropagation.h"
+
+using mrpt::maps::CMultiBinElevationMap;
+using mrpt::poses::CPose3D;
+using mrpt::poses::CPose3DPDFGaussian;
+
+namespace {
+CPose3DPDFGaussian poseWithCov(const CPose3D& mean, const std::array<double, 6>& sigmas) {
+    CPose3DPDFGaussian pdf;
+    pdf.mean = mean;
+    pdf.cov.setZero();
+    for (int i = 0; i < 6; i++) pdf.cov(i, i) = sigmas[size_t(i)] * sigmas[size_t(i)];
+    pdf.cov(0, 4) = pdf.cov(4, 0) = 0.3 * sigmas[0] * sigmas[4];  // some correlation
+    return pdf;
+}
+
+/** A pitched 2D laser seeing the plane z = 0 from 0.26 m, like the paper's URG-04LX. */
+mrpt::obs::CObservation2DRangeScan::Ptr pitchedScanOverFloor(double height_m, double pitch_rad) {
+    auto scan = mrpt::obs::CObservation2DRangeScan::Create();
+    scan->sensorLabel = "LASER";
+    scan->aperture = float(mrpt::DEG2RAD(240.0));
+    scan->maxRange = 4.0f;
+    scan->sensorPose = CPose3D(0, 0, height_m, 0, pitch_rad, 0);
+    const size_t N = 683;
+    scan->resizeScan(N);
+    for (size_t i = 0; i < N; i++) {
+        const double a = -0.5 * scan->aperture + scan->aperture * double(i) / (N - 1);
+        // Ray direction in the robot frame; hits z = 0 at t = h / -dz.
+        const mrpt::math::TVector3D d =
+            scan->sensorPose.rotateVector(mrpt::math::TVector3D(std::cos(a), std::sin(a), 0));
+        const double t = d.z < -1e-3 ? height_m / -d.z : 100.0;
+        const bool valid = t < scan->maxRange;
+        scan->setScanRange(i, valid ? float(t) : 0.f);
+        scan->setScanRangeValidity(i, valid);
+    }
+    return scan;
+}
+
+std::vector<uint8_t> serialize(const mrpt::serialization::CSerializable& o) {
+    mrpt::io::CMemoryStream buf;
+    auto arch = mrpt::serialization::archiveFrom(buf);
+    arch.WriteObject(&o);
+    const auto* p = static_cast<const uint8_t*>(buf.getRawBufferData());
+    return std::vector<uint8_t>(p, p + buf.getTotalBytesCount());
+}
+}  // namespace
+
+TEST(PosePropagation, JacobianMatchesFiniteDifferencesAndMrpt) {
+    const CPose3DPDFGaussian robot =
+        poseWithCov(CPose3D(1.0, -2.0, 0.3, 0.7, -0.2, 0.15), {0.01, 0.01, 0.01, 0.01, 0.01, 0.01});
+    const CPose3D sensor(0.1, 0.0, 0.26, 0.0, mrpt::DEG2RAD(45.0), 0.0);
+    const multibin::PosePropagator prop(robot, sensor);
+    const Eigen::Vector3d pr(0.8, 0.3, -0.1);  // point in the robot frame
+    const Eigen::Matrix<double, 3, 6> J = prop.jacobianWrtRobotPose(pr);
+    const double h = 1e-6;
+    for (int k = 0; k < 6; k++) {
+        double vp[6], vm[6];
+        for (int i = 0; i < 6; i++) vp[i] = vm[i] = robot.mean[i];
+        vp[k] += h;
+        vm[k] -= h;
+        const CPose3D plus(vp[0], vp[1], vp[2], vp[3], vp[4], vp[5]);
+        const CPose3D minus(vm[0], vm[1], vm[2], vm[3], vm[4], vm[5]);
+        const auto gp = plus.composePoint(mrpt::math::TPoint3D(pr.x(), pr.y(), pr.z()));
+        const auto gm = minus.composePoint(mrpt::math::TPoint3D(pr.x(), pr.y(), pr.z()));
+        EXPECT_NEAR(J(0, k), (gp.x - gm.x) / (2 * h), 1e-6) << "column " << k;
+        EXPECT_NEAR(J(1, k), (gp.y - gm.y) / (2 * h), 1e-6) << "column " << k;
+        EXPECT_NEAR(J(2, k), (gp.z - gm.z) / (2 * h), 1e-6) << "column " << k;
+    }
+    mrpt::math::CMatrixDouble36 Jmrpt;
+    double gx, gy, gz;
+    robot.mean.composePoint(pr.x(), pr.y(), pr.z(), gx, gy, gz, std::nullopt, Jmrpt);
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 6; c++) EXPECT_NEAR(J(r, c), Jmrpt(r, c), 1e-9);
+}
+
+TEST(PosePropagation, CovarianceMatchesMonteCarlo) {
+    const CPose3DPDFGaussian robot = poseWithCov(CPose3D(0.5, 0.2, 0.1, 0.3, 0.05, -0.04),
+                                                 {0.02, 0.015, 0.01, 0.02, 0.01, 0.015});
+    const CPose3D sensor(0.1, 0.0, 0.26, 0.0, mrpt::DEG2RAD(45.0), 0.0);
+    const multibin::PosePropagator prop(robot, sensor);
+    multibin::PointWithCov ps;
+    ps.point_m = Eigen::Vector3f(0.6f, 0.2f, 0.0f);
+    const Eigen::Vector3f dir = ps.point_m.normalized();
+    ps.cov_m2 = multibin::rangeOnlyCovariance(dir, 0.005f);
+    const multibin::PointWithCov pm = prop.apply(ps);
+    const Eigen::Matrix3d C = pm.cov_m2.toMatrix();
+
+    mrpt::random::CRandomGenerator rng(1234);
+    std::mt19937 gen(99);
+    std::normal_distribution<double> n01;
+    const int N = 20000;
+    std::vector<mrpt::math::CVectorDouble> poses;
+    rng.drawGaussianMultivariateMany(poses, N, robot.cov);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d M2 = Eigen::Matrix3d::Zero();
+    std::vector<Eigen::Vector3d> samples;
+    double nees = 0;
+    const Eigen::Matrix3d Cinv = C.inverse();
+    for (int s = 0; s < N; s++) {
+        double v[6];
+        for (int i = 0; i < 6; i++) v[i] = robot.mean[i] + poses[size_t(s)][i];
+        const CPose3D R(v[0], v[1], v[2], v[3], v[4], v[5]);
+        const Eigen::Vector3d local = (ps.point_m + dir * float(0.005 * n01(gen))).cast<double>();
+        const auto g =
+            (R + sensor).composePoint(mrpt::math::TPoint3D(local.x(), local.y(), local.z()));
+        const Eigen::Vector3d e = Eigen::Vector3d(g.x, g.y, g.z) - pm.point_m.cast<double>();
+        M2 += e * e.transpose();
+        nees += e.dot(Cinv * e);
+    }
+    M2 /= N;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            EXPECT_NEAR(M2(r, c), C(r, c), 0.05 * std::sqrt(C(r, r) * C(c, c)))
+                << "entry " << r << "," << c;
+    // Mean NEES of N samples of a 3-dof chi-square: 3 +- 99 % bounds (normal approx., 6/N var).
+    const double meanNees = nees / N, halfWidth = 2.576 * std::sqrt(6.0 / N);
+    EXPECT_GT(meanNees, 3 - halfWidth);
+    EXPECT_LT(meanNees, 3 + halfWidth);
+}
+
+TEST(CMultiBinElevationMap, PitchedLaserOverFloorGivesFlatMapWithHonestSigma) {
+    CMultiBinElevationMap map;
+    const auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    CPose3DPDFGaussian pose =
+        poseWithCov(CPose3D(0, 0, 0, 0, 0, 0), {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4});
+    ASSERT_TRUE(map.insertObservation(*scan, pose));
+    EXPECT_GT(map.insertStats().accepted, 300u);
+    double h, s;
+    ASSERT_TRUE(map.getHeight(0.26, 0.0, h, s));  // straight ahead, 0.26 m at 45 deg
+    EXPECT_NEAR(h, 0.0, 0.001);
+    EXPECT_GE(s, map.insertionOptions.height_sigma_floor_m - 1e-9);
+    EXPECT_FALSE(map.getHeight(-0.5, 0.0, h, s));  // behind the robot: never seen
+    EXPECT_EQ(map.poseFallbackCount(), 0u);
+}
+
+TEST(CMultiBinElevationMap, UsesLatestRobotPoseCovarianceWhileFresh) {
+    CMultiBinElevationMap map;
+    auto robotPose = mrpt::obs::CObservationRobotPose::Create();
+    robotPose->pose = poseWithCov(CPose3D(), {0.001, 0.001, 0.02, 0.001, 0.001, 0.001});
+    robotPose->timestamp = mrpt::Clock::fromDouble(100.0);
+    auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    map.insertionOptions.max_elevation_uncertainty_m = 1.0;
+
+    scan->timestamp = mrpt::Clock::fromDouble(100.1);
+    map.insertObservation(*robotPose);
+    ASSERT_TRUE(map.insertObservation(*scan, CPose3D()));
+    EXPECT_EQ(map.poseFallbackCount(), 0u);
+    double h, sFresh;
+    ASSERT_TRUE(map.getHeight(0.26, 0.0, h, sFresh));
+    // sigma_z of the robot pose is 20 mm; one scan's points are fused as independent, so the
+    // cell's sigma is 20 mm / sqrt(points in the cell).
+    EXPECT_GT(sFresh, 0.005);
+
+    CMultiBinElevationMap map2;
+    map2.insertionOptions = map.insertionOptions;
+    scan->timestamp = mrpt::Clock::fromDouble(101.0);  // 0.9 s > robot_pose_max_dt
+    map2.insertObservation(*robotPose);
+    ASSERT_TRUE(map2.insertObservation(*scan, CPose3D()));
+    EXPECT_EQ(map2.poseFallbackCount(), 1u);
+    double sStale;
+    ASSERT_TRUE(map2.getHeight(0.26, 0.0, h, sStale));
+    // sigma_z: about 10.4 mm with the default covariance against 20 mm with the robot pose's.
+    EXPECT_NEAR(sStale / sFresh, 10.4 / 20.0, 0.05);
+}
+
+TEST(CMultiBinElevationMap, SerializationRoundTripIsBitExactThroughClassRegistry) {
+    CMultiBinElevationMap map;
+    map.insertionOptions.height_sigma_floor_m = 0.0031;
+    map.insertionOptions.sensor_labels = {"LASER", "STEREO"};
+    const auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    for (int k = 0; k < 5; k++)
+        map.insertObservation(*scan, poseWithCov(CPose3D(0.05 * k, 0, 0.01 * k, 0.1 * k, 0, 0),
+                                                 {1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3}));
+    ASSERT_GT(map.grid().binCount(), 100u);
+    const std::vector<uint8_t> bytes = serialize(map);
+
+    mrpt::io::CMemoryStream buf;
+    buf.assignMemoryNotOwn(bytes.data(), bytes.size());
+    auto arch = mrpt::serialization::archiveFrom(buf);
+    const mrpt::serialization::CSerializable::Ptr obj = arch.ReadObject();  // via the registry
+    const auto copy = std::dynamic_pointer_cast<CMultiBinElevationMap>(obj);
+    ASSERT_TRUE(copy);
+    EXPECT_EQ(serialize(*copy), bytes);
+    EXPECT_EQ(copy->grid().binCount(), map.grid().binCount());
+    EXPECT_EQ(copy->insertionOptions.sensor_labels, map.insertionOptions.sensor_labels);
+    const auto& w = map.grid().window();
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            const auto* a = map.grid().winningBin(ix, iy);
+            const auto* b = copy->grid().winningBin(ix, iy);
+            ASSERT_EQ(a == nullptr, b == nullptr);
+            if (a) {
+                EXPECT_EQ(a->height_m, b->height_m);
+                EXPECT_EQ(a->variance_m2, b->variance_m2);
+                EXPECT_EQ(a->certainty, b->certainty);
+            }
+        }
+}
+
+TEST(CMultiBinElevationMap, CorruptOrUnknownVersionSerializationIsRefused) {
+    CMultiBinElevationMap map;
+    map.insertObservation(*pitchedScanOverFloor(0.26, 0.78), CPose3D());
+    std::vector<uint8_t> bytes = serialize(map);
+    // Truncated stream.
+    {
+        mrpt::io::CMemoryStream buf;
+        buf.assignMemoryNotOwn(bytes.data(), bytes.size() / 2);
+        auto arch = mrpt::serialization::archiveFrom(buf);
+        EXPECT_ANY_THROW(arch.ReadObject());
+    }
+    // Unknown version: the version byte follows the class name in MRPT's object header.
+    const std::string name = "CMultiBinElevationMap";
+    auto it = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
+    ASSERT_NE(it, bytes.end());
+    *(it + long(name.size())) = 77;
+    {
+        mrpt::io::CMemoryStream buf;
+        buf.assignMemoryNotOwn(bytes.data(), bytes.size());
+        auto arch = mrpt::serialization::archiveFrom(buf);
+        EXPECT_ANY_THROW(arch.ReadObject());
+    }
+}
+
+TEST(CMultiBinElevationMap, IniOptionsRoundTripAndMalformedValuesAreRefused) {
+    CMultiBinElevationMap::TCreationOptions c;
+    c.resolution_m = 0.015;
+    c.bin_height_m = 0.04;
+    c.grow = false;
+    c.min_x = -1;
+    c.max_x = 1;
+    c.min_y = -2;
+    c.max_y = 2.5;
+    CMultiBinElevationMap::TInsertionOptions in;
+    in.max_elevation_uncertainty_m = 0.0731;
+    in.default_pose_sigmas = {0.1, 0.2, 0.3, 0.01, 0.02, 0.03};
+    in.sensor_labels = {"STEREO"};
+    in.colormap = mrpt::img::cmHOT;
+    mrpt::config::CConfigFileMemory ini;
+    c.saveToConfigFile(ini, "c");
+    in.saveToConfigFile(ini, "i");
+    CMultiBinElevationMap::TCreationOptions c2;
+    CMultiBinElevationMap::TInsertionOptions in2;
+    c2.loadFromConfigFile(ini, "c");
+    in2.loadFromConfigFile(ini, "i");
+    EXPECT_EQ(c2.resolution_m, c.resolution_m);
+    EXPECT_EQ(c2.bin_height_m, c.bin_height_m);
+    EXPECT_EQ(c2.grow, c.grow);
+    EXPECT_EQ(c2.max_y, c.max_y);
+    EXPECT_EQ(in2.max_elevation_uncertainty_m, in.max_elevation_uncertainty_m);
+    EXPECT_EQ(in2.default_pose_sigmas, in.default_pose_sigmas);
+    EXPECT_EQ(in2.sensor_labels, in.sensor_labels);
+    EXPECT_EQ(in2.colormap, in.colormap);
+
+    auto expectRefused = [](const std::string& text, const std::string& mention) {
+        mrpt::config::CConfigFileMemory bad(text);
+        CMultiBinElevationMap::TCreationOptions o;
+        try {
+            o.loadFromConfigFile(bad, "c");
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(mention), std::string::npos) << e.what();
+        }
+    };
+    expectRefused("[c]\nresolution = 0.0x5\n", "resolution");
+    expectRefused("[c]\nresoltion = 0.05\n", "resoltion");  // unknown key (typo)
+    expectRefused("[c]\nresolution = -0.05\n", "resolution");
+    expectRefused("[c]\ngrow = maybe\n", "grow");
+    expectRefused("[c]\nresolution = 0.0001\nmax_size_m = 100\n", "max_size_m");  // too big
+    // MRPT's generic keys are accepted.
+    mrpt::config::CConfigFileMemory generic("[c]\nenableSaveAs3DObject = false\n");
+    EXPECT_NO_THROW(c2.loadFromConfigFile(generic, "c"));
+}
+
+TEST(CMultiBinElevationMap, CMultiMetricMapFromIniTextContainsTheMap) {
+    const std::string ini =
+        "[map]\n"
+        "multiBinElevationMap_count = 1\n"
+        "[map_multiBinElevationMap_00_creationOpts]\n"
+        "resolution = 0.03\n"
+        "enableSaveAs3DObject = true\n"
+        "[map_multiBinElevationMap_00_insertOpts]\n"
+        "max_elevation_uncertainty = 0.08\n";
+    mrpt::config::CConfigFileMemory cfg(ini);
+    mrpt::maps::TSetOfMetricMapInitializers inits;
+    inits.loadFromConfigFile(cfg, "map");
+    mrpt::maps::CMultiMetricMap mm(inits);
+    const auto map = mm.mapByClass<CMultiBinElevationMap>();
+    ASSERT_TRUE(map);
+    EXPECT_DOUBLE_EQ(map->creationOptions.resolution_m, 0.03);
+    EXPECT_DOUBLE_EQ(map->insertionOptions.max_elevation_uncertainty_m, 0.08);
+    const auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    mm.insertObservation(*scan, CPose3D());
+    EXPECT_FALSE(map->isEmpty());
+
+    mrpt::config::CConfigFileMemory bad(
+        "[map]\nmultiBinElevationMap_count = 1\n[map_multiBinElevationMap_00_insertOpts]\n"
+        "max_elevation_uncertainty = 8cm\n");
+    mrpt::maps::TSetOfMetricMapInitializers badInits;
+    EXPECT_THROW(badInits.loadFromConfigFile(bad, "map"), std::exception);
+}
+
+TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
+    CMultiBinElevationMap::TCreationOptions c;
+    c.max_size_m = 4.0;
+    CMultiBinElevationMap map(c);
+    auto obs = mrpt::obs::CObservationPointCloud::Create();
+    auto pts = mrpt::maps::CSimplePointsMap::Create();
+    // A plane z = -1 in the sensor frame, 3 x 3 m, plus far points.
+    for (double x = -1.5; x <= 1.5; x += 0.05)
+        for (double y = -1.5; y <= 1.5; y += 0.05) pts->insertPoint(float(x), float(y), -1.0f);
+    pts->insertPoint(15.f, 0.f, -1.f);
+    pts->insertPoint(50.f, 0.f, -1.f);  // beyond max_range
+    obs->pointcloud = pts;
+    obs->sensorPose = CPose3D(0, 0, 1.0, 0, 0, 0);
+    ASSERT_TRUE(map.insertObservation(*obs, CPose3D(10, 5, 0, 0, 0, 0)));
+    double h, s;
+    ASSERT_TRUE(map.getHeight(10.0, 5.0, h, s));
+    EXPECT_NEAR(h, 0.0, 1e-4);
+    EXPECT_LE(map.getXMax() - map.getXMin(), 4.0 + 1e-9);
+    EXPECT_EQ(map.insertStats().outsideMap, 1u);  // 15 m away: beyond the growth limit
+    EXPECT_EQ(map.insertStats().outOfRange, 1u);  // 50 m away: beyond max_range
+}
