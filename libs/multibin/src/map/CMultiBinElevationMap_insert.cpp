@@ -107,7 +107,8 @@ bool CMultiBinElevationMap::insertObservation(const mrpt::obs::CObservation& obs
     return done;
 }
 
-size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(const mrpt::maps::CSimpleMap& simplemap) {
+size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
+    const mrpt::maps::CSimpleMap& simplemap, const std::function<void(size_t, size_t)>& progress) {
     size_t inserted = 0;
     for (size_t i = 0; i < simplemap.size(); i++) {
         const auto& [posePdf, sf] = simplemap.get(i);
@@ -118,6 +119,7 @@ size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(const mrpt::maps::CSim
         pdf.cov = cov;
         for (const auto& obs : *sf)
             if (obs && insertObservation(*obs, pdf)) inserted++;
+        if (progress) progress(i + 1, simplemap.size());
     }
     return inserted;
 }

@@ -146,10 +146,15 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
 
 void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     const std::string& filNamePrefix) const {
-    mrpt::img::CImage img;
-    getAsImage(img);
-    img.saveToFile(filNamePrefix + "_height.png");
-    toRaster().save(filNamePrefix + "_height.asc");
+    for (const bool sigma : {false, true}) {
+        const std::string layer = sigma ? "_sigma" : "_height";
+        mrpt::img::CImage img;
+        getAsImage(img, sigma);
+        if (!img.saveToFile(filNamePrefix + layer + ".png"))
+            throw std::runtime_error("CMultiBinElevationMap: cannot write " + filNamePrefix +
+                                     layer + ".png");
+        toRaster(sigma).save(filNamePrefix + layer + ".asc");
+    }
     mrpt::opengl::COpenGLScene scene;
     auto obj = mrpt::opengl::CSetOfObjects::Create();
     getVisualizationInto(*obj);

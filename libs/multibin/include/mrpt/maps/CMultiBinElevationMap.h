@@ -11,6 +11,7 @@
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 #include <mrpt/serialization/CSerializable.h>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -117,8 +118,10 @@ public:
 
     /** Inserts every observation of a simplemap with its keyframe's own pose PDF (mean and 6x6
      * covariance from getCovarianceAndMean()). MRPT's stock loadFromSimpleMap() passes only the
-     * mean pose. Returns the number of observations inserted. Does not clear the map. */
-    size_t insertSimpleMapWithPosePdfs(const mrpt::maps::CSimpleMap& simplemap);
+     * mean pose. Returns the number of observations inserted. Does not clear the map.
+     * `progress(keyframesDone, keyframesTotal)` is called after each keyframe, if given. */
+    size_t insertSimpleMapWithPosePdfs(const mrpt::maps::CSimpleMap& simplemap,
+                                       const std::function<void(size_t, size_t)>& progress = {});
 
     /** Inserts points already in the map frame with their covariance (the shared insertion core,
      * for sensors the map does not model). `continuityBound_m` is eq 14's Delta_zmax. */
@@ -150,7 +153,8 @@ public:
     bool isEmpty() const override;
     std::string asString() const override;
     void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
-    /** Writes PREFIX_height.png (height image, north up) and PREFIX.3Dscene. */
+    /** Writes PREFIX_height.png and PREFIX_sigma.png (colour images, north up), PREFIX_height.asc
+     * and PREFIX_sigma.asc (ESRI ASCII rasters [m]) and PREFIX.3Dscene. */
     void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
     float compute3DMatchingRatio(const mrpt::maps::CMetricMap* otherMap,
                                  const mrpt::poses::CPose3D& otherMapPose,
