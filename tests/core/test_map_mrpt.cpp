@@ -17,6 +17,7 @@
 #include <random>
 
 #include "multibin/PosePropagation.h"
+#include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 using mrpt::poses::CPose3D;
@@ -30,28 +31,6 @@ CPose3DPDFGaussian poseWithCov(const CPose3D& mean, const std::array<double, 6>&
     for (int i = 0; i < 6; i++) pdf.cov(i, i) = sigmas[size_t(i)] * sigmas[size_t(i)];
     pdf.cov(0, 4) = pdf.cov(4, 0) = 0.3 * sigmas[0] * sigmas[4];  // some correlation
     return pdf;
-}
-
-/** A pitched 2D laser seeing the plane z = 0 from 0.26 m, like the paper's URG-04LX. */
-mrpt::obs::CObservation2DRangeScan::Ptr pitchedScanOverFloor(double height_m, double pitch_rad) {
-    auto scan = mrpt::obs::CObservation2DRangeScan::Create();
-    scan->sensorLabel = "LASER";
-    scan->aperture = float(mrpt::DEG2RAD(240.0));
-    scan->maxRange = 4.0f;
-    scan->sensorPose = CPose3D(0, 0, height_m, 0, pitch_rad, 0);
-    const size_t N = 683;
-    scan->resizeScan(N);
-    for (size_t i = 0; i < N; i++) {
-        const double a = -0.5 * scan->aperture + scan->aperture * double(i) / (N - 1);
-        // Ray direction in the robot frame; hits z = 0 at t = h / -dz.
-        const mrpt::math::TVector3D d =
-            scan->sensorPose.rotateVector(mrpt::math::TVector3D(std::cos(a), std::sin(a), 0));
-        const double t = d.z < -1e-3 ? height_m / -d.z : 100.0;
-        const bool valid = t < scan->maxRange;
-        scan->setScanRange(i, valid ? float(t) : 0.f);
-        scan->setScanRangeValidity(i, valid);
-    }
-    return scan;
 }
 
 std::vector<uint8_t> serialize(const mrpt::serialization::CSerializable& o) {
@@ -138,7 +117,7 @@ TEST(PosePropagation, CovarianceMatchesMonteCarlo) {
 
 TEST(CMultiBinElevationMap, PitchedLaserOverFloorGivesFlatMapWithHonestSigma) {
     CMultiBinElevationMap map;
-    const auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    const auto scan = test_scenes::pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
     CPose3DPDFGaussian pose =
         poseWithCov(CPose3D(0, 0, 0, 0, 0, 0), {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4});
     ASSERT_TRUE(map.insertObservation(*scan, pose));
@@ -156,7 +135,7 @@ TEST(CMultiBinElevationMap, UsesLatestRobotPoseCovarianceWhileFresh) {
     auto robotPose = mrpt::obs::CObservationRobotPose::Create();
     robotPose->pose = poseWithCov(CPose3D(), {0.001, 0.001, 0.02, 0.001, 0.001, 0.001});
     robotPose->timestamp = mrpt::Clock::fromDouble(100.0);
-    auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    auto scan = test_scenes::pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
     map.insertionOptions.max_elevation_uncertainty_m = 1.0;
 
     scan->timestamp = mrpt::Clock::fromDouble(100.1);
@@ -185,7 +164,7 @@ TEST(CMultiBinElevationMap, SerializationRoundTripIsBitExactThroughClassRegistry
     CMultiBinElevationMap map;
     map.insertionOptions.height_sigma_floor_m = 0.0031;
     map.insertionOptions.sensor_labels = {"LASER", "STEREO"};
-    const auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    const auto scan = test_scenes::pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
     for (int k = 0; k < 5; k++)
         map.insertObservation(*scan, poseWithCov(CPose3D(0.05 * k, 0, 0.01 * k, 0.1 * k, 0, 0),
                                                  {1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3}));
@@ -217,7 +196,7 @@ TEST(CMultiBinElevationMap, SerializationRoundTripIsBitExactThroughClassRegistry
 
 TEST(CMultiBinElevationMap, CorruptOrUnknownVersionSerializationIsRefused) {
     CMultiBinElevationMap map;
-    map.insertObservation(*pitchedScanOverFloor(0.26, 0.78), CPose3D());
+    map.insertObservation(*test_scenes::pitchedScanOverFloor(0.26, 0.78), CPose3D());
     std::vector<uint8_t> bytes = serialize(map);
     // Truncated stream.
     {
@@ -306,7 +285,7 @@ TEST(CMultiBinElevationMap, CMultiMetricMapFromIniTextContainsTheMap) {
     ASSERT_TRUE(map);
     EXPECT_DOUBLE_EQ(map->creationOptions.resolution_m, 0.03);
     EXPECT_DOUBLE_EQ(map->insertionOptions.max_elevation_uncertainty_m, 0.08);
-    const auto scan = pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    const auto scan = test_scenes::pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
     mm.insertObservation(*scan, CPose3D());
     EXPECT_FALSE(map->isEmpty());
 
