@@ -55,8 +55,8 @@ Arguments parseArguments(int argc, char** argv) {
     Arguments a;
     if (argc == 1) {
         const fs::path src = MULTIBIN_SOURCE_DIR;
-        a.config = (src / "ini" / "mockup.ini").string();
-        a.rawlog = (src / "rawlogs" / "mockup.rawlog").string();
+        a.config = (src / "ini" / "depth-camera.ini").string();
+        a.rawlog = (src / "rawlogs" / "mrpt_tests_rgbd.rawlog").string();
         a.out = "elevation-mapper-out";
         a.usedDefaults = true;
         return a;
