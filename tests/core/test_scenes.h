@@ -31,5 +31,42 @@ inline mrpt::obs::CObservation2DRangeScan::Ptr pitchedScanOverFloor(double heigh
     }
     return scan;
 }
+/** A pitched 2D laser scan of a height field `terrain(x, y)` [m], found by ray marching,
+ * with the robot at `robot` and the laser `height_m` above it, pitched down by `pitch_rad`. */
+template <typename Terrain>
+mrpt::obs::CObservation2DRangeScan::Ptr pitchedScanOver(const Terrain& terrain,
+                                                        const mrpt::poses::CPose3D& robot,
+                                                        double height_m, double pitch_rad) {
+    auto scan = mrpt::obs::CObservation2DRangeScan::Create();
+    scan->sensorLabel = "LASER";
+    scan->aperture = float(mrpt::DEG2RAD(240.0));
+    scan->maxRange = 4.0f;
+    scan->sensorPose = mrpt::poses::CPose3D(0, 0, height_m, 0, pitch_rad, 0);
+    const size_t N = 683;
+    scan->resizeScan(N);
+    const mrpt::poses::CPose3D sensorInMap = robot + scan->sensorPose;
+    for (size_t i = 0; i < N; i++) {
+        const double a = -0.5 * scan->aperture + scan->aperture * double(i) / (N - 1);
+        const mrpt::math::TVector3D d =
+            sensorInMap.rotateVector(mrpt::math::TVector3D(std::cos(a), std::sin(a), 0));
+        float range = 0;
+        auto below = [&](double t) {
+            return sensorInMap.z() + t * d.z <=
+                   terrain(sensorInMap.x() + t * d.x, sensorInMap.y() + t * d.y);
+        };
+        // The terrain is below the sensor: upward beams never hit. March in 4 mm steps, then
+        // bisect to 0.01 mm.
+        for (double t = 0.02; d.z < 0 && t < scan->maxRange; t += 0.004) {
+            if (!below(t)) continue;
+            double lo = t - 0.004, hi = t;
+            while (hi - lo > 1e-5) (below(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
+            range = float(hi);
+            break;
+        }
+        scan->setScanRange(i, range);
+        scan->setScanRangeValidity(i, range > 0);
+    }
+    return scan;
+}
 
 }  // namespace test_scenes

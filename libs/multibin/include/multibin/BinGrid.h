@@ -120,6 +120,29 @@ public:
         for (uint32_t b = m_heads[slot(ix, iy)]; b != kNoBin; b = m_pool[b].next) f(m_pool[b]);
     }
 
+    /** Calls f(Bin&) for every bin of the cell; a bin for which f returns false is removed.
+     * Returns the number of bins removed. */
+    template <typename F>
+    size_t editBins(int ix, int iy, F&& f);
+
+    /** @name Update cycles: which cells one observation updated (for the visibility constraint).
+     * @{ */
+    /** A cell updated in the current cycle, with the highest height accepted into it [m]. */
+    struct UpdatedCell {
+        int ix, iy;
+        float maxHeight_m;
+        uint32_t points;  //!< points accepted into the cell in this cycle
+    };
+    /** Starts a new cycle: forgets which cells were updated. */
+    void beginCycle();
+    const std::vector<UpdatedCell>& updatedCells() const { return m_updated; }
+    bool updatedThisCycle(int ix, int iy) const {
+        return m_window.contains(ix, iy) && m_stamp[slot(ix, iy)] == m_cycle;
+    }
+    /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
+    double maxHeight_m() const { return m_maxHeight_m; }
+    /** @} */
+
     /** Removes every bin of one cell. */
     void clearCell(int ix, int iy);
     /** Appends a bin as stored elsewhere (deserialization, grid-to-grid copies). */
@@ -147,11 +170,17 @@ private:
     }
     uint32_t allocateBin();
     void releaseChain(uint32_t head);
+    void noteUpdate(size_t slot, int ix, int iy, double height_m);
 
     double m_cellSize_m;
     CellWindow m_window;
-    std::vector<uint32_t> m_heads;  //!< per slot: first bin of the cell or kNoBin
-    std::vector<Bin> m_pool;        //!< all bins; free ones are chained from m_freeHead
+    std::vector<uint32_t> m_heads;         //!< per slot: first bin of the cell or kNoBin
+    std::vector<Bin> m_pool;               //!< all bins; free ones are chained from m_freeHead
+    std::vector<uint32_t> m_stamp;         //!< per slot: the cycle that last updated the cell
+    std::vector<uint32_t> m_updatedIndex;  //!< per slot: index into m_updated, this cycle
+    std::vector<UpdatedCell> m_updated;
+    uint32_t m_cycle = 1;
+    double m_maxHeight_m = -std::numeric_limits<double>::infinity();
     uint32_t m_freeHead = kNoBin;
     size_t m_freeCount = 0;
 };
@@ -179,6 +208,7 @@ void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
     auto handleEntering = [&](int ix, int iy) {
         int lx, ly;
         leaverOf(ix, iy, lx, ly);
+        m_stamp[slot(lx, ly)] = 0;
         if (m_heads[slot(lx, ly)] != kNoBin) {
             onLeave(lx, ly);
             clearCell(lx, ly);
@@ -200,6 +230,28 @@ void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
         }
     }
     m_window = newW;
+}
+
+template <typename F>
+size_t BinGrid::editBins(int ix, int iy, F&& f) {
+    if (!m_window.contains(ix, iy)) return 0;
+    size_t removed = 0;
+    const size_t s = slot(ix, iy);
+    uint32_t prev = kNoBin, b = m_heads[s];
+    while (b != kNoBin) {
+        const uint32_t next = m_pool[b].next;
+        if (f(m_pool[b])) {
+            prev = b;
+        } else {
+            (prev == kNoBin ? m_heads[s] : m_pool[prev].next) = next;
+            m_pool[b].next = m_freeHead;
+            m_freeHead = b;
+            m_freeCount++;
+            removed++;
+        }
+        b = next;
+    }
+    return removed;
 }
 
 }  // namespace multibin

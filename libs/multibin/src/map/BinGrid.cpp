@@ -30,6 +30,10 @@ void BinGrid::reset(double cellSize_m, const CellWindow& window) {
     m_cellSize_m = cellSize_m;
     m_window = window;
     m_heads.assign(window.cellCount(), kNoBin);
+    m_stamp.assign(window.cellCount(), 0);
+    m_updatedIndex.assign(window.cellCount(), 0);
+    m_updated.clear();
+    m_maxHeight_m = -std::numeric_limits<double>::infinity();
     m_pool.clear();
     m_freeHead = kNoBin;
     m_freeCount = 0;
@@ -60,6 +64,31 @@ void BinGrid::growToInclude(const CellWindow& w) {
         }
     m_heads.swap(heads);
     m_window = nw;
+    // Growth happens between update cycles: the cycle bookkeeping starts afresh.
+    m_stamp.assign(nw.cellCount(), 0);
+    m_updatedIndex.assign(nw.cellCount(), 0);
+    m_updated.clear();
+}
+
+void BinGrid::beginCycle() {
+    m_updated.clear();
+    if (++m_cycle == 0) {  // wrapped: no stale stamp may match the new cycle
+        std::fill(m_stamp.begin(), m_stamp.end(), 0);
+        m_cycle = 1;
+    }
+}
+
+void BinGrid::noteUpdate(size_t s, int ix, int iy, double height_m) {
+    m_maxHeight_m = std::max(m_maxHeight_m, height_m);
+    if (m_stamp[s] != m_cycle) {
+        m_stamp[s] = m_cycle;
+        m_updatedIndex[s] = static_cast<uint32_t>(m_updated.size());
+        m_updated.push_back({ix, iy, float(height_m), 1});
+    } else {
+        UpdatedCell& u = m_updated[m_updatedIndex[s]];
+        u.maxHeight_m = std::max(u.maxHeight_m, float(height_m));
+        u.points++;
+    }
 }
 
 uint32_t BinGrid::allocateBin() {
@@ -98,6 +127,7 @@ void BinGrid::appendBin(int ix, int iy, const Bin& bin) {
     const uint32_t b = allocateBin();  // may reallocate the pool: hold indices, not pointers
     m_pool[b] = bin;
     m_pool[b].next = kNoBin;
+    m_maxHeight_m = std::max(m_maxHeight_m, double(bin.height_m));
     const size_t s = slot(ix, iy);
     uint32_t last = m_heads[s];
     if (last == kNoBin) {
@@ -170,6 +200,7 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
     }
     bin.pointCount++;
     stats.accepted++;
+    noteUpdate(s, ix, iy, height_m);
     return true;
 }
 

@@ -130,6 +130,9 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     else
         s.fail("colormap", "expected jet, hot or grayscale, got '" + cmap + "'");
     s.read("color_by_sigma", color_by_sigma);
+    s.read("visibility_constraint", visibility.enabled);
+    s.read("visibility_margin", visibility.margin_m);
+    s.read("visibility_certainty_decrement", visibility.certaintyDecrement);
     s.finish();
     validate();
 }
@@ -153,6 +156,9 @@ void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CC
     c.write(section, "sensor_labels", labels);
     c.write(section, "colormap", std::string(colormapName(colormap)));
     c.write(section, "color_by_sigma", color_by_sigma);
+    c.write(section, "visibility_constraint", visibility.enabled);
+    c.write(section, "visibility_margin", visibility.margin_m);
+    c.write(section, "visibility_certainty_decrement", visibility.certaintyDecrement);
 }
 
 void CMultiBinElevationMap::TInsertionOptions::validate() const {
@@ -169,6 +175,9 @@ void CMultiBinElevationMap::TInsertionOptions::validate() const {
         if (!(v >= 0)) bad("default_pose_sigmas", "values must be >= 0");
     if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt", "must be >= 0 [s]");
     if (!(range_sigma_m > 0)) bad("range_sigma", "must be positive [m]");
+    if (!(visibility.margin_m >= 0)) bad("visibility_margin", "must be >= 0 [m]");
+    if (!(visibility.certaintyDecrement > 0))
+        bad("visibility_certainty_decrement", "must be positive");
     if (!(min_range_m >= 0 && max_range_m > min_range_m))
         bad("min_range/max_range", "need 0 <= min_range < max_range [m]");
 }
@@ -233,6 +242,7 @@ void CMultiBinElevationMap::internal_clear() {
     }
     m_grid.reset(res, w);
     m_stats = {};
+    m_visibilityStats = {};
     m_poseFallbacks = 0;
     m_skippedByLabel = 0;
     m_lastRobotPose.reset();

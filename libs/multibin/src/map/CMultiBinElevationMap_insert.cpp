@@ -183,14 +183,25 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     PointsWithCov mapPoints;
     propagator.apply(sensorPoints, mapPoints);
     growToCover(mapPoints, propagator.sensorOriginInMap_m());
-    return insertPoints(mapPoints, continuityBound_m).accepted > 0;
+    return insertPoints(mapPoints, continuityBound_m, propagator.sensorOriginInMap_m()).accepted >
+           0;
 }
 
-multibin::InsertStats CMultiBinElevationMap::insertPoints(const PointsWithCov& mapPoints,
-                                                          double continuityBound_m) {
-    const multibin::InsertStats s =
-        m_grid.insertPoints(mapPoints, binUpdateParams(), continuityBound_m);
+multibin::InsertStats CMultiBinElevationMap::insertPoints(
+    const PointsWithCov& mapPoints, double continuityBound_m,
+    const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    const multibin::BinUpdateParams params = binUpdateParams();
+    m_grid.beginCycle();
+    const multibin::InsertStats s = m_grid.insertPoints(mapPoints, params, continuityBound_m);
     m_stats += s;
+    if (sensorOrigin_m) {
+        const multibin::VisibilityStats v = multibin::applyVisibilityConstraint(
+            m_grid, *sensorOrigin_m, insertionOptions.visibility, params);
+        m_visibilityStats.raysCast += v.raysCast;
+        m_visibilityStats.cellsVisited += v.cellsVisited;
+        m_visibilityStats.binsRemoved += v.binsRemoved;
+        m_visibilityStats.binsWeakened += v.binsWeakened;
+    }
     return s;
 }
 

@@ -18,6 +18,7 @@
 
 #include "multibin/BinGrid.h"
 #include "multibin/EsriAsciiGrid.h"
+#include "multibin/VisibilityConstraint.h"
 
 namespace mrpt::maps {
 
@@ -92,6 +93,9 @@ public:
         double min_range_m = 0.02, max_range_m = 20.0;  //!< accepted ranges [m]
         /** Only observations with these sensor labels are inserted; empty = all. */
         std::vector<std::string> sensor_labels;
+        /** Visibility constraint after each observation (keys `visibility_constraint`,
+         * `visibility_margin`, `visibility_certainty_decrement`). */
+        multibin::VisibilityParams visibility;
         mrpt::img::TColormap colormap = mrpt::img::cmJET;
         bool color_by_sigma = false;  //!< 3D view coloured by sigma instead of height
 
@@ -124,10 +128,13 @@ public:
                                        const std::function<void(size_t, size_t)>& progress = {});
 
     /** Inserts points already in the map frame with their covariance (the shared insertion core,
-     * for sensors the map does not model). `continuityBound_m` is eq 14's Delta_zmax. */
+     * for sensors the map does not model): one update cycle. `continuityBound_m` is eq 14's
+     * Delta_zmax. With a sensor origin [m, map frame] the visibility constraint follows. The grid
+     * does not grow here (see insertObservation). */
     multibin::InsertStats insertPoints(
         const multibin::PointsWithCov& mapPoints,
-        double continuityBound_m = std::numeric_limits<double>::infinity());
+        double continuityBound_m = std::numeric_limits<double>::infinity(),
+        const std::optional<Eigen::Vector3d>& sensorOrigin_m = std::nullopt);
 
     /** @name Queries @{ */
     const multibin::BinGrid& grid() const { return m_grid; }
@@ -142,6 +149,8 @@ public:
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
     /** Sums of what every insertion did with its points. */
     const multibin::InsertStats& insertStats() const { return m_stats; }
+    /** Sums of what the visibility constraint did. */
+    const multibin::VisibilityStats& visibilityStats() const { return m_visibilityStats; }
     /** Observations inserted with the default pose covariance because no valid pose PDF was known.
      */
     size_t poseFallbackCount() const { return m_poseFallbacks; }
@@ -203,6 +212,7 @@ private:
 
     multibin::BinGrid m_grid;
     multibin::InsertStats m_stats;
+    multibin::VisibilityStats m_visibilityStats;
     size_t m_poseFallbacks = 0;
     size_t m_skippedByLabel = 0;
     /** The latest CObservationRobotPose: its PDF and timestamp. */

@@ -1,0 +1,74 @@
+/* Part of the multibin elevation-mapping library. */
+#include "multibin/VisibilityConstraint.h"
+
+#include <cmath>
+
+namespace multibin {
+
+VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
+                                          const VisibilityParams& vis,
+                                          const BinUpdateParams& binParams) {
+    VisibilityStats stats;
+    if (!vis.enabled) return stats;
+    const double cell = grid.cellSize_m();
+    const double step = 0.5 * cell;
+    const double maxStoredHeight = grid.maxHeight_m();
+    auto conflictMargin = [&](const Bin& b) {
+        return vis.margin_m + 3.0 * BinGrid::sigma_m(b, binParams);
+    };
+
+    for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
+        const Bin* winner = grid.winningBin(u.ix, u.iy);
+        const float targetCertainty = winner ? winner->certainty : 0.f;
+        const double tz = u.maxHeight_m;
+        const float decrement = vis.certaintyDecrement * float(u.points);
+
+        // Bins of the updated cell above all that was measured in it now.
+        grid.editBins(u.ix, u.iy, [&](Bin& b) {
+            if (b.height_m - tz <= conflictMargin(b)) return true;
+            b.certainty -= decrement;
+            stats.binsWeakened++;
+            if (b.certainty > 0) return true;
+            stats.binsRemoved++;
+            return false;
+        });
+
+        // Walk the line of sight from the updated cell back to the sensor.
+        const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
+        const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
+        const double length = std::hypot(dx, dy);
+        if (length < cell) continue;
+        stats.raysCast++;
+        const double slope = (sensor_m.z() - tz) / length;  // ray height gained per metre back
+        // The ray's highest point within a cell lies at most half a diagonal from a sample.
+        const double inCellRise = std::abs(slope) * 0.7072 * cell;
+        int lastIx = u.ix, lastIy = u.iy;
+        for (double d = step; d < length; d += step) {
+            const double rayZ = tz + slope * d;
+            if (slope > 0 && rayZ - inCellRise > maxStoredHeight + vis.margin_m) break;
+            const int ix = grid.cellIndex(tx + dx * d / length);
+            const int iy = grid.cellIndex(ty + dy * d / length);
+            if (ix == lastIx && iy == lastIy) continue;
+            lastIx = ix;
+            lastIy = iy;
+            if (!grid.window().contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
+            stats.cellsVisited++;
+            const double rayHigh = rayZ + inCellRise;
+            grid.editBins(ix, iy, [&](Bin& b) {
+                if (b.height_m - rayHigh <= conflictMargin(b)) return true;
+                if (b.certainty < targetCertainty) {
+                    stats.binsRemoved++;
+                    return false;
+                }
+                b.certainty -= decrement;
+                stats.binsWeakened++;
+                if (b.certainty > 0) return true;
+                stats.binsRemoved++;
+                return false;
+            });
+        }
+    }
+    return stats;
+}
+
+}  // namespace multibin
