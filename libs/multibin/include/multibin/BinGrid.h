@@ -109,6 +109,11 @@ public:
     bool insertHeight(int ix, int iy, double height_m, double variance_m2,
                       const BinUpdateParams& params, double continuityBound_m, InsertStats& stats);
 
+    /** Fuses a bin estimated elsewhere (another grid) into cell (ix, iy): Kalman fusion of its
+     * height and variance, certainty and point count added; no gates. The cell must be inside the
+     * window. */
+    void fuseBin(int ix, int iy, const Bin& other, const BinUpdateParams& params);
+
     /** The cell's winning bin: most certain, ties broken by the lower variance; nullptr if the cell
      * has no bin with certainty > 0 or is outside the window. */
     const Bin* winningBin(int ix, int iy) const;

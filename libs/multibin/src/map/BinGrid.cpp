@@ -138,6 +138,39 @@ void BinGrid::appendBin(int ix, int iy, const Bin& bin) {
     m_pool[last].next = b;
 }
 
+void BinGrid::fuseBin(int ix, int iy, const Bin& other, const BinUpdateParams& params) {
+    if (!m_window.contains(ix, iy))
+        throw std::out_of_range("BinGrid::fuseBin: cell outside the window");
+    const double binPos = std::floor(other.height_m / params.binHeight_m);
+    if (!(binPos >= std::numeric_limits<int16_t>::min() &&
+          binPos <= std::numeric_limits<int16_t>::max()))
+        return;
+    const auto n = static_cast<int16_t>(binPos);
+    const size_t s = slot(ix, iy);
+    uint32_t prev = kNoBin, b = m_heads[s];
+    while (b != kNoBin && m_pool[b].index != n) {
+        prev = b;
+        b = m_pool[b].next;
+    }
+    if (b == kNoBin) {
+        b = allocateBin();
+        m_pool[b] = other;
+        m_pool[b].index = n;
+        m_pool[b].next = kNoBin;
+        (prev == kNoBin ? m_heads[s] : m_pool[prev].next) = b;
+        m_maxHeight_m = std::max(m_maxHeight_m, double(other.height_m));
+        return;
+    }
+    Bin& bin = m_pool[b];
+    const double v1 = bin.variance_m2, v2 = other.variance_m2;
+    const double K = v1 + v2 > 0 ? v1 / (v1 + v2) : 0.5;
+    bin.height_m = static_cast<float>(bin.height_m - K * (bin.height_m - other.height_m));
+    bin.variance_m2 = static_cast<float>((1.0 - K) * v1);
+    bin.certainty += other.certainty;
+    bin.pointCount += other.pointCount;
+    m_maxHeight_m = std::max(m_maxHeight_m, double(bin.height_m));
+}
+
 const Bin* BinGrid::winningBin(int ix, int iy) const {
     if (!m_window.contains(ix, iy)) return nullptr;
     const Bin* best = nullptr;

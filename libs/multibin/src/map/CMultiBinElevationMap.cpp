@@ -65,6 +65,11 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     s.read("max_x", max_x);
     s.read("min_y", min_y);
     s.read("max_y", max_y);
+    s.read("dual_grid", dual_grid);
+    s.read("local_size_m", local_size_m);
+    s.read("local_resolution", local_resolution_m);
+    s.read("global_size_m", global_size_m);
+    s.read("global_resolution", global_resolution_m);
     s.allow(kGenericMapKeys);
     s.finish();
     validate();
@@ -80,6 +85,11 @@ void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CCo
     c.write(section, "max_x", max_x);
     c.write(section, "min_y", min_y);
     c.write(section, "max_y", max_y);
+    c.write(section, "dual_grid", dual_grid);
+    c.write(section, "local_size_m", local_size_m);
+    c.write(section, "local_resolution", local_resolution_m);
+    c.write(section, "global_size_m", global_size_m);
+    c.write(section, "global_resolution", global_resolution_m);
 }
 
 void CMultiBinElevationMap::TCreationOptions::validate() const {
@@ -93,6 +103,14 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
     if (!(max_size_m > 0) || !std::isfinite(max_size_m))
         bad("max_size_m", "must be a positive size [m]");
     if (max_x < min_x || max_y < min_y) bad("min_x/max_x/min_y/max_y", "max must not be below min");
+    for (const auto& [key, v] : {std::pair{"local_size_m", local_size_m},
+                                 {"local_resolution", local_resolution_m},
+                                 {"global_size_m", global_size_m},
+                                 {"global_resolution", global_resolution_m}})
+        if (!(v > 0) || !std::isfinite(v)) bad(key, "must be positive [m]");
+    if (dual_grid &&
+        (local_size_m / local_resolution_m > 2e4 || global_size_m / global_resolution_m > 2e4))
+        bad("local_size_m/global_size_m", "a dual grid side may hold at most 20000 cells");
     if (!grow && (max_x <= min_x || max_y <= min_y))
         bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
     // Refuse before allocating: the cell heads alone take 4 bytes per cell.
@@ -119,6 +137,7 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     s.read("min_range", min_range_m);
     s.read("max_range", max_range_m);
     s.read("sensor_labels", sensor_labels);
+    s.read("global_sensor_labels", global_sensor_labels);
     std::string cmap = colormapName(colormap);
     s.read("colormap", cmap);
     if (cmap == "jet")
@@ -154,6 +173,10 @@ void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CC
     std::string labels;
     for (const auto& l : sensor_labels) labels += (labels.empty() ? "" : ",") + l;
     c.write(section, "sensor_labels", labels);
+    std::string globalLabels;
+    for (const auto& l : global_sensor_labels)
+        globalLabels += (globalLabels.empty() ? "" : ",") + l;
+    c.write(section, "global_sensor_labels", globalLabels);
     c.write(section, "colormap", std::string(colormapName(colormap)));
     c.write(section, "color_by_sigma", color_by_sigma);
     c.write(section, "visibility_constraint", visibility.enabled);
@@ -240,7 +263,19 @@ void CMultiBinElevationMap::internal_clear() {
         w.nx = static_cast<int>(std::ceil(c.max_x / res)) - w.ix0;
         w.ny = static_cast<int>(std::ceil(c.max_y / res)) - w.iy0;
     }
-    m_grid.reset(res, w);
+    if (c.dual_grid) {
+        // Robot-centred windows, placed by recenter() at the first observation.
+        auto side = [](double size_m, double res_m) {
+            return std::max(1, static_cast<int>(std::lround(size_m / res_m)));
+        };
+        const int nl = side(c.local_size_m, c.local_resolution_m);
+        const int ng = side(c.global_size_m, c.global_resolution_m);
+        m_local.reset(c.local_resolution_m, multibin::CellWindow{-nl / 2, -nl / 2, nl, nl});
+        m_grid.reset(c.global_resolution_m, multibin::CellWindow{-ng / 2, -ng / 2, ng, ng});
+    } else {
+        m_grid.reset(res, w);
+        m_local.reset(res, multibin::CellWindow{});
+    }
     m_stats = {};
     m_visibilityStats = {};
     m_poseFallbacks = 0;
@@ -260,14 +295,35 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
-    const multibin::Bin* b = m_grid.winningBin(m_grid.cellIndex(x_m), m_grid.cellIndex(y_m));
-    if (!b) return false;
-    height_m = b->height_m;
-    sigma_m = multibin::BinGrid::sigma_m(*b, binUpdateParams());
+    const multibin::BinUpdateParams p = binUpdateParams();
+    const multibin::Bin* g = m_grid.winningBin(m_grid.cellIndex(x_m), m_grid.cellIndex(y_m));
+    const multibin::Bin* l =
+        isDualGrid() ? m_local.winningBin(m_local.cellIndex(x_m), m_local.cellIndex(y_m)) : nullptr;
+    if (!g && !l) return false;
+    if (!g || !l) {
+        const multibin::Bin* b = g ? g : l;
+        height_m = b->height_m;
+        sigma_m = multibin::BinGrid::sigma_m(*b, p);
+        return true;
+    }
+    // Both grids: their data are disjoint (each observation updates one grid), so agreeing
+    // estimates are fused by inverse variance; disagreeing ones leave the more certain.
+    const double vg = std::pow(multibin::BinGrid::sigma_m(*g, p), 2);
+    const double vl = std::pow(multibin::BinGrid::sigma_m(*l, p), 2);
+    const double d = double(l->height_m) - double(g->height_m);
+    if (d * d <= 9.0 * (vg + vl)) {
+        const double v = 1.0 / (1.0 / vg + 1.0 / vl);
+        height_m = v * (l->height_m / vl + g->height_m / vg);
+        sigma_m = std::sqrt(v);
+    } else {
+        const multibin::Bin* b = l->certainty >= g->certainty ? l : g;
+        height_m = b->height_m;
+        sigma_m = multibin::BinGrid::sigma_m(*b, p);
+    }
     return true;
 }
 
-bool CMultiBinElevationMap::isEmpty() const { return m_grid.empty(); }
+bool CMultiBinElevationMap::isEmpty() const { return m_grid.empty() && m_local.empty(); }
 
 std::string CMultiBinElevationMap::asString() const {
     std::ostringstream os;

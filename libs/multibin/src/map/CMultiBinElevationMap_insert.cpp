@@ -182,21 +182,32 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     PointsWithCov mapPoints;
     propagator.apply(sensorPoints, mapPoints);
-    growToCover(mapPoints, propagator.sensorOriginInMap_m());
-    return insertPoints(mapPoints, continuityBound_m, propagator.sensorOriginInMap_m()).accepted >
-           0;
+    if (isDualGrid())
+        recenter(robotPose.mean.x(), robotPose.mean.y());
+    else
+        growToCover(mapPoints, propagator.sensorOriginInMap_m());
+    return insertIntoGrid(gridFor(obs), mapPoints, continuityBound_m,
+                          propagator.sensorOriginInMap_m())
+               .accepted > 0;
 }
 
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    return insertIntoGrid(isDualGrid() ? m_local : m_grid, mapPoints, continuityBound_m,
+                          sensorOrigin_m);
+}
+
+multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
+    multibin::BinGrid& grid, const PointsWithCov& mapPoints, double continuityBound_m,
+    const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
     const multibin::BinUpdateParams params = binUpdateParams();
-    m_grid.beginCycle();
-    const multibin::InsertStats s = m_grid.insertPoints(mapPoints, params, continuityBound_m);
+    grid.beginCycle();
+    const multibin::InsertStats s = grid.insertPoints(mapPoints, params, continuityBound_m);
     m_stats += s;
     if (sensorOrigin_m) {
         const multibin::VisibilityStats v = multibin::applyVisibilityConstraint(
-            m_grid, *sensorOrigin_m, insertionOptions.visibility, params);
+            grid, *sensorOrigin_m, insertionOptions.visibility, params);
         m_visibilityStats.raysCast += v.raysCast;
         m_visibilityStats.cellsVisited += v.cellsVisited;
         m_visibilityStats.binsRemoved += v.binsRemoved;
@@ -208,7 +219,7 @@ multibin::InsertStats CMultiBinElevationMap::insertPoints(
 void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
                                         const Eigen::Vector3d& sensor_m) {
     const auto& c = creationOptions;
-    if (!c.grow || mapPoints.empty()) return;
+    if (!c.grow || c.dual_grid || mapPoints.empty()) return;
     // Only points within max_size_m/2 of the sensor can make the grid grow: a stray far return
     // must not stretch the map.
     const double half = 0.5 * c.max_size_m;

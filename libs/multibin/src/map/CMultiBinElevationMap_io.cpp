@@ -15,6 +15,59 @@ constexpr const char* kCreationSection = "creation";
 constexpr const char* kInsertionSection = "insertion";
 // A serialized window larger than this is corrupt (the options refuse such maps anyway).
 constexpr double kMaxSerializedCells = 2.0e8;
+
+/** A grid: its window, then each non-empty cell with its bins. */
+void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid) {
+    const multibin::CellWindow& w = grid.window();
+    out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
+    uint64_t nonEmpty = 0;
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            bool any = false;
+            grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
+            nonEmpty += any;
+        }
+    out << nonEmpty;
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            uint16_t n = 0;
+            grid.forEachBin(ix, iy, [&](const multibin::Bin&) { n++; });
+            if (!n) continue;
+            out << int32_t(ix) << int32_t(iy) << n;
+            grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+                out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
+            });
+        }
+}
+
+void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double cellSize_m) {
+    auto corrupt = [](const std::string& what) {
+        throw std::runtime_error("CMultiBinElevationMap: corrupt serialized map (" + what + ")");
+    };
+    int32_t ix0, iy0, nx, ny;
+    in >> ix0 >> iy0 >> nx >> ny;
+    if (nx < 0 || ny < 0 || double(nx) * double(ny) > kMaxSerializedCells)
+        corrupt("window of " + std::to_string(nx) + " x " + std::to_string(ny) + " cells");
+    grid.reset(cellSize_m, multibin::CellWindow{ix0, iy0, nx, ny});
+    uint64_t nonEmpty;
+    in >> nonEmpty;
+    if (nonEmpty > uint64_t(nx) * uint64_t(ny))
+        corrupt(std::to_string(nonEmpty) + " cells in a window of " +
+                std::to_string(uint64_t(nx) * uint64_t(ny)));
+    for (uint64_t c = 0; c < nonEmpty; c++) {
+        int32_t ix, iy;
+        uint16_t n;
+        in >> ix >> iy >> n;
+        if (!grid.window().contains(ix, iy)) corrupt("cell outside the window");
+        for (uint16_t k = 0; k < n; k++) {
+            multibin::Bin b;
+            in >> b.height_m >> b.variance_m2 >> b.certainty >> b.pointCount >> b.index;
+            if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) || !(b.certainty >= 0))
+                corrupt("invalid bin");
+            grid.appendBin(ix, iy, b);
+        }
+    }
+}
 }  // namespace
 
 uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 0; }
@@ -28,26 +81,8 @@ void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) cons
     ini.getContent(iniText);
     out << iniText;
 
-    const multibin::CellWindow& w = m_grid.window();
-    out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
-    uint64_t nonEmpty = 0;
-    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
-            bool any = false;
-            m_grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
-            nonEmpty += any;
-        }
-    out << nonEmpty;
-    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
-            uint16_t n = 0;
-            m_grid.forEachBin(ix, iy, [&](const multibin::Bin&) { n++; });
-            if (!n) continue;
-            out << int32_t(ix) << int32_t(iy) << n;
-            m_grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
-                out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
-            });
-        }
+    writeGrid(out, m_grid);
+    if (creationOptions.dual_grid) writeGrid(out, m_local);
 }
 
 void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version) {
@@ -61,39 +96,16 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
             creation.loadFromConfigFile(ini, kCreationSection);
             insertion.loadFromConfigFile(ini, kInsertionSection);
 
-            int32_t ix0, iy0, nx, ny;
-            in >> ix0 >> iy0 >> nx >> ny;
-            if (nx < 0 || ny < 0 || double(nx) * double(ny) > kMaxSerializedCells)
-                throw std::runtime_error(
-                    "CMultiBinElevationMap: corrupt serialized map (window of " +
-                    std::to_string(nx) + " x " + std::to_string(ny) + " cells)");
+            // Read everything before touching the map: a corrupt stream leaves it unchanged.
+            multibin::BinGrid grid, local;
+            readGrid(in, grid,
+                     creation.dual_grid ? creation.global_resolution_m : creation.resolution_m);
+            if (creation.dual_grid) readGrid(in, local, creation.local_resolution_m);
             creationOptions = creation;
             insertionOptions = insertion;
             internal_clear();
-            m_grid.reset(creation.resolution_m, multibin::CellWindow{ix0, iy0, nx, ny});
-
-            uint64_t nonEmpty;
-            in >> nonEmpty;
-            if (nonEmpty > uint64_t(nx) * uint64_t(ny))
-                throw std::runtime_error("CMultiBinElevationMap: corrupt serialized map (" +
-                                         std::to_string(nonEmpty) + " cells in a window of " +
-                                         std::to_string(uint64_t(nx) * uint64_t(ny)) + ")");
-            for (uint64_t c = 0; c < nonEmpty; c++) {
-                int32_t ix, iy;
-                uint16_t n;
-                in >> ix >> iy >> n;
-                if (!m_grid.window().contains(ix, iy))
-                    throw std::runtime_error(
-                        "CMultiBinElevationMap: corrupt serialized map (cell outside window)");
-                for (uint16_t k = 0; k < n; k++) {
-                    multibin::Bin b;
-                    in >> b.height_m >> b.variance_m2 >> b.certainty >> b.pointCount >> b.index;
-                    if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) || !(b.certainty >= 0))
-                        throw std::runtime_error(
-                            "CMultiBinElevationMap: corrupt serialized map (invalid bin)");
-                    m_grid.appendBin(ix, iy, b);
-                }
-            }
+            m_grid = std::move(grid);
+            m_local = std::move(local);
         } break;
         default:
             MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);

@@ -72,6 +72,15 @@ public:
          * grow = false. An empty range starts with no cells. */
         double min_x = 0, max_x = 0, min_y = 0, max_y = 0;
 
+        /** Dual grid (key `dual_grid`): a precise local grid and a large global grid, both
+         * centred on the robot and moved with it. When on, the keys below replace `resolution`,
+         * `grow`, `max_size_m` and the extent. */
+        bool dual_grid = false;
+        double local_size_m = 2.0;          //!< side of the local grid [m] (key `local_size_m`)
+        double local_resolution_m = 0.015;  //!< local cell size [m] (key `local_resolution`)
+        double global_size_m = 10.0;        //!< side of the global grid [m] (key `global_size_m`)
+        double global_resolution_m = 0.05;  //!< global cell size [m] (key `global_resolution`)
+
         void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                 const std::string& section) override;
         void saveToConfigFile(mrpt::config::CConfigFileBase& target,
@@ -93,6 +102,9 @@ public:
         double min_range_m = 0.02, max_range_m = 20.0;  //!< accepted ranges [m]
         /** Only observations with these sensor labels are inserted; empty = all. */
         std::vector<std::string> sensor_labels;
+        /** Dual grid only: observations with these labels (and every CObservationStereoImages)
+         * update the global grid; all others update the local grid. */
+        std::vector<std::string> global_sensor_labels{"STEREO"};
         /** Visibility constraint after each observation (keys `visibility_constraint`,
          * `visibility_margin`, `visibility_certainty_decrement`). */
         multibin::VisibilityParams visibility;
@@ -139,8 +151,22 @@ public:
     /** @name Queries @{ */
     const multibin::BinGrid& grid() const { return m_grid; }
     multibin::BinUpdateParams binUpdateParams() const;
-    /** Height [m] and sigma [m] of the cell at (x, y) from its winning bin; false if unobserved. */
+    /** Height [m] and sigma [m] at (x, y) from the winning bin; false if unobserved. With the
+     * dual grid, where both grids know the place and agree within 3 sigma, their independent
+     * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
+
+    /** @name Dual grid @{ */
+    bool isDualGrid() const { return creationOptions.dual_grid; }
+    /** The precise local grid (empty unless dual grid). grid() is the global one. */
+    const multibin::BinGrid& localGrid() const { return m_local; }
+    /** Centres both grids on (x, y) [m]: cells still inside are untouched; local cells that
+     * leave are written back into the global grid. Called before each insertion. */
+    void recenter(double x_m, double y_m);
+    /** Writes every local cell back into the global grid and empties the local grid, so the
+     * global grid holds the whole run (for evaluation and export). */
+    void flushLocalToGlobal();
+    /** @} */
     /** Winning-bin heights (or sigmas) of the window as a raster [m], NaN where unobserved;
      * row 0 is the southernmost row. */
     multibin::EsriAsciiGrid toRaster(bool sigma = false) const;
@@ -210,7 +236,17 @@ private:
     void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m);
     bool acceptsLabel(const std::string& label) const;
 
-    multibin::BinGrid m_grid;
+    /** One update cycle of `grid`: insertion core, then the visibility constraint. */
+    multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid,
+                                         const multibin::PointsWithCov& mapPoints,
+                                         double continuityBound_m,
+                                         const std::optional<Eigen::Vector3d>& sensorOrigin_m);
+    /** Fuses one local cell into the global grid (write-back of data the global grid lacks). */
+    void writeBackLocalCell(int ix, int iy);
+    multibin::BinGrid& gridFor(const mrpt::obs::CObservation& obs);
+
+    multibin::BinGrid m_grid;   //!< the single grid, or the global grid of the dual grid
+    multibin::BinGrid m_local;  //!< dual grid only: the precise local grid
     multibin::InsertStats m_stats;
     multibin::VisibilityStats m_visibilityStats;
     size_t m_poseFallbacks = 0;

@@ -1,0 +1,58 @@
+/* Part of the multibin elevation-mapping library.
+ * CMultiBinElevationMap: the dual grid (a precise local grid and a large global grid that move
+ * with the robot).
+ *
+ * Each observation updates exactly one grid (global: stereo and global_sensor_labels; local: all
+ * other sensors), so no datum is ever in both. Local cells that scroll out are fused into the
+ * global grid, which therefore holds everything seen; a local cell that enters starts empty and
+ * queries combine it with the global estimate (getHeight), so the same data are never counted
+ * twice. */
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/obs/CObservationStereoImages.h>
+
+#include <algorithm>
+#include <cmath>
+
+using namespace mrpt::maps;
+
+multibin::BinGrid& CMultiBinElevationMap::gridFor(const mrpt::obs::CObservation& obs) {
+    if (!isDualGrid()) return m_grid;
+    const auto& labels = insertionOptions.global_sensor_labels;
+    const bool global = dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs) != nullptr ||
+                        std::find(labels.begin(), labels.end(), obs.sensorLabel) != labels.end();
+    return global ? m_grid : m_local;
+}
+
+void CMultiBinElevationMap::writeBackLocalCell(int ix, int iy) {
+    const double x = m_local.cellCenter_m(ix), y = m_local.cellCenter_m(iy);
+    const int gx = m_grid.cellIndex(x), gy = m_grid.cellIndex(y);
+    if (!m_grid.window().contains(gx, gy)) return;  // beyond the global grid too
+    const multibin::BinUpdateParams params = binUpdateParams();
+    m_local.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+        if (b.certainty > 0) m_grid.fuseBin(gx, gy, b, params);
+    });
+}
+
+void CMultiBinElevationMap::recenter(double x_m, double y_m) {
+    if (!isDualGrid()) return;
+    // Global first, so that local cells written back land inside it.
+    for (multibin::BinGrid* g : {&m_grid, &m_local}) {
+        const multibin::CellWindow& w = g->window();
+        const int ix0 = g->cellIndex(x_m) - w.nx / 2, iy0 = g->cellIndex(y_m) - w.ny / 2;
+        if (ix0 == w.ix0 && iy0 == w.iy0) continue;
+        if (g == &m_local)
+            g->moveWindowTo(ix0, iy0, [&](int ix, int iy) { writeBackLocalCell(ix, iy); });
+        else
+            g->moveWindowTo(ix0, iy0);
+    }
+}
+
+void CMultiBinElevationMap::flushLocalToGlobal() {
+    if (!isDualGrid()) return;
+    const multibin::CellWindow w = m_local.window();
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            writeBackLocalCell(ix, iy);
+            m_local.clearCell(ix, iy);
+        }
+}
