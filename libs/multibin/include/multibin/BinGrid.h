@@ -80,7 +80,7 @@ public:
      * absurd coordinates never overflow. */
     int cellIndex(double coord_m) const {
         constexpr double kLimit = std::numeric_limits<int>::max() / 4;
-        const double f = std::floor(coord_m / m_cellSize_m);
+        const double f = std::floor(coord_m * m_invCellSize);
         if (std::isnan(f)) return static_cast<int>(kLimit);
         return static_cast<int>(f < -kLimit ? -kLimit : (f > kLimit ? kLimit : f));
     }
@@ -167,22 +167,27 @@ public:
     }
 
 private:
+    /** Storage slot of a cell inside the window: (ix mod nx) + (iy mod ny) nx, computed from the
+     * window origin's residues without a division. */
     size_t slot(int ix, int iy) const {
-        int sx = ix % m_window.nx, sy = iy % m_window.ny;
-        if (sx < 0) sx += m_window.nx;
-        if (sy < 0) sy += m_window.ny;
+        int sx = ix - m_window.ix0 + m_originSlotX, sy = iy - m_window.iy0 + m_originSlotY;
+        if (sx >= m_window.nx) sx -= m_window.nx;
+        if (sy >= m_window.ny) sy -= m_window.ny;
         return size_t(sx) + size_t(sy) * size_t(m_window.nx);
     }
+    void setWindow(const CellWindow& w);
     uint32_t allocateBin();
     void releaseChain(uint32_t head);
     void noteUpdate(size_t slot, int ix, int iy, double height_m);
 
     double m_cellSize_m;
+    double m_invCellSize = 1.0;  //!< 1 / cell size [1/m]
     CellWindow m_window;
-    std::vector<uint32_t> m_heads;         //!< per slot: first bin of the cell or kNoBin
-    std::vector<Bin> m_pool;               //!< all bins; free ones are chained from m_freeHead
-    std::vector<uint32_t> m_stamp;         //!< per slot: the cycle that last updated the cell
-    std::vector<uint32_t> m_updatedIndex;  //!< per slot: index into m_updated, this cycle
+    int m_originSlotX = 0, m_originSlotY = 0;  //!< ix0 mod nx, iy0 mod ny
+    std::vector<uint32_t> m_heads;             //!< per slot: first bin of the cell or kNoBin
+    std::vector<Bin> m_pool;                   //!< all bins; free ones are chained from m_freeHead
+    std::vector<uint32_t> m_stamp;             //!< per slot: the cycle that last updated the cell
+    std::vector<uint32_t> m_updatedIndex;      //!< per slot: index into m_updated, this cycle
     std::vector<UpdatedCell> m_updated;
     uint32_t m_cycle = 1;
     double m_maxHeight_m = -std::numeric_limits<double>::infinity();
@@ -197,7 +202,7 @@ void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
     newW.ix0 = ix0;
     newW.iy0 = iy0;
     if (oldW.nx == 0 || oldW.ny == 0) {
-        m_window = newW;
+        setWindow(newW);
         return;
     }
     // Slots are keyed by (ix mod nx, iy mod ny): a cell that stays keeps its slot. Each entering
@@ -234,7 +239,7 @@ void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
             }
         }
     }
-    m_window = newW;
+    setWindow(newW);
 }
 
 template <typename F>

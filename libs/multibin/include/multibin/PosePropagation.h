@@ -45,6 +45,11 @@ private:
     Eigen::Vector3d m_tSensorOnRobot_m, m_tRobot_m, m_sensorOrigin_m;
     Eigen::Matrix3d m_dRot[3];  //!< dRot/dyaw, dRot/dpitch, dRot/droll of the robot pose
     Eigen::Matrix3d m_covTT, m_covTA, m_covAA;  //!< blocks of C_R: translation / angles
+    // Single-precision copies for the per-point work (covariances need no more).
+    Eigen::Matrix3f m_rotSensorToRobotF, m_rotRobotToMapF, m_rotSensorToMapF, m_covTTF, m_covATF,
+        m_covAAF;
+    Eigen::Vector3f m_tSensorOnRobotF, m_tRobotF;
+    Eigen::Matrix3f m_dRotF[3];
 };
 
 }  // namespace multibin

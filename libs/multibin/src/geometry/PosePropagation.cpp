@@ -47,6 +47,15 @@ PosePropagator::PosePropagator(const mrpt::poses::CPose3DPDFGaussian& robotPoseI
             m_covTA(r, c) = C(r, 3 + c);
             m_covAA(r, c) = C(3 + r, 3 + c);
         }
+    m_rotSensorToRobotF = m_rotSensorToRobot.cast<float>();
+    m_rotRobotToMapF = m_rotRobotToMap.cast<float>();
+    m_rotSensorToMapF = m_rotSensorToMap.cast<float>();
+    m_covTTF = m_covTT.cast<float>();
+    m_covATF = m_covTA.transpose().cast<float>();
+    m_covAAF = m_covAA.cast<float>();
+    m_tSensorOnRobotF = m_tSensorOnRobot_m.cast<float>();
+    m_tRobotF = m_tRobot_m.cast<float>();
+    for (int k = 0; k < 3; k++) m_dRotF[k] = m_dRot[k].cast<float>();
 }
 
 Eigen::Matrix<double, 3, 6> PosePropagator::jacobianWrtRobotPose(
@@ -58,19 +67,29 @@ Eigen::Matrix<double, 3, 6> PosePropagator::jacobianWrtRobotPose(
 }
 
 PointWithCov PosePropagator::apply(const PointWithCov& in) const {
-    const Eigen::Vector3d ps = in.point_m.cast<double>();
-    const Eigen::Vector3d pr = m_rotSensorToRobot * ps + m_tSensorOnRobot_m;
-    const Eigen::Vector3d pm = m_rotRobotToMap * pr + m_tRobot_m;
+    const Eigen::Vector3f pr = m_rotSensorToRobotF * in.point_m + m_tSensorOnRobotF;
+    const Eigen::Vector3f pm = m_rotRobotToMapF * pr + m_tRobotF;
 
-    // J_R C_R J_R^T with J_R = [I | M]: C_TT + M C_AT + C_TA M^T + M C_AA M^T.
-    Eigen::Matrix3d M;
-    for (int k = 0; k < 3; k++) M.col(k) = m_dRot[k] * pr;
-    const Eigen::Matrix3d MCat = M * m_covTA.transpose();
-    Eigen::Matrix3d cov = m_covTT + MCat + MCat.transpose() + M * m_covAA * M.transpose();
+    // J_R C_R J_R^T with J_R = [I | M]: C_TT + M C_AT + (M C_AT)^T + M C_AA M^T.
+    Eigen::Matrix3f M;
+    M.col(0) = m_dRotF[0] * pr;
+    M.col(1) = m_dRotF[1] * pr;
+    M.col(2) = m_dRotF[2] * pr;
+    const Eigen::Matrix3f MCat = M * m_covATF;
+    const Eigen::Matrix3f MCaa = M * m_covAAF;
     // J_S C_S J_S^T with J_S the sensor-to-map rotation.
-    cov += m_rotSensorToMap * in.cov_m2.toMatrix() * m_rotSensorToMap.transpose();
+    const SymmetricCov3& s = in.cov_m2;
+    Eigen::Matrix3f Cs;
+    Cs << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
+    const Eigen::Matrix3f RCs = m_rotSensorToMapF * Cs;
 
-    return PointWithCov{pm.cast<float>(), SymmetricCov3::fromMatrix(cov)};
+    // Only the upper triangle of the symmetric sum is needed.
+    auto entry = [&](int r, int c) {
+        return m_covTTF(r, c) + MCat(r, c) + MCat(c, r) + MCaa.row(r).dot(M.row(c)) +
+               RCs.row(r).dot(m_rotSensorToMapF.row(c));
+    };
+    return PointWithCov{pm, SymmetricCov3{entry(0, 0), entry(0, 1), entry(0, 2), entry(1, 1),
+                                          entry(1, 2), entry(2, 2)}};
 }
 
 void PosePropagator::apply(const PointsWithCov& in, PointsWithCov& out) const {

@@ -28,7 +28,8 @@ void BinGrid::reset(double cellSize_m, const CellWindow& window) {
     if (window.nx < 0 || window.ny < 0)
         throw std::invalid_argument("BinGrid: negative window size");
     m_cellSize_m = cellSize_m;
-    m_window = window;
+    m_invCellSize = 1.0 / cellSize_m;
+    setWindow(window);
     m_heads.assign(window.cellCount(), kNoBin);
     m_stamp.assign(window.cellCount(), 0);
     m_updatedIndex.assign(window.cellCount(), 0);
@@ -63,11 +64,18 @@ void BinGrid::growToInclude(const CellWindow& w) {
             heads[size_t(sx) + size_t(sy) * size_t(nw.nx)] = h;
         }
     m_heads.swap(heads);
-    m_window = nw;
+    setWindow(nw);
     // Growth happens between update cycles: the cycle bookkeeping starts afresh.
     m_stamp.assign(nw.cellCount(), 0);
     m_updatedIndex.assign(nw.cellCount(), 0);
     m_updated.clear();
+}
+
+void BinGrid::setWindow(const CellWindow& w) {
+    m_window = w;
+    auto residue = [](int i, int n) { return n > 0 ? ((i % n) + n) % n : 0; };
+    m_originSlotX = residue(w.ix0, w.nx);
+    m_originSlotY = residue(w.iy0, w.ny);
 }
 
 void BinGrid::beginCycle() {
