@@ -1,0 +1,103 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "multibin/EsriAsciiGrid.h"
+
+namespace multibin::eval {
+
+/** Per-cell layer of the evaluation lattice [m]; NaN where a method has no value. Row = y index
+ * (south to north), column = x index. */
+using CellArray = Eigen::ArrayXXf;
+
+/** The evaluation lattice: cells (ix, iy) of the map's own lattice, cell ix covering
+ * [ix, ix+1) * cellSize_m [m] (the lattice is anchored at the map origin, as BinGrid's is), for
+ * ix0 <= ix < ix0 + nx and iy0 <= iy < iy0 + ny. */
+struct EvalLattice {
+    double cellSize_m = 0.02;
+    int ix0 = 0, iy0 = 0, nx = 0, ny = 0;
+
+    double cellCenterX_m(int col) const { return (ix0 + col + 0.5) * cellSize_m; }
+    double cellCenterY_m(int row) const { return (iy0 + row + 0.5) * cellSize_m; }
+    /** Area covered [m]: {xmin, xmax, ymin, ymax}. */
+    std::vector<double> area_m() const {
+        return {ix0 * cellSize_m, (ix0 + nx) * cellSize_m, iy0 * cellSize_m,
+                (iy0 + ny) * cellSize_m};
+    }
+    /** Column/row of the cell containing (x, y) [m]; false if outside the lattice. */
+    bool cellOf(double x_m, double y_m, int& col, int& row) const;
+};
+
+/** Ground truth on the lattice: a cell's truth is the mean of the truth samples whose centres lie
+ * inside it; NaN where none does. The lattice covers exactly the cells that hold samples. */
+CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m,
+                               EvalLattice& latticeOut);
+
+/** The raw map of eq 17: range points simply registered in the grid, a cell's value being the
+ * mean of the points that fall in it. */
+class RawPointGrid {
+public:
+    explicit RawPointGrid(const EvalLattice& lattice);
+    void addPoint(double x_m, double y_m, double z_m);
+    CellArray heights_m() const;  //!< mean height per cell, NaN where no point fell
+
+private:
+    EvalLattice m_lattice;
+    Eigen::ArrayXXd m_sum_m;
+    Eigen::ArrayXXi m_count;
+};
+
+/** One method's estimate over the lattice, with what it took to make it. */
+struct MethodEstimate {
+    std::string name;
+    CellArray height_m;
+    CellArray sigma_m;     //!< empty (0 x 0) when the method gives no sigma
+    std::string baseline;  //!< the raw method that is this method's PI denominator (eq 17)
+    double insert_s = 0;   //!< wall time to insert [s]
+    double fill_s = 0;     //!< wall time to fill [s]
+};
+
+/** Mean squared error over the cells where both the estimate and the truth are finite (and the
+ * optional mask is true). */
+struct SquaredError {
+    double mse_m2 = 0;
+    size_t cells = 0;
+};
+SquaredError meanSquaredError(
+    const CellArray& estimate_m, const CellArray& truth_m,
+    const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>* mask = nullptr);
+
+/** Eq 17: PI = [sum o_f (h_f - h_t)^2 / N_f] / [sum o_r (h_r - h_t)^2 / N_r]; NaN if the raw map
+ * has no valid cell or zero error. */
+double performanceIndex(const SquaredError& method, const SquaredError& raw);
+
+/** What the evaluation reports for one method (report.json). */
+struct MethodScore {
+    double rmse_m = 0;
+    double pi = 0;                       //!< eq 17 over each map's own valid cells
+    double piShared = 0;                 //!< eq 17 over the cells every method covers
+    double coverage = 0;                 //!< share of truth cells with an estimate
+    std::optional<double> within3Sigma;  //!< share of valid cells with |h - h_t| <= 3 sigma
+    size_t validCells = 0;
+    double insert_s = 0, fill_s = 0;
+};
+
+/** Scores every method against the truth. Every method's `baseline` must name a method of the
+ * list (raw methods name themselves, or nothing). */
+std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
+                                                const std::vector<MethodEstimate>& methods);
+
+/** report.json: {"methods": {name: {rmse_m, pi, pi_shared, coverage, within_3sigma, insert_s,
+ * fill_s, valid_cells}}, "cell_size_m", "area_m": [xmin, xmax, ymin, ymax]}; methods in `order`. */
+std::string reportJson(const std::map<std::string, MethodScore>& scores,
+                       const std::vector<std::string>& order, const EvalLattice& lattice);
+/** The same numbers as a fixed-width text table. */
+std::string reportTable(const std::map<std::string, MethodScore>& scores,
+                        const std::vector<std::string>& order);
+
+}  // namespace multibin::eval

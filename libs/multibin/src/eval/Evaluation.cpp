@@ -1,0 +1,195 @@
+/* Part of the multibin elevation-mapping library: evaluation against ground truth (eq 17). */
+#include "multibin/eval/Evaluation.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace multibin::eval {
+
+namespace {
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+int floorIndex(double coord_m, double cellSize_m) {
+    return static_cast<int>(std::floor(coord_m / cellSize_m));
+}
+}  // namespace
+
+bool EvalLattice::cellOf(double x_m, double y_m, int& col, int& row) const {
+    if (!std::isfinite(x_m) || !std::isfinite(y_m)) return false;
+    col = floorIndex(x_m, cellSize_m) - ix0;
+    row = floorIndex(y_m, cellSize_m) - iy0;
+    return col >= 0 && row >= 0 && col < nx && row < ny;
+}
+
+CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m,
+                               EvalLattice& latticeOut) {
+    if (!(cellSize_m > 0)) throw std::invalid_argument("ground truth: cell size must be > 0");
+    if (truth.rows() == 0 || truth.cols() == 0)
+        throw std::invalid_argument("ground truth: the raster is empty");
+    EvalLattice& L = latticeOut;
+    L.cellSize_m = cellSize_m;
+    L.ix0 = floorIndex(truth.xllcenter_m, cellSize_m);
+    L.iy0 = floorIndex(truth.yllcenter_m, cellSize_m);
+    L.nx = floorIndex(truth.xMax_m(), cellSize_m) - L.ix0 + 1;
+    L.ny = floorIndex(truth.yMax_m(), cellSize_m) - L.iy0 + 1;
+
+    Eigen::ArrayXXd sum = Eigen::ArrayXXd::Zero(L.ny, L.nx);
+    Eigen::ArrayXXi count = Eigen::ArrayXXi::Zero(L.ny, L.nx);
+    for (int r = 0; r < truth.rows(); r++)
+        for (int c = 0; c < truth.cols(); c++) {
+            const float h = truth.heights_m(r, c);
+            if (!std::isfinite(h)) continue;
+            int col, row;
+            if (!L.cellOf(truth.xllcenter_m + c * truth.cellsize_m,
+                          truth.yllcenter_m + r * truth.cellsize_m, col, row))
+                continue;
+            sum(row, col) += h;
+            count(row, col)++;
+        }
+    CellArray out(L.ny, L.nx);
+    for (int r = 0; r < L.ny; r++)
+        for (int c = 0; c < L.nx; c++)
+            out(r, c) = count(r, c) > 0 ? float(sum(r, c) / count(r, c)) : kNaN;
+    return out;
+}
+
+RawPointGrid::RawPointGrid(const EvalLattice& lattice)
+    : m_lattice(lattice),
+      m_sum_m(Eigen::ArrayXXd::Zero(lattice.ny, lattice.nx)),
+      m_count(Eigen::ArrayXXi::Zero(lattice.ny, lattice.nx)) {}
+
+void RawPointGrid::addPoint(double x_m, double y_m, double z_m) {
+    int col, row;
+    if (!std::isfinite(z_m) || !m_lattice.cellOf(x_m, y_m, col, row)) return;
+    m_sum_m(row, col) += z_m;
+    m_count(row, col)++;
+}
+
+CellArray RawPointGrid::heights_m() const {
+    CellArray out(m_lattice.ny, m_lattice.nx);
+    for (int r = 0; r < m_lattice.ny; r++)
+        for (int c = 0; c < m_lattice.nx; c++)
+            out(r, c) = m_count(r, c) > 0 ? float(m_sum_m(r, c) / m_count(r, c)) : kNaN;
+    return out;
+}
+
+SquaredError meanSquaredError(const CellArray& estimate_m, const CellArray& truth_m,
+                              const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>* mask) {
+    if (estimate_m.rows() != truth_m.rows() || estimate_m.cols() != truth_m.cols())
+        throw std::invalid_argument("meanSquaredError: estimate and truth differ in size");
+    SquaredError e;
+    double sum = 0;
+    for (Eigen::Index r = 0; r < truth_m.rows(); r++)
+        for (Eigen::Index c = 0; c < truth_m.cols(); c++) {
+            if (mask && !(*mask)(r, c)) continue;
+            const float h = estimate_m(r, c), t = truth_m(r, c);
+            if (!std::isfinite(h) || !std::isfinite(t)) continue;
+            sum += double(h - t) * double(h - t);
+            e.cells++;
+        }
+    e.mse_m2 = e.cells ? sum / double(e.cells) : std::numeric_limits<double>::quiet_NaN();
+    return e;
+}
+
+double performanceIndex(const SquaredError& method, const SquaredError& raw) {
+    if (raw.cells == 0 || !(raw.mse_m2 > 0) || method.cells == 0)
+        return std::numeric_limits<double>::quiet_NaN();
+    return method.mse_m2 / raw.mse_m2;
+}
+
+std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
+                                                const std::vector<MethodEstimate>& methods) {
+    std::map<std::string, const MethodEstimate*> byName;
+    for (const auto& m : methods) {
+        if (m.height_m.rows() != truth_m.rows() || m.height_m.cols() != truth_m.cols())
+            throw std::invalid_argument("evaluation: method '" + m.name +
+                                        "' does not cover the evaluation lattice");
+        byName[m.name] = &m;
+    }
+    // Cells every method covers (and the truth knows): the shared PI.
+    Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> shared = truth_m.isFinite();
+    for (const auto& m : methods) shared = shared && m.height_m.isFinite();
+
+    const size_t truthCells = size_t(truth_m.isFinite().count());
+    std::map<std::string, MethodScore> scores;
+    for (const auto& m : methods) {
+        const std::string& baseName = m.baseline.empty() ? m.name : m.baseline;
+        const auto base = byName.find(baseName);
+        if (base == byName.end())
+            throw std::invalid_argument("evaluation: method '" + m.name + "' names baseline '" +
+                                        baseName + "', which is not evaluated");
+        MethodScore s;
+        const SquaredError own = meanSquaredError(m.height_m, truth_m);
+        const SquaredError raw = meanSquaredError(base->second->height_m, truth_m);
+        s.validCells = own.cells;
+        s.rmse_m = std::sqrt(own.mse_m2);
+        s.pi = performanceIndex(own, raw);
+        s.piShared = performanceIndex(meanSquaredError(m.height_m, truth_m, &shared),
+                                      meanSquaredError(base->second->height_m, truth_m, &shared));
+        s.coverage = truthCells ? double(own.cells) / double(truthCells) : 0.0;
+        if (m.sigma_m.size() > 0) {
+            size_t inside = 0;
+            for (Eigen::Index r = 0; r < truth_m.rows(); r++)
+                for (Eigen::Index c = 0; c < truth_m.cols(); c++) {
+                    const float h = m.height_m(r, c), t = truth_m(r, c);
+                    if (!std::isfinite(h) || !std::isfinite(t)) continue;
+                    if (std::abs(h - t) <= 3.f * m.sigma_m(r, c)) inside++;
+                }
+            s.within3Sigma = own.cells ? double(inside) / double(own.cells) : 0.0;
+        }
+        s.insert_s = m.insert_s;
+        s.fill_s = m.fill_s;
+        scores[m.name] = s;
+    }
+    return scores;
+}
+
+std::string reportJson(const std::map<std::string, MethodScore>& scores,
+                       const std::vector<std::string>& order, const EvalLattice& lattice) {
+    // NaN is not JSON: unknown values are written as null.
+    auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+    nlohmann::ordered_json methods = nlohmann::ordered_json::object();
+    for (const std::string& name : order) {
+        const auto it = scores.find(name);
+        if (it == scores.end()) continue;
+        const MethodScore& s = it->second;
+        methods[name] = {{"rmse_m", number(s.rmse_m)},
+                         {"pi", number(s.pi)},
+                         {"pi_shared", number(s.piShared)},
+                         {"coverage", number(s.coverage)},
+                         {"within_3sigma", s.within3Sigma ? number(*s.within3Sigma) : nullptr},
+                         {"insert_s", number(s.insert_s)},
+                         {"fill_s", number(s.fill_s)},
+                         {"valid_cells", s.validCells}};
+    }
+    nlohmann::ordered_json report = {
+        {"methods", methods}, {"cell_size_m", lattice.cellSize_m}, {"area_m", lattice.area_m()}};
+    return report.dump(2) + "\n";
+}
+
+std::string reportTable(const std::map<std::string, MethodScore>& scores,
+                        const std::vector<std::string>& order) {
+    std::ostringstream os;
+    char line[256];
+    std::snprintf(line, sizeof line, "%-22s %10s %7s %9s %9s %9s %9s %8s\n", "method", "rmse [mm]",
+                  "PI", "PI shared", "coverage", "in 3sigma", "insert s", "fill s");
+    os << line;
+    for (const std::string& name : order) {
+        const auto it = scores.find(name);
+        if (it == scores.end()) continue;
+        const MethodScore& s = it->second;
+        char within[32] = "-";
+        if (s.within3Sigma) std::snprintf(within, sizeof within, "%.3f", *s.within3Sigma);
+        std::snprintf(line, sizeof line, "%-22s %10.2f %7.3f %9.3f %9.3f %9s %9.3f %8.3f\n",
+                      name.c_str(), 1000 * s.rmse_m, s.pi, s.piShared, s.coverage, within,
+                      s.insert_s, s.fill_s);
+        os << line;
+    }
+    return os.str();
+}
+
+}  // namespace multibin::eval

@@ -1,0 +1,129 @@
+/* Evaluation against ground truth: eq 17 (PI) on hand-computed cases, truth on the lattice,
+ * raw map, report.json, and the map's exports. */
+#include <gtest/gtest.h>
+#include <mrpt/containers/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "multibin/RasterExport.h"
+#include "multibin/eval/Evaluation.h"
+
+using namespace multibin::eval;
+
+namespace {
+CellArray array2x2(float a, float b, float c, float d) {
+    CellArray x(2, 2);
+    x << a, b, c, d;
+    return x;
+}
+}  // namespace
+
+TEST(Evaluation, PerformanceIndexMatchesHandComputedCase) {
+    const CellArray truth = array2x2(0.10f, 0.20f, 0.30f, 0.40f);
+    // Method: errors 0.01, -0.02 on two cells, two cells unknown -> MSE = (1e-4 + 4e-4) / 2.
+    const CellArray method = array2x2(0.11f, 0.18f, NAN, NAN);
+    // Raw: errors 0.03, 0.04, 0, -0.05 -> MSE = (9 + 16 + 0 + 25) e-4 / 4 = 12.5e-4.
+    const CellArray raw = array2x2(0.13f, 0.24f, 0.30f, 0.35f);
+    const SquaredError em = meanSquaredError(method, truth), er = meanSquaredError(raw, truth);
+    EXPECT_EQ(em.cells, 2u);
+    EXPECT_EQ(er.cells, 4u);
+    EXPECT_NEAR(em.mse_m2, 2.5e-4, 1e-9);
+    EXPECT_NEAR(er.mse_m2, 12.5e-4, 1e-9);
+    EXPECT_NEAR(performanceIndex(em, er), 0.2, 1e-5);
+
+    std::vector<MethodEstimate> methods{{"raw", raw, {}, "raw", 0, 0},
+                                        {"method", method, {}, "raw", 0, 0}};
+    const auto scores = scoreMethods(truth, methods);
+    EXPECT_NEAR(scores.at("method").pi, 0.2, 1e-5);
+    EXPECT_NEAR(scores.at("raw").pi, 1.0, 1e-12);
+    // Shared cells: only the first two; raw MSE there = (9 + 16) e-4 / 2.
+    EXPECT_NEAR(scores.at("method").piShared, 2.5 / 12.5, 1e-5);
+    EXPECT_NEAR(scores.at("method").coverage, 0.5, 1e-12);
+    EXPECT_NEAR(scores.at("method").rmse_m, std::sqrt(2.5e-4), 1e-7);
+    EXPECT_FALSE(scores.at("method").within3Sigma.has_value());
+}
+
+TEST(Evaluation, Within3SigmaCountsCellsInsideTheBand) {
+    const CellArray truth = array2x2(0, 0, 0, 0);
+    MethodEstimate m{
+        "m", array2x2(0.029f, -0.031f, 0.01f, NAN), array2x2(0.01f, 0.01f, 0.01f, 1), "m", 0, 0};
+    const auto scores = scoreMethods(truth, {m});
+    ASSERT_TRUE(scores.at("m").within3Sigma.has_value());
+    EXPECT_NEAR(*scores.at("m").within3Sigma, 2.0 / 3.0, 1e-12);
+}
+
+TEST(Evaluation, UnknownBaselineIsRefused) {
+    const CellArray truth = array2x2(0, 0, 0, 0);
+    EXPECT_THROW(scoreMethods(truth, {{"m", truth, {}, "nope", 0, 0}}), std::invalid_argument);
+}
+
+TEST(Evaluation, GroundTruthCellIsTheMeanOfItsSamples) {
+    // 4 x 4 samples of 1 cm starting at the cell centre (0.005, 0.005): 2 x 2 samples per 2 cm
+    // cell; heights = column index in mm.
+    multibin::EsriAsciiGrid gt;
+    gt.cellsize_m = 0.01;
+    gt.xllcenter_m = 0.005;
+    gt.yllcenter_m = 0.005;
+    gt.heights_m.resize(4, 4);
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) gt.heights_m(r, c) = 0.001f * float(c);
+    EvalLattice L;
+    const CellArray truth = groundTruthOnLattice(gt, 0.02, L);
+    EXPECT_EQ(L.ix0, 0);
+    EXPECT_EQ(L.iy0, 0);
+    ASSERT_EQ(L.nx, 2);
+    ASSERT_EQ(L.ny, 2);
+    EXPECT_NEAR(truth(0, 0), 0.0005, 1e-7);  // mean of columns 0 and 1
+    EXPECT_NEAR(truth(1, 1), 0.0025, 1e-7);  // mean of columns 2 and 3
+
+    RawPointGrid raw(L);
+    raw.addPoint(0.01, 0.01, 0.1);
+    raw.addPoint(0.015, 0.019, 0.2);
+    raw.addPoint(0.03, 0.03, 0.5);
+    raw.addPoint(5.0, 0.0, 9.0);  // outside: ignored
+    const CellArray h = raw.heights_m();
+    EXPECT_NEAR(h(0, 0), 0.15, 1e-6);
+    EXPECT_NEAR(h(1, 1), 0.5, 1e-6);
+    EXPECT_TRUE(std::isnan(h(0, 1)));
+}
+
+TEST(Evaluation, ReportJsonHasTheDocumentedFields) {
+    const CellArray truth = array2x2(0.1f, 0.2f, 0.3f, 0.4f);
+    std::vector<MethodEstimate> methods{
+        {"raw_all", array2x2(0.12f, 0.2f, 0.3f, 0.4f), {}, "raw_all", 0.5, 0},
+        {"multibin", array2x2(0.11f, 0.2f, 0.3f, NAN), array2x2(0.01f, 0.01f, 0.01f, 0), "raw_all",
+         1.5, 0.25}};
+    const auto scores = scoreMethods(truth, methods);
+    EvalLattice L;
+    L.cellSize_m = 0.02;
+    L.nx = L.ny = 2;
+    const std::string json = reportJson(scores, {"raw_all", "multibin"}, L);
+    const auto doc = mrpt::containers::yaml::FromText(json);
+    const auto& mb = doc["methods"]["multibin"];
+    EXPECT_NEAR(mb["rmse_m"].as<double>(), std::sqrt(1e-4 / 3), 1e-6);
+    EXPECT_NEAR(mb["pi"].as<double>(), (1e-4 / 3) / (4e-4 / 4), 1e-4);
+    EXPECT_NEAR(mb["coverage"].as<double>(), 0.75, 1e-12);
+    EXPECT_NEAR(mb["within_3sigma"].as<double>(), 1.0, 1e-12);
+    EXPECT_NEAR(mb["insert_s"].as<double>(), 1.5, 1e-12);
+    EXPECT_NEAR(mb["fill_s"].as<double>(), 0.25, 1e-12);
+    EXPECT_TRUE(doc["methods"]["raw_all"]["within_3sigma"].isNullNode());
+    EXPECT_NEAR(doc["cell_size_m"].as<double>(), 0.02, 1e-12);
+    EXPECT_EQ(doc["area_m"].asSequence().size(), 4u);
+}
+
+TEST(Exports, PlyMeshHasOneVertexPerKnownCellAndTwoTrianglesPerKnownQuad) {
+    multibin::EsriAsciiGrid g;
+    g.cellsize_m = 0.1;
+    g.heights_m.setConstant(3, 3, 0.5f);
+    g.heights_m(2, 2) = NAN;  // 8 vertices; quads: 3 full (6 triangles) + 1 with 3 known (1)
+    const auto path = std::filesystem::temp_directory_path() / "multibin_test_mesh.ply";
+    multibin::saveMeshPly(g, path.string());
+    std::ifstream f(path);
+    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("element vertex 8\n"), std::string::npos);
+    EXPECT_NE(text.find("element face 7\n"), std::string::npos);
+    std::filesystem::remove(path);
+}
