@@ -6,7 +6,8 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir=${MULTIBIN_BUILD_DIR:-$root/build}
 
 packages=(g++ cmake ninja-build pkg-config libmrpt-dev mrpt-apps mrpt-common libeigen3-dev
-          libopencv-dev libgtest-dev libbenchmark-dev)
+          libopencv-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
+          python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
