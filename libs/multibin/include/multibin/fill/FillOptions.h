@@ -1,0 +1,83 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <string>
+
+#include "multibin/fill/GaussianSurface.h"
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace multibin {
+class StrictConfigSection;
+}
+
+namespace multibin::fill {
+
+/** How a filled cell gets its sigma. */
+enum class FillSigmaModel {
+    /** Calibrated on held-out cells (default; see doc/gap-filling.md). Median cells:
+     * sigma^2 = sigma_nb^2 + (median_sigma_gain * s)^2, s the weighted RMS spread of the window's
+     * heights about the median. Gaussian cells: sigma^2 = rms_res^2 + gaussian_sigma_gain^2 *
+     * 2 gamma(d), gamma the semivariogram of the support area's known heights, d the distance
+     * to the nearest known cell. Both floored at sigma_floor_m. */
+    Calibrated,
+    /** The paper's rule: the weighted average of the neighbours' sigma (same skeleton as the
+     * median); Gaussian cells get the mean sigma of their training points. Too small for the
+     * real interpolation error; kept for comparison. */
+    Paper
+};
+
+/** Options of gap filling. Ini keys (all prefixed `fill_` so they can live in the map's
+ * insertion-options section) are given in brackets. */
+struct FillOptions {
+    bool enabled = true;  //!< [fill_enabled] run filling at all
+
+    // --- Weighted median (small gaps) ---
+    int medianWindow_cells = 5;  //!< [fill_median_window] odd side of the window [cells], >= 3
+    /** [fill_median_min_known] a gap cell is filled by the median when its window holds at least
+     * this many measured cells; a gap with a cell that has fewer goes to the Gaussian surface. */
+    int medianMinKnown = 3;
+
+    // --- Gaussian surface (large gaps, eq 16) ---
+    bool gaussianEnabled = true;  //!< [fill_gaussian] false: large gaps by repeated median
+    /** [fill_max_gap_cells] gaps (4-connected never-observed cells) larger than this stay
+     * Unfilled: beyond the sensors' reach there is nothing to interpolate from [cells]. */
+    int maxGapCells = 2500;
+    int supportMargin_cells = 4;  //!< [fill_support_margin] margin of the square support [cells]
+    /** [fill_max_training_points] known cells used per support area at most (regular
+     * subsampling beyond it, to bound the fitting time) [-]. */
+    int maxTrainingPoints = 600;
+    /** [fill_residual_correction] beyond the paper: add to the fitted surface the residuals of
+     * the rim cells, carried into the gap as a harmonic function, so the fill meets the rim. */
+    bool residualCorrection = true;
+    int maxTerms = 4;             //!< [fill_max_terms] largest m tried by AIC [-]
+    double minWidth_cells = 1.0;  //!< [fill_min_width] narrowest Gaussian sigma [cells]
+    int swarmParticles = 20;      //!< [fill_pso_particles]
+    int swarmIterations = 40;     //!< [fill_pso_iterations]
+    unsigned swarmSeed = 1;       //!< [fill_pso_seed]
+
+    // --- Sigma of filled cells ---
+    FillSigmaModel sigmaModel =
+        FillSigmaModel::Calibrated;   //!< [fill_sigma_model] calibrated|paper
+    double medianSigmaGain = 0.77;    //!< [fill_median_sigma_gain] calibrated gain [-]
+    double gaussianSigmaGain = 0.89;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
+    double sigmaFloor_m = 0.002;      //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
+
+    /** The Gaussian-fit settings these options imply. */
+    GaussianFitOptions gaussianFitOptions() const;
+
+    /** Reads the `fill_*` keys through a strict reader of the section they live in (the caller
+     * owns the reader and calls finish()); absent keys keep their value. Then validate(). */
+    void read(StrictConfigSection& section);
+    /** Reads a section holding only `fill_*` keys (unknown keys are an error). */
+    void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
+                            const std::string& section);
+    /** Writes every `fill_*` key to `section`. */
+    void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const;
+    /** Throws std::invalid_argument naming the ini key of the first bad value. */
+    void validate() const;
+};
+
+}  // namespace multibin::fill

@@ -1,0 +1,488 @@
+/* Part of the multibin elevation-mapping library. */
+#include "multibin/fill/GapFilling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace multibin::fill {
+
+namespace {
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+}
+
+// ---------------------------------------------------------------------------------------------
+// HeightRaster
+// ---------------------------------------------------------------------------------------------
+HeightRaster::HeightRaster(int nx_, int ny_, double cellSize)
+    : nx(nx_),
+      ny(ny_),
+      cellSize_m(cellSize),
+      height_m(size_t(std::max(nx_, 0)) * size_t(std::max(ny_, 0)), kNaN),
+      sigma_m(height_m.size(), kNaN),
+      certainty(height_m.size(), 0.0f) {}
+
+bool HeightRaster::isMeasured(size_t k) const {
+    return certainty[k] > 0 && std::isfinite(height_m[k]) && std::isfinite(sigma_m[k]) &&
+           sigma_m[k] > 0;
+}
+
+void HeightRaster::setMeasured(int ix, int iy, float h, float s, float c) {
+    const size_t k = index(ix, iy);
+    height_m[k] = h;
+    sigma_m[k] = s;
+    certainty[k] = c > 0 ? c : 1.0f;
+}
+
+void HeightRaster::setUnknown(int ix, int iy) {
+    const size_t k = index(ix, iy);
+    height_m[k] = kNaN;
+    sigma_m[k] = kNaN;
+    certainty[k] = 0;
+}
+
+void HeightRaster::validate() const {
+    auto bad = [](const std::string& field, const std::string& what) {
+        throw std::invalid_argument("HeightRaster." + field + ": " + what);
+    };
+    if (nx < 0 || ny < 0) bad("nx/ny", "must be >= 0");
+    if (!(cellSize_m > 0) || !std::isfinite(cellSize_m)) bad("cellSize_m", "must be positive [m]");
+    const size_t n = size();
+    if (height_m.size() != n)
+        bad("height_m", "has " + std::to_string(height_m.size()) +
+                            " values, expected nx * ny = " + std::to_string(n));
+    if (sigma_m.size() != n) bad("sigma_m", "size differs from nx * ny");
+    if (certainty.size() != n) bad("certainty", "size differs from nx * ny");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------------
+double medianSkeletonWeight(int di, int dj) { return std::sqrt(double(di * di + dj * dj)); }
+
+std::vector<int> labelGaps(const HeightRaster& r, std::vector<int>& sizes) {
+    std::vector<int> label(r.size(), -1);
+    sizes.clear();
+    std::vector<int> stack;
+    for (int iy = 0; iy < r.ny; iy++)
+        for (int ix = 0; ix < r.nx; ix++) {
+            const size_t k0 = r.index(ix, iy);
+            if (label[k0] != -1 || r.isMeasured(k0)) continue;
+            const int id = int(sizes.size());
+            sizes.push_back(0);
+            label[k0] = id;
+            stack.assign(1, int(k0));
+            while (!stack.empty()) {
+                const int k = stack.back();
+                stack.pop_back();
+                sizes[id]++;
+                const int x = k % r.nx, y = k / r.nx;
+                const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
+                for (const auto& p : nb) {
+                    if (!r.inside(p[0], p[1])) continue;
+                    const size_t kk = r.index(p[0], p[1]);
+                    if (label[kk] == -1 && !r.isMeasured(kk)) {
+                        label[kk] = id;
+                        stack.push_back(int(kk));
+                    }
+                }
+            }
+        }
+    return label;
+}
+
+std::vector<double> semivariogram(const HeightRaster& r, int x0, int y0, int w, int h, int maxLag) {
+    const int xa = std::max(x0, 0), ya = std::max(y0, 0);
+    const int xb = std::min(x0 + w, r.nx), yb = std::min(y0 + h, r.ny);
+    maxLag = std::max(maxLag, 1);
+    std::vector<double> sum(size_t(maxLag) + 1, 0.0), cnt(size_t(maxLag) + 1, 0.0);
+    for (int iy = ya; iy < yb; iy++)
+        for (int ix = xa; ix < xb; ix++) {
+            const size_t k = r.index(ix, iy);
+            if (!r.isMeasured(k)) continue;
+            const double z = r.height_m[k];
+            for (int lag = 1; lag <= maxLag; lag++) {
+                if (ix + lag < xb) {
+                    const size_t kk = k + size_t(lag);
+                    if (r.isMeasured(kk)) {
+                        const double d = r.height_m[kk] - z;
+                        sum[lag] += d * d;
+                        cnt[lag]++;
+                    }
+                }
+                if (iy + lag < yb) {
+                    const size_t kk = r.index(ix, iy + lag);
+                    if (r.isMeasured(kk)) {
+                        const double d = r.height_m[kk] - z;
+                        sum[lag] += d * d;
+                        cnt[lag]++;
+                    }
+                }
+            }
+        }
+    std::vector<double> gamma(size_t(maxLag) + 1, 0.0);
+    for (int lag = 1; lag <= maxLag; lag++)
+        gamma[lag] = cnt[lag] > 0 ? 0.5 * sum[lag] / cnt[lag] : gamma[lag - 1];
+    return gamma;
+}
+
+namespace {
+
+/** Weighted-median filling of single cells; `usable` tells which cells count as data. */
+class MedianFiller {
+public:
+    MedianFiller(const HeightRaster& r, const FillOptions& o) : m_r(r), m_o(o) {
+        const int half = o.medianWindow_cells / 2;
+        for (int dj = -half; dj <= half; dj++)
+            for (int di = -half; di <= half; di++)
+                if (di || dj) m_offsets.push_back({di, dj, medianSkeletonWeight(di, dj)});
+    }
+
+    /** Fills cell (ix, iy) of `out` from the cells of `out` flagged in `usable`; false (and the
+     * cell untouched) if the window holds fewer than medianMinKnown of them. */
+    bool fillCell(int ix, int iy, FillResult& out, const std::vector<char>& usable) {
+        m_vals.clear();
+        double wSum = 0;
+        for (const auto& o : m_offsets) {
+            const int x = ix + o.di, y = iy + o.dj;
+            if (!m_r.inside(x, y)) continue;
+            const size_t k = m_r.index(x, y);
+            if (!usable[k]) continue;
+            m_vals.push_back({out.height_m[k], out.sigma_m[k], o.w});
+            wSum += o.w;
+        }
+        if (int(m_vals.size()) < m_o.medianMinKnown) return false;
+        std::sort(m_vals.begin(), m_vals.end(),
+                  [](const Sample& a, const Sample& b) { return a.h < b.h; });
+        double acc = 0, med = m_vals.back().h;
+        for (const auto& s : m_vals) {
+            acc += s.w;
+            if (acc >= 0.5 * wSum) {
+                med = s.h;
+                break;
+            }
+        }
+        double sigma;
+        if (m_o.sigmaModel == FillSigmaModel::Paper) {
+            double ws = 0;
+            for (const auto& s : m_vals) ws += s.w * s.s;
+            sigma = ws / wSum;
+        } else {
+            // Neighbour noise plus the local spread of heights about the median: a cell on a
+            // step edge gets a large sigma, one on a flat plate stays near the sensor noise.
+            double var = 0, spread = 0;
+            for (const auto& s : m_vals) {
+                var += s.w * s.s * s.s;
+                spread += s.w * (s.h - med) * (s.h - med);
+            }
+            var /= wSum;
+            spread /= wSum;
+            sigma = std::sqrt(var + m_o.medianSigmaGain * m_o.medianSigmaGain * spread);
+            sigma = std::max(sigma, m_o.sigmaFloor_m);
+        }
+        const size_t k = m_r.index(ix, iy);
+        out.height_m[k] = float(med);
+        out.sigma_m[k] = float(sigma);
+        out.source[k] = FillSource::Median;
+        return true;
+    }
+
+    /** Fills `cells` pass after pass, each pass using the cells filled by earlier passes; returns
+     * how many were filled. */
+    int fillRepeated(const std::vector<int>& cells, FillResult& out, std::vector<char>& usable) {
+        std::vector<int> todo = cells, next, filledNow;
+        int filled = 0;
+        while (!todo.empty()) {
+            next.clear();
+            filledNow.clear();
+            for (int k : todo) {
+                if (fillCell(k % m_r.nx, k / m_r.nx, out, usable))
+                    filledNow.push_back(k);
+                else
+                    next.push_back(k);
+            }
+            if (filledNow.empty()) break;
+            for (int k : filledNow) usable[size_t(k)] = 1;  // data for the next pass only
+            filled += int(filledNow.size());
+            todo.swap(next);
+        }
+        return filled;
+    }
+
+private:
+    struct Offset {
+        int di, dj;
+        double w;
+    };
+    struct Sample {
+        double h, s, w;
+    };
+    const HeightRaster& m_r;
+    const FillOptions& m_o;
+    std::vector<Offset> m_offsets;
+    std::vector<Sample> m_vals;
+};
+
+FillResult initResult(const HeightRaster& r, std::vector<char>& measured) {
+    FillResult out;
+    out.nx = r.nx;
+    out.ny = r.ny;
+    out.height_m.assign(r.size(), kNaN);
+    out.sigma_m.assign(r.size(), kNaN);
+    out.source.assign(r.size(), FillSource::Unfilled);
+    measured.assign(r.size(), 0);
+    for (size_t k = 0; k < r.size(); k++)
+        if (r.isMeasured(k)) {
+            measured[k] = 1;
+            out.height_m[k] = r.height_m[k];
+            out.sigma_m[k] = r.sigma_m[k];
+            out.source[k] = FillSource::Measured;
+        }
+    return out;
+}
+
+void countSources(FillResult& out) {
+    auto& s = out.stats;
+    s.measured = s.median = s.gaussian = s.unfilled = 0;
+    for (auto src : out.source) switch (src) {
+            case FillSource::Measured:
+                s.measured++;
+                break;
+            case FillSource::Median:
+                s.median++;
+                break;
+            case FillSource::Gaussian:
+                s.gaussian++;
+                break;
+            default:
+                s.unfilled++;
+        }
+}
+
+/** The residual h - g of the measured cells around a gap, carried into the gap as a harmonic
+ * function (Laplace equation, Dirichlet data on the rim, solved by over-relaxed Gauss-Seidel):
+ * the filled surface then meets every rim cell instead of passing near it. Returns one value
+ * per gap cell [m]. */
+std::vector<double> harmonicResiduals(const HeightRaster& r, const GaussianSurface& g,
+                                      const std::vector<int>& cells, int sx, int sy, int ex,
+                                      int ey) {
+    const int w = ex - sx, h = ey - sy;
+    // 0 = not used, 1 = measured (fixed residual), 2 = gap cell (unknown).
+    std::vector<char> kind(size_t(w) * size_t(h), 0);
+    std::vector<double> res(kind.size(), 0.0);
+    auto at = [&](int ix, int iy) { return size_t(iy - sy) * size_t(w) + size_t(ix - sx); };
+    for (int iy = sy; iy < ey; iy++)
+        for (int ix = sx; ix < ex; ix++) {
+            const size_t k = r.index(ix, iy);
+            if (!r.isMeasured(k)) continue;
+            kind[at(ix, iy)] = 1;
+            res[at(ix, iy)] = r.height_m[k] - g(ix - sx, iy - sy);
+        }
+    for (int k : cells) kind[at(k % r.nx, k / r.nx)] = 2;
+    constexpr double kOmega = 1.8;         // over-relaxation factor
+    constexpr double kTolerance_m = 1e-5;  // well below any sensor noise
+    for (int it = 0; it < 2000; it++) {
+        double maxStep = 0;
+        for (int k : cells) {
+            const int ix = k % r.nx, iy = k / r.nx;
+            double sum = 0;
+            int n = 0;
+            const int nb[4][2] = {{ix - 1, iy}, {ix + 1, iy}, {ix, iy - 1}, {ix, iy + 1}};
+            for (const auto& p : nb) {
+                if (p[0] < sx || p[1] < sy || p[0] >= ex || p[1] >= ey) continue;
+                const size_t kk = at(p[0], p[1]);
+                if (kind[kk]) sum += res[kk], n++;
+            }
+            if (!n) continue;
+            double& v = res[at(ix, iy)];
+            const double step = kOmega * (sum / n - v);
+            v += step;
+            maxStep = std::max(maxStep, std::abs(step));
+        }
+        if (maxStep < kTolerance_m) break;
+    }
+    std::vector<double> out(cells.size());
+    for (size_t c = 0; c < cells.size(); c++) out[c] = res[at(cells[c] % r.nx, cells[c] / r.nx)];
+    return out;
+}
+
+/** Fits eq 16 on the square support area around one gap and fills its cells; false if the area
+ * holds too little data (the caller then falls back to the repeated median). */
+bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
+                             const std::vector<int>& cells, FillResult& out) {
+    int x0 = r.nx, x1 = -1, y0 = r.ny, y1 = -1;
+    for (int k : cells) {
+        const int x = k % r.nx, y = k / r.nx;
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+    const int side = std::max(x1 - x0 + 1, y1 - y0 + 1) + 2 * o.supportMargin_cells;
+    // Centre the square on the gap, then slide it inside the raster where it fits.
+    auto place = [&](int lo, int hi, int n) {
+        int start = (lo + hi + 1) / 2 - side / 2;
+        start = std::min(start, n - side);
+        return std::max(start, 0);
+    };
+    const int sx = place(x0, x1, r.nx), sy = place(y0, y1, r.ny);
+    const int ex = std::min(sx + side, r.nx), ey = std::min(sy + side, r.ny);
+
+    // Training points: measured cells of the area, the ones nearest the gap first if capped.
+    struct Cand {
+        SurfaceSample s;
+        int gapDist;
+    };
+    std::vector<Cand> cand;
+    for (int iy = sy; iy < ey; iy++)
+        for (int ix = sx; ix < ex; ix++) {
+            const size_t k = r.index(ix, iy);
+            if (!r.isMeasured(k)) continue;
+            const int dx = ix < x0 ? x0 - ix : (ix > x1 ? ix - x1 : 0);
+            const int dy = iy < y0 ? y0 - iy : (iy > y1 ? iy - y1 : 0);
+            cand.push_back(
+                {SurfaceSample{ix - sx, iy - sy, r.height_m[k], r.sigma_m[k]}, std::max(dx, dy)});
+        }
+    if (int(cand.size()) > o.maxTrainingPoints) {
+        std::stable_sort(cand.begin(), cand.end(),
+                         [](const Cand& a, const Cand& b) { return a.gapDist < b.gapDist; });
+        cand.resize(size_t(o.maxTrainingPoints));
+    }
+    // Fewer than this and even m = 1 cannot be judged by the criterion.
+    if (cand.size() < 12) return false;
+    std::vector<SurfaceSample> samples;
+    samples.reserve(cand.size());
+    for (const auto& c : cand) samples.push_back(c.s);
+
+    const GaussianSurface g = fitGaussianSurface(samples, side, o.gaussianFitOptions());
+    // The surface never leaves the heights of its data by more than a quarter of their range:
+    // far from the rim the model is an extrapolation, and the data say nothing beyond that.
+    double hLo = samples[0].h_m, hHi = hLo;
+    for (const auto& s : samples) hLo = std::min(hLo, s.h_m), hHi = std::max(hHi, s.h_m);
+    const double slack = 0.25 * (hHi - hLo);
+    out.stats.supportAreas++;
+    out.stats.termsChosen.push_back(int(g.terms.size()));
+
+    // Distance of each gap cell to the nearest training point [cells].
+    std::vector<double> dist(cells.size(), std::numeric_limits<double>::infinity());
+    double maxDist = 1;
+    for (size_t c = 0; c < cells.size(); c++) {
+        const int i = cells[c] % r.nx - sx, j = cells[c] / r.nx - sy;
+        int best = std::numeric_limits<int>::max();
+        for (const auto& s : samples)
+            best = std::min(best, (s.i - i) * (s.i - i) + (s.j - j) * (s.j - j));
+        dist[c] = std::sqrt(double(best));
+        maxDist = std::max(maxDist, dist[c]);
+    }
+    const int maxLag = std::min(int(std::ceil(maxDist)) + 1, std::max(side - 1, 1));
+    std::vector<double> gamma;
+    double meanSigma = 0;
+    if (o.sigmaModel == FillSigmaModel::Calibrated)
+        gamma = semivariogram(r, sx, sy, side, side, maxLag);
+    else {
+        for (const auto& s : samples) meanSigma += s.sigma_m;
+        meanSigma /= double(samples.size());
+    }
+    const std::vector<double> resid = o.residualCorrection
+                                          ? harmonicResiduals(r, g, cells, sx, sy, ex, ey)
+                                          : std::vector<double>(cells.size(), 0.0);
+    for (size_t c = 0; c < cells.size(); c++) {
+        const int ix = cells[c] % r.nx, iy = cells[c] / r.nx;
+        const double h = std::clamp(g(ix - sx, iy - sy) + resid[c], hLo - slack, hHi + slack);
+        double sigma = meanSigma;
+        if (o.sigmaModel == FillSigmaModel::Calibrated) {
+            // Interpolated semivariogram at the distance to the data (flat beyond maxLag).
+            const double d = std::min(dist[c], double(maxLag));
+            const int l = std::min(int(d), maxLag - 1);
+            const double t = d - l;
+            const double gam = (1 - t) * gamma[size_t(l)] + t * gamma[size_t(l) + 1];
+            sigma = std::sqrt(g.rmsResidual_m * g.rmsResidual_m +
+                              o.gaussianSigmaGain * o.gaussianSigmaGain * 2.0 * gam);
+            sigma = std::max(sigma, o.sigmaFloor_m);
+        }
+        const size_t k = size_t(cells[c]);
+        out.height_m[k] = float(h);
+        out.sigma_m[k] = float(sigma);
+        out.source[k] = FillSource::Gaussian;
+    }
+    return true;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Public entry points
+// ---------------------------------------------------------------------------------------------
+FillResult weightedMedianFill(const HeightRaster& r, const FillOptions& o, bool repeat) {
+    r.validate();
+    o.validate();
+    std::vector<char> usable;
+    FillResult out = initResult(r, usable);
+    MedianFiller median(r, o);
+    std::vector<int> gaps;
+    for (size_t k = 0; k < r.size(); k++)
+        if (!usable[k]) gaps.push_back(int(k));
+    if (repeat)
+        median.fillRepeated(gaps, out, usable);
+    else
+        for (int k : gaps) median.fillCell(k % r.nx, k / r.nx, out, usable);
+    countSources(out);
+    return out;
+}
+
+FillResult fillGaps(const HeightRaster& r, const FillOptions& o) {
+    r.validate();
+    o.validate();
+    std::vector<char> measured;
+    FillResult out = initResult(r, measured);
+    std::vector<int> sizes;
+    const std::vector<int> label = labelGaps(r, sizes);
+    out.stats.gapComponents = int(sizes.size());
+    if (!o.enabled || sizes.empty()) {
+        countSources(out);
+        return out;
+    }
+
+    // Measured cells per window, from a summed-area table: O(1) per cell.
+    const int half = o.medianWindow_cells / 2;
+    std::vector<int> sat(size_t(r.nx + 1) * size_t(r.ny + 1), 0);
+    auto S = [&](int x, int y) -> int& { return sat[size_t(y) * size_t(r.nx + 1) + size_t(x)]; };
+    for (int iy = 0; iy < r.ny; iy++)
+        for (int ix = 0; ix < r.nx; ix++)
+            S(ix + 1, iy + 1) =
+                measured[r.index(ix, iy)] + S(ix, iy + 1) + S(ix + 1, iy) - S(ix, iy);
+    auto knownInWindow = [&](int ix, int iy) {
+        const int xa = std::max(ix - half, 0), xb = std::min(ix + half + 1, r.nx);
+        const int ya = std::max(iy - half, 0), yb = std::min(iy + half + 1, r.ny);
+        return S(xb, yb) - S(xa, yb) - S(xb, ya) + S(xa, ya);
+    };
+
+    std::vector<std::vector<int>> cells(sizes.size());
+    std::vector<char> medianReach(sizes.size(), 1);
+    for (size_t id = 0; id < sizes.size(); id++)
+        if (sizes[id] <= o.maxGapCells) cells[id].reserve(size_t(sizes[id]));
+    for (size_t k = 0; k < r.size(); k++) {
+        const int id = label[k];
+        if (id < 0 || sizes[size_t(id)] > o.maxGapCells) continue;
+        cells[size_t(id)].push_back(int(k));
+        if (knownInWindow(int(k) % r.nx, int(k) / r.nx) < o.medianMinKnown)
+            medianReach[size_t(id)] = 0;
+    }
+
+    MedianFiller median(r, o);
+    std::vector<char> usable = measured;  // the median of a small gap uses measured cells only
+    for (size_t id = 0; id < sizes.size(); id++) {
+        if (cells[id].empty()) continue;  // too large: stays Unfilled
+        if (medianReach[id]) {
+            for (int k : cells[id]) median.fillCell(k % r.nx, k / r.nx, out, usable);
+            continue;
+        }
+        if (o.gaussianEnabled && fillWithGaussianSurface(r, o, cells[id], out)) continue;
+        // Fallback: rim-inwards median; its intermediate cells must not leak into other gaps.
+        std::vector<char> local = measured;
+        median.fillRepeated(cells[id], out, local);
+    }
+    countSources(out);
+    return out;
+}
+
+}  // namespace multibin::fill
