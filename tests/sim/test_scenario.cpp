@@ -239,7 +239,7 @@ TEST_P(ShippedScenario, StockRawlogEditReadsIt) {
         EXPECT_NE(out.find(s), std::string::npos) << s << "\n" << out;
     const fs::path d = tempDir("list_images_" + GetParam());
     const std::string list = (d / "images.txt").string();
-    rc = run(exe + " --list-images -i " + prefix() + ".rawlog -o " + list, &out);
+    rc = run(exe + " --list-images -i " + prefix() + ".rawlog --text-file-output " + list, &out);
     EXPECT_EQ(rc, 0) << out;
     ASSERT_TRUE(fs::exists(list)) << out;
     EXPECT_EQ(fs::file_size(list), 0u) << "images are inline: no external image files listed";
