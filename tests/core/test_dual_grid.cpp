@@ -86,7 +86,9 @@ CMultiBinElevationMap dualMap() {
     CMultiBinElevationMap::TCreationOptions c;
     c.dual_grid = true;
     CMultiBinElevationMap map(c);
-    map.insertionOptions.range_sigma_m = 0.01;
+    // Point clouds use the depth-camera model: make it a constant 10 mm along the ray.
+    map.insertionOptions.sensors.depth.axialSigma0_m = 0.01;
+    map.insertionOptions.sensors.depth.axialSigmaQuadratic_per_m = 0.0;
     map.insertionOptions.height_sigma_floor_m = 0.0;  // compare raw Kalman variances
     map.insertionOptions.default_pose_sigmas = {0, 0, 0, 0, 0, 0};
     return map;

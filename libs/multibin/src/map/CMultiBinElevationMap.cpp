@@ -152,6 +152,7 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     s.read("visibility_constraint", visibility.enabled);
     s.read("visibility_margin", visibility.margin_m);
     s.read("visibility_certainty_decrement", visibility.certaintyDecrement);
+    sensors.load(s);
     s.finish();
     validate();
 }
@@ -182,6 +183,7 @@ void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CC
     c.write(section, "visibility_constraint", visibility.enabled);
     c.write(section, "visibility_margin", visibility.margin_m);
     c.write(section, "visibility_certainty_decrement", visibility.certaintyDecrement);
+    sensors.save(c, section);
 }
 
 void CMultiBinElevationMap::TInsertionOptions::validate() const {
@@ -203,6 +205,7 @@ void CMultiBinElevationMap::TInsertionOptions::validate() const {
         bad("visibility_certainty_decrement", "must be positive");
     if (!(min_range_m >= 0 && max_range_m > min_range_m))
         bad("min_range/max_range", "need 0 <= min_range < max_range [m]");
+    sensors.validate();
 }
 
 mrpt::math::CMatrixDouble66 CMultiBinElevationMap::TInsertionOptions::defaultPoseCovariance()
@@ -281,6 +284,7 @@ void CMultiBinElevationMap::internal_clear() {
     m_poseFallbacks = 0;
     m_skippedByLabel = 0;
     m_lastRobotPose.reset();
+    m_sensorState.reset();
 }
 
 multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {

@@ -1,10 +1,6 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: observation dispatch, pose PDFs and the insertion core. */
 #include <mrpt/maps/CMultiBinElevationMap.h>
-#include <mrpt/maps/CSimplePointsMap.h>
-#include <mrpt/obs/CObservation2DRangeScan.h>
-#include <mrpt/obs/CObservation3DRangeScan.h>
-#include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/system/datetime.h>
 
@@ -12,53 +8,10 @@
 #include <cmath>
 
 #include "multibin/PosePropagation.h"
-#include "multibin/sensors/RangeSigmaCurve.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;
 using multibin::PointWithCov;
-
-namespace {
-
-/** Points of a laser scan in its sensor frame, with range-only covariance (bearing exact). */
-void laserScanPoints(const mrpt::obs::CObservation2DRangeScan& scan, double minRange_m,
-                     PointsWithCov& out, size_t& outOfRange) {
-    const multibin::sensors::RangeSigmaCurve sigmaOfRange;
-    out.clear();
-    out.reserve(scan.getScanSize());
-    for (size_t i = 0; i < scan.getScanSize(); i++) {
-        const float r = scan.getScanRange(i);
-        if (!scan.getScanRangeValidity(i) || !std::isfinite(r) || r < minRange_m ||
-            r >= scan.maxRange) {
-            outOfRange++;
-            continue;
-        }
-        const float a = scan.getScanAngle(i);
-        const Eigen::Vector3f dir(std::cos(a), std::sin(a), 0.f);
-        out.push_back({dir * r, multibin::rangeOnlyCovariance(dir, float(sigmaOfRange(r)))});
-    }
-}
-
-/** Appends a sensor-frame point measured along its ray with range noise sigma_m. */
-void appendRangePoint(float x, float y, float z, double minRange_m, double maxRange_m,
-                      double sigma_m, PointsWithCov& out, size_t& outOfRange) {
-    const Eigen::Vector3f p(x, y, z);
-    const float r = p.norm();
-    if (!std::isfinite(r) || r < minRange_m || r > maxRange_m) {
-        outOfRange++;
-        return;
-    }
-    const Eigen::Vector3f dir = p / r;
-    // A tiny isotropic term keeps the covariance positive-definite (bearing is nearly exact).
-    multibin::SymmetricCov3 c = multibin::rangeOnlyCovariance(dir, float(sigma_m));
-    const float lateral2 = float(1e-6 * r * r);  // ~1 mrad bearing noise
-    c.xx += lateral2;
-    c.yy += lateral2;
-    c.zz += lateral2;
-    out.push_back({p, c});
-}
-
-}  // namespace
 
 bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
     const auto& labels = insertionOptions.sensor_labels;
@@ -136,46 +89,15 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                                         obs.sensorLabel + "' has a NaN or infinite component");
     obs.load();  // externally stored observations
 
-    PointsWithCov sensorPoints;
     multibin::InsertStats sensorStats;  // rejections before the insertion core
-    mrpt::poses::CPose3D sensorPose;
-    double continuityBound_m = std::numeric_limits<double>::infinity();
-    const auto& io = insertionOptions;
-    if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
-        laserScanPoints(*scan, io.min_range_m, sensorPoints, sensorStats.outOfRange);
-        sensorPose = scan->sensorPose;
-    } else if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
-        sensorPose = depth->sensorPose;
-        if (depth->hasPoints3D) {
-            for (size_t i = 0; i < depth->points3D_x.size(); i++)
-                appendRangePoint(depth->points3D_x[i], depth->points3D_y[i], depth->points3D_z[i],
-                                 io.min_range_m, io.max_range_m, io.range_sigma_m, sensorPoints,
-                                 sensorStats.outOfRange);
-        } else if (depth->hasRangeImage) {
-            mrpt::maps::CSimplePointsMap local;
-            mrpt::obs::T3DPointsProjectionParams pp;
-            pp.takeIntoAccountSensorPoseOnRobot = false;  // sensor frame (+x forward)
-            const_cast<mrpt::obs::CObservation3DRangeScan*>(depth)->unprojectInto(local, pp);
-            const auto& xs = local.getPointsBufferRef_x();
-            const auto& ys = local.getPointsBufferRef_y();
-            const auto& zs = local.getPointsBufferRef_z();
-            for (size_t i = 0; i < xs.size(); i++)
-                appendRangePoint(xs[i], ys[i], zs[i], io.min_range_m, io.max_range_m,
-                                 io.range_sigma_m, sensorPoints, sensorStats.outOfRange);
-        }
-    } else if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
-        sensorPose = cloud->sensorPose;
-        if (cloud->pointcloud) {
-            const auto& xs = cloud->pointcloud->getPointsBufferRef_x();
-            const auto& ys = cloud->pointcloud->getPointsBufferRef_y();
-            const auto& zs = cloud->pointcloud->getPointsBufferRef_z();
-            for (size_t i = 0; i < xs.size(); i++)
-                appendRangePoint(xs[i], ys[i], zs[i], io.min_range_m, io.max_range_m,
-                                 io.range_sigma_m, sensorPoints, sensorStats.outOfRange);
-        }
-    } else {
+    multibin::sensors::SensorPoints sensed;
+    if (!multibin::sensors::observationToSensorPoints(
+            obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
+            insertionOptions.max_range_m, m_sensorState, sensorStats, sensed))
         return false;  // not an observation this map models
-    }
+    const PointsWithCov& sensorPoints = sensed.points;
+    const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
+    const double continuityBound_m = sensed.continuityBound_m;
     m_stats += sensorStats;
     if (sensorPoints.empty()) return false;
 

@@ -19,6 +19,7 @@
 #include "multibin/BinGrid.h"
 #include "multibin/EsriAsciiGrid.h"
 #include "multibin/VisibilityConstraint.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 namespace mrpt::maps {
 
@@ -108,6 +109,8 @@ public:
         /** Visibility constraint after each observation (keys `visibility_constraint`,
          * `visibility_margin`, `visibility_certainty_decrement`). */
         multibin::VisibilityParams visibility;
+        /** Sensor models: laser, stereo, depth camera (keys `laser_*`, `stereo_*`, `depth_*`). */
+        multibin::sensors::SensorModelOptions sensors;
         mrpt::img::TColormap colormap = mrpt::img::cmJET;
         bool color_by_sigma = false;  //!< 3D view coloured by sigma instead of height
 
@@ -182,6 +185,10 @@ public:
     size_t poseFallbackCount() const { return m_poseFallbacks; }
     /** Observations skipped because their sensor label is not in insertionOptions.sensor_labels. */
     size_t skippedByLabelCount() const { return m_skippedByLabel; }
+    /** What the sensor models did (per sensor kind), since the last clear(). */
+    const multibin::sensors::SensorModelStats& sensorModelStats() const {
+        return m_sensorState.stats;
+    }
     /** @} */
 
     /** @name CMetricMap @{ */
@@ -254,6 +261,8 @@ private:
     /** The latest CObservationRobotPose: its PDF and timestamp. */
     std::optional<mrpt::poses::CPose3DPDFGaussian> m_lastRobotPose;
     mrpt::Clock::time_point m_lastRobotPoseTime;
+    /** Previous laser scans (eq 14), stereo covariance table, sensor statistics. */
+    multibin::sensors::SensorModelState m_sensorState;
 };
 
 }  // namespace mrpt::maps

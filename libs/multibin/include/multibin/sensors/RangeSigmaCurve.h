@@ -9,9 +9,9 @@ namespace multibin::sensors {
  * 0.1 m rising to about 4.5 mm at 1 m (the largest standard deviation over five surfaces at a
  * 30 deg incidence angle). */
 struct RangeSigmaCurve {
-    double c0_m = 0.0006;     //!< [m]
-    double c1 = 0.0039;       //!< [m/m]
-    double c2_per_m = 0.0;    //!< [m/m^2]
+    double c0_m = 0.0006;   //!< [m]
+    double c1 = 0.0039;     //!< [m/m]
+    double c2_per_m = 0.0;  //!< [m/m^2]
 
     double operator()(double range_m) const { return c0_m + (c1 + c2_per_m * range_m) * range_m; }
 };

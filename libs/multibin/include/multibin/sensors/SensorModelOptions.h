@@ -1,0 +1,118 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <array>
+#include <map>
+#include <string>
+
+#include "multibin/StrictConfigSection.h"
+#include "multibin/sensors/RangeSigmaCurve.h"
+
+namespace multibin::sensors {
+
+/** Pitched 2D laser scanner (Hokuyo URG-04LX) model options. */
+struct LaserModelOptions {
+    RangeSigmaCurve rangeSigma;  //!< sigma_r(r) (key `laser_range_sigma_coeffs = c0 c1 c2`)
+    /** AGC voltage per sensor label (key `laser_agc = LABEL:value[,LABEL:value...]`) [raw units
+     * of eq 1]. A label without an entry gets no intensity check. */
+    std::map<std::string, double> agcByLabel;
+    double minRestoredIntensity =
+        100.0;  //!< eq 1 threshold on Ires (key `laser_min_restored_intensity`)
+    double intensityCheckRange_m = 1.0;  //!< only readings closer than this are checked [m]
+    bool mixedPixelFilter = true;        //!< key `laser_mixed_pixel_filter`
+    /** Range jump separating two clusters of consecutive beams [m] (key `laser_mixed_pixel_jump`).
+     */
+    double mixedPixelJump_m = 0.03;
+    /** A cluster of at most this many beams whose range lies between its two neighbouring
+     * clusters is a mixed measurement (key `laser_mixed_pixel_max_beams`). */
+    int mixedPixelMaxBeams = 2;
+    bool continuity = true;  //!< eq 14 gate on (key `laser_continuity`)
+    double continuitySigmas =
+        3.0;  //!< Delta_zmax covers this many sigmas (key `laser_continuity_sigmas`)
+    /** Correlation of the pose errors of consecutive scans, 0 = independent, 1 = identical (key
+     * `laser_continuity_pose_correlation`). */
+    double continuityPoseCorrelation = 0.0;
+    /** Height variation of the terrain inside a cell that the gate must allow [m] (key
+     * `laser_continuity_allowance`). */
+    double continuityAllowance_m = 0.01;
+    /** Scans further apart in time are not consecutive: no gate [s] (key
+     * `laser_continuity_max_dt`). */
+    double continuityMaxDt_s = 1.0;
+};
+
+/** Stereo camera (STOC-style) model options. */
+struct StereoModelOptions {
+    /** Standard deviations of fx, fy, cx, cy [px], k1, k2, p1, p2, k3 [-] of each camera, in the
+     * order of cv::calibrateCamera's stdDeviationsIntrinsics (keys `stereo_left_intrinsics_sigma`,
+     * `stereo_right_intrinsics_sigma`). */
+    std::array<double, 9> leftIntrinsicsSigma{0.5,   0.5,    0.5,    0.5, 0.002,
+                                              0.002, 0.0002, 0.0002, 0.0};
+    std::array<double, 9> rightIntrinsicsSigma{0.5,   0.5,    0.5,    0.5, 0.002,
+                                               0.002, 0.0002, 0.0002, 0.0};
+    /** Right camera relative to the left: rotation vector [rad] and translation [m] sigmas (key
+     * `stereo_extrinsics_sigma = s_rx s_ry s_rz s_tx s_ty s_tz`). */
+    std::array<double, 6> extrinsicsSigma{0.0005, 0.0005, 0.0005, 0.0005, 0.0005, 0.0005};
+    double matchingSigma_px =
+        0.25;                 //!< matching noise per image [px] (key `stereo_matching_sigma`)
+    int subsample = 2;        //!< use every n-th pixel in u and v (key `stereo_subsample`)
+    double minDepth_m = 0.2;  //!< nearer points are out of the horopter (key `stereo_min_depth`)
+
+    /** @name OpenCV StereoSGBM, used when the observation has no disparity image (keys
+     * `stereo_sgbm_*`). p1/p2 = 0 means OpenCV's usual 8 and 32 * block_size^2. @{ */
+    int sgbmMinDisparity = 0;
+    int sgbmNumDisparities = 256;  //!< multiple of 16
+    int sgbmBlockSize = 5;         //!< odd
+    int sgbmP1 = 0, sgbmP2 = 0;
+    int sgbmDisp12MaxDiff = 1;
+    int sgbmUniquenessRatio = 15;
+    int sgbmSpeckleWindowSize = 200;
+    int sgbmSpeckleRange = 2;            //!< [px of disparity]
+    std::string sgbmMode = "sgbm_3way";  //!< sgbm, hh, sgbm_3way or hh4
+    /** @} */
+
+    /** Halo filter: pixels on the near side of a disparity jump larger than haloJump_px, within
+     * haloRadius_px of it (keys `stereo_halo_filter`, `stereo_halo_jump`, `stereo_halo_radius`). */
+    bool haloFilter = true;
+    double haloJump_px = 3.0;
+    int haloRadius_px = 4;
+    /** Near-cluster filter: connected regions (neighbours within nearClusterStep_px of disparity)
+     * of fewer than nearClusterMaxArea_px pixels that are nearer than their surroundings by more
+     * than nearClusterJump_px (keys `stereo_near_cluster_filter`, `stereo_near_cluster_max_area`,
+     * `stereo_near_cluster_step`, `stereo_near_cluster_jump`). */
+    bool nearClusterFilter = true;
+    int nearClusterMaxArea_px = 400;
+    double nearClusterStep_px = 2.0;
+    double nearClusterJump_px = 2.0;
+};
+
+/** Structured-light depth camera model (Nguyen, Izadi, Lovell 2012):
+ * sigma_axial(z) = axialSigma0 + axialSigmaQuadratic (z - axialOffset)^2 along the ray,
+ * sigma_lateral(z) = lateralSigma_rad * z across it, z the range of the point. */
+struct DepthModelOptions {
+    double axialSigma0_m = 0.0012;              //!< key `depth_axial_sigma` [m]
+    double axialSigmaQuadratic_per_m = 0.0019;  //!< key `depth_axial_sigma_quadratic` [m/m^2]
+    double axialOffset_m = 0.4;                 //!< key `depth_axial_offset` [m]
+    double lateralSigma_rad = 0.0014;  //!< key `depth_lateral_sigma` [rad] (0.8 px at 580 px)
+
+    double axialSigma_m(double z_m) const {
+        const double dz = z_m - axialOffset_m;
+        return axialSigma0_m + axialSigmaQuadratic_per_m * dz * dz;
+    }
+};
+
+/** Every sensor-model option of CMultiBinElevationMap (ini section `..._insertOpts`). */
+struct SensorModelOptions {
+    LaserModelOptions laser;
+    StereoModelOptions stereo;
+    DepthModelOptions depth;
+
+    /** Reads the keys present in `s` (the others keep their value), then validate(). */
+    void load(StrictConfigSection& s);
+    void save(mrpt::config::CConfigFileBase& target, const std::string& section) const;
+    /** Throws std::invalid_argument naming the key of the first bad value. */
+    void validate() const;
+};
+
+}  // namespace multibin::sensors

@@ -1,0 +1,151 @@
+/* Part of the multibin elevation-mapping library. */
+#include "multibin/sensors/LaserModel.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "multibin/PosePropagation.h"
+
+namespace multibin::sensors {
+
+LaserStats& LaserStats::operator+=(const LaserStats& o) {
+    beams += o.beams;
+    noReturn += o.noReturn;
+    notFinite += o.notFinite;
+    outOfRange += o.outOfRange;
+    lowIntensity += o.lowIntensity;
+    mixedPixel += o.mixedPixel;
+    kept += o.kept;
+    return *this;
+}
+
+double restoredIntensity(double rawIntensity, double agcVoltage) {
+    return std::sqrt(std::max(0.0, rawIntensity) * 1023.0 / agcVoltage);
+}
+
+std::vector<bool> findMixedPixels(const std::vector<float>& ranges_m,
+                                  const LaserModelOptions& opts) {
+    const size_t n = ranges_m.size();
+    std::vector<bool> mixed(n, false);
+    auto finiteRange = [&](size_t i) { return std::isfinite(ranges_m[i]); };
+    size_t i = 0;
+    while (i < n) {
+        if (!finiteRange(i)) {
+            i++;
+            continue;
+        }
+        // Cluster [i, j): consecutive returns with small range steps.
+        size_t j = i + 1;
+        while (j < n && finiteRange(j) &&
+               std::abs(ranges_m[j] - ranges_m[j - 1]) <= opts.mixedPixelJump_m)
+            j++;
+        const size_t size = j - i;
+        // Both sides must be known beams (a return or "no return"); scan ends are not edges.
+        if (size <= size_t(opts.mixedPixelMaxBeams) && i > 0 && j < n) {
+            const double before = ranges_m[i - 1], after = ranges_m[j];  // +inf = no return
+            const double lo = std::min(before, after), hi = std::max(before, after);
+            bool between = true;
+            for (size_t k = i; k < j; k++)
+                between = between && ranges_m[k] > lo + opts.mixedPixelJump_m &&
+                          ranges_m[k] < hi - opts.mixedPixelJump_m;
+            if (between)
+                for (size_t k = i; k < j; k++) mixed[k] = true;
+        }
+        i = j;
+    }
+    return mixed;
+}
+
+void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
+                       const LaserModelOptions& opts, double minRange_m, double maxRange_m,
+                       PointsWithCov& out, LaserStats& stats) {
+    const size_t n = scan.getScanSize();
+    out.clear();
+    out.reserve(n);
+    stats.beams += n;
+
+    // Ranges for the mixed-pixel clustering: +inf = no return, NaN = unusable reading.
+    std::vector<float> ranges(n);
+    for (size_t i = 0; i < n; i++) {
+        const float r = scan.getScanRange(i);
+        if (!std::isfinite(r))
+            ranges[i] = std::numeric_limits<float>::quiet_NaN();
+        else if (!scan.getScanRangeValidity(i) || r >= scan.maxRange || r <= 0)
+            ranges[i] = std::numeric_limits<float>::infinity();
+        else
+            ranges[i] = r;
+    }
+    const std::vector<bool> mixed =
+        opts.mixedPixelFilter ? findMixedPixels(ranges, opts) : std::vector<bool>(n, false);
+
+    const auto agc = opts.agcByLabel.find(scan.sensorLabel);
+    const bool checkIntensity = scan.hasIntensity() && agc != opts.agcByLabel.end();
+    for (size_t i = 0; i < n; i++) {
+        const float r = ranges[i];
+        if (std::isnan(r)) {
+            stats.notFinite++;
+            continue;
+        }
+        if (std::isinf(r)) {
+            stats.noReturn++;
+            continue;
+        }
+        if (r < minRange_m || r > maxRange_m) {
+            stats.outOfRange++;
+            continue;
+        }
+        if (checkIntensity && r < opts.intensityCheckRange_m &&
+            restoredIntensity(scan.getScanIntensity(i), agc->second) < opts.minRestoredIntensity) {
+            stats.lowIntensity++;
+            continue;
+        }
+        if (mixed[i]) {
+            stats.mixedPixel++;
+            continue;
+        }
+        const float a = scan.getScanAngle(i);
+        const Eigen::Vector3f dir(std::cos(a), std::sin(a), 0.f);
+        out.push_back({dir * r, rangeOnlyCovariance(dir, float(opts.rangeSigma(r)))});
+        stats.kept++;
+    }
+}
+
+double continuityBound_m(const PointsWithCov& sensorPoints, const mrpt::poses::CPose3D& sensorPose,
+                         const mrpt::poses::CPose3DPDFGaussian& previousRobotPose,
+                         const mrpt::poses::CPose3DPDFGaussian& currentRobotPose,
+                         const LaserModelOptions& opts) {
+    if (sensorPoints.empty()) return std::numeric_limits<double>::infinity();
+    const PosePropagator prev(previousRobotPose, sensorPose), cur(currentRobotPose, sensorPose);
+    Eigen::Matrix<double, 6, 6> Cprev, Ccur;
+    for (int r = 0; r < 6; r++)
+        for (int c = 0; c < 6; c++) {
+            Cprev(r, c) = previousRobotPose.cov(r, c);
+            Ccur(r, c) = currentRobotPose.cov(r, c);
+        }
+    const auto& Rs = sensorPose.getRotationMatrix();
+    const auto& Rr = currentRobotPose.mean.getRotationMatrix();
+    // Height component of a sensor-frame direction in the map: row 2 of Rr * Rs.
+    Eigen::Vector3d zRow;
+    for (int c = 0; c < 3; c++)
+        zRow[c] = Rr(2, 0) * Rs(0, c) + Rr(2, 1) * Rs(1, c) + Rr(2, 2) * Rs(2, c);
+    const double rho = opts.continuityPoseCorrelation;
+
+    double worst2 = 0;
+    for (const PointWithCov& p : sensorPoints) {
+        const Eigen::Vector3d ps = p.point_m.cast<double>();
+        const double range = ps.norm();
+        if (!(range > 0)) continue;
+        const double sZr = opts.rangeSigma(range) * std::abs(zRow.dot(ps / range));
+        Eigen::Vector3d pr;
+        sensorPose.composePoint(ps.x(), ps.y(), ps.z(), pr.x(), pr.y(), pr.z());
+        const Eigen::Matrix<double, 1, 6> ja = prev.jacobianWrtRobotPose(pr).row(2);
+        const Eigen::Matrix<double, 1, 6> jb = cur.jacobianWrtRobotPose(pr).row(2);
+        const double sa2 = (ja * Cprev * ja.transpose())(0, 0);
+        const double sb2 = (jb * Ccur * jb.transpose())(0, 0);
+        const double sZp2 = std::max(0.0, sa2 + sb2 - 2 * rho * std::sqrt(sa2 * sb2));
+        worst2 = std::max(worst2, 2 * sZr * sZr + sZp2);
+    }
+    return opts.continuitySigmas * std::sqrt(worst2) + opts.continuityAllowance_m;
+}
+
+}  // namespace multibin::sensors

@@ -1,0 +1,163 @@
+/* Depth-camera model: Nguyen 2012 curve, covariance along the ray, Monte Carlo consistency, the
+ * real MRPT depth frame through the map. */
+#include <gtest/gtest.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CRawlog.h>
+
+#include <cmath>
+#include <random>
+
+#include "mc_check.h"
+#include "multibin/PosePropagation.h"
+#include "multibin/sensors/DepthModel.h"
+#include "multibin/sensors/SensorDispatch.h"
+
+using namespace multibin;
+using namespace multibin::sensors;
+
+TEST(DepthModel, AxialAndLateralSigmasFollowTheModel) {
+    DepthModelOptions o;
+    // Nguyen 2012: 0.0012 + 0.0019 (z - 0.4)^2: 1.2 mm at 0.4 m, 4.24 mm at 1.65 m.
+    EXPECT_NEAR(o.axialSigma_m(0.4), 0.0012, 1e-12);
+    EXPECT_NEAR(o.axialSigma_m(1.65), 0.0012 + 0.0019 * 1.5625, 1e-12);
+    const Eigen::Vector3f p(2.0f, 1.0f, -0.5f);
+    const Eigen::Matrix3d C = depthPointCovariance(p, o).toMatrix();
+    const double r = p.cast<double>().norm();
+    const Eigen::Vector3d d = p.cast<double>() / r;
+    EXPECT_NEAR(d.dot(C * d), std::pow(o.axialSigma_m(r), 2), 1e-9);
+    // Any direction across the ray: (lateral sigma * r)^2.
+    const Eigen::Vector3d across = d.cross(Eigen::Vector3d::UnitZ()).normalized();
+    EXPECT_NEAR(across.dot(C * across), std::pow(o.lateralSigma_rad * r, 2), 1e-9);
+    EXPECT_NEAR(across.dot(C * d), 0.0, 1e-9);
+}
+
+TEST(DepthModel, InvalidPointsSkippedAndCounted) {
+    DepthModelOptions o;
+    PointsWithCov out;
+    DepthStats st;
+    appendDepthPoint(Eigen::Vector3f(NAN, 0, 0), o, 0.1, 5, out, st);
+    appendDepthPoint(Eigen::Vector3f(0, 0, 0), o, 0.1, 5, out, st);  // no return
+    appendDepthPoint(Eigen::Vector3f(6, 0, 0), o, 0.1, 5, out, st);
+    appendDepthPoint(Eigen::Vector3f(1, 0, 0), o, 0.1, 5, out, st);
+    EXPECT_EQ(st.points, 4u);
+    EXPECT_EQ(st.notFinite, 1u);
+    EXPECT_EQ(st.outOfRange, 2u);
+    EXPECT_EQ(st.kept, 1u);
+    EXPECT_EQ(out.size(), 1u);
+}
+
+TEST(DepthModel, MonteCarloCovarianceMatchesPropagation) {
+    // Axial and lateral noise of the stated model, plus robot pose noise, through the real
+    // transform; compared with the depth covariance + PosePropagator.
+    DepthModelOptions o;
+    const mrpt::poses::CPose3D sensor(0.2, 0.0, 0.6, 0.1, 0.4, 0.0);
+    const auto pdf = mc::robotPosePdf();
+    const Eigen::Vector3d p(2.5, 0.4, -0.3);
+    const double r = p.norm();
+    const Eigen::Vector3d d = p / r;
+    const Eigen::Vector3d e1 = d.cross(Eigen::Vector3d::UnitZ()).normalized(), e2 = d.cross(e1);
+    const PointWithCov pred =
+        PosePropagator(pdf, sensor)
+            .apply(PointWithCov{p.cast<float>(), depthPointCovariance(p.cast<float>(), o)});
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n01;
+    std::vector<Eigen::Vector3d> samples;
+    for (int k = 0; k < 4000; k++) {
+        const Eigen::Vector3d q = p + o.axialSigma_m(r) * n01(rng) * d +
+                                  o.lateralSigma_rad * r * (n01(rng) * e1 + n01(rng) * e2);
+        const auto m = (mc::samplePose(pdf, rng) + sensor)
+                           .composePoint(mrpt::math::TPoint3D(q.x(), q.y(), q.z()));
+        samples.emplace_back(m.x, m.y, m.z);
+    }
+    mc::expectConsistent(samples, pred.point_m.cast<double>(), pred.cov_m2.toMatrix());
+}
+
+TEST(DepthModel, PointCloudObservationUsesTheModel) {
+    mrpt::obs::CObservationPointCloud cloud;
+    auto pts = mrpt::maps::CSimplePointsMap::Create();
+    pts->insertPoint(1.0f, 0.0f, 0.0f);
+    pts->insertPoint(3.0f, 1.0f, -1.0f);
+    cloud.pointcloud = pts;
+    SensorModelOptions opts;
+    SensorModelState state;
+    InsertStats core;
+    SensorPoints sp;
+    ASSERT_TRUE(observationToSensorPoints(cloud, mrpt::poses::CPose3DPDFGaussian(), opts, 0.02, 20,
+                                          state, core, sp));
+    ASSERT_EQ(sp.points.size(), 2u);
+    const Eigen::Matrix3d C = sp.points[1].cov_m2.toMatrix();
+    const Eigen::Vector3d d = Eigen::Vector3d(3, 1, -1).normalized();
+    EXPECT_NEAR(d.dot(C * d), std::pow(opts.depth.axialSigma_m(std::sqrt(11.0)), 2), 1e-8);
+}
+
+TEST(DepthModel, RealMrptDepthFrameInsertsWithoutNaN) {
+    mrpt::obs::CRawlog rawlog;
+    ASSERT_TRUE(rawlog.loadFromRawLogFile(MULTIBIN_SOURCE_DIR "/rawlogs/mrpt_tests_rgbd.rawlog"));
+    mrpt::maps::CMultiBinElevationMap map;
+    map.insertionOptions.max_range_m = 6.0;
+    map.insertionOptions.max_elevation_uncertainty_m = 0.15;
+    SensorModelOptions opts = map.insertionOptions.sensors;
+    size_t frames = 0;
+    for (size_t i = 0; i < rawlog.size(); i++) {
+        mrpt::obs::CObservation::Ptr obs;
+        if (rawlog.getType(i) == mrpt::obs::CRawlog::etObservation)
+            obs = rawlog.getAsObservation(i);
+        else if (rawlog.getType(i) == mrpt::obs::CRawlog::etSensoryFrame)
+            obs = rawlog.getAsObservations(i)
+                      ->getObservationByClass<mrpt::obs::CObservation3DRangeScan>();
+        auto depth = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(obs);
+        if (!depth) continue;
+        frames++;
+        // The points carry the depth model's covariance.
+        SensorModelState state;
+        InsertStats core;
+        SensorPoints sp;
+        ASSERT_TRUE(observationToSensorPoints(*depth, mrpt::poses::CPose3DPDFGaussian(), opts, 0.02,
+                                              6.0, state, core, sp));
+        ASSERT_GT(sp.points.size(), 1000u);
+        for (const auto& p : sp.points) {
+            const Eigen::Matrix3d C = p.cov_m2.toMatrix();
+            const Eigen::Vector3d d = p.point_m.cast<double>().normalized();
+            const double r = p.point_m.cast<double>().norm();
+            ASSERT_NEAR(std::sqrt(d.dot(C * d)), opts.depth.axialSigma_m(r), 1e-5);
+        }
+        EXPECT_TRUE(map.insertObservation(*depth, mrpt::poses::CPose3DPDFGaussian()));
+    }
+    ASSERT_EQ(frames, 1u);
+    EXPECT_GT(map.sensorModelStats().depth.kept, 1000u);
+    EXPECT_GT(map.insertStats().accepted, 1000u);
+    // No NaN anywhere: every bin of every cell has a finite height, variance and certainty.
+    const auto& g = map.grid();
+    size_t bins = 0;
+    for (int iy = g.window().iy0; iy < g.window().iy0 + g.window().ny; iy++)
+        for (int ix = g.window().ix0; ix < g.window().ix0 + g.window().nx; ix++)
+            g.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+                bins++;
+                EXPECT_TRUE(std::isfinite(b.height_m) && std::isfinite(b.variance_m2) &&
+                            std::isfinite(b.certainty));
+                EXPECT_GT(b.variance_m2, 0.f);
+            });
+    EXPECT_GT(bins, 100u);
+}
+
+TEST(MonteCarloCheck, DetectsACovarianceTwentyPercentOff) {
+    // The consistency check itself: samples of N(0, I) pass against I and fail against 1.2 I
+    // (NEES too small) and 0.8 I (NEES too large).
+    std::mt19937 rng(9);
+    std::normal_distribution<double> n01;
+    std::vector<Eigen::Vector3d> s;
+    for (int k = 0; k < 4000; k++) s.emplace_back(n01(rng), n01(rng), n01(rng));
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+    const mc::Consistency ok = mc::consistency(s, Eigen::Vector3d::Zero(), I);
+    EXPECT_LT(ok.worstEntry, 0.1);
+    EXPECT_TRUE(ok.meanNees > ok.neesLo && ok.meanNees < ok.neesHi) << ok.meanNees;
+    const mc::Consistency big = mc::consistency(s, Eigen::Vector3d::Zero(), 1.2 * I);
+    EXPECT_LT(big.meanNees, big.neesLo);
+    EXPECT_GT(big.worstEntry, 0.1);
+    const mc::Consistency small = mc::consistency(s, Eigen::Vector3d::Zero(), 0.8 * I);
+    EXPECT_GT(small.meanNees, small.neesHi);
+    EXPECT_GT(small.shareAbove, 0.01 + small.shareTol);
+}
