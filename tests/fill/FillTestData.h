@@ -75,6 +75,24 @@ inline void hideBox(fill::HeightRaster& r, int x0, int y0, int w, int h) {
             if (r.inside(ix, iy)) r.setUnknown(ix, iy);
 }
 
+/** An n x n raster tiled from the boards (board (tx + ty) mod 6 at tile (tx, ty)), every cell
+ * measured with noise as in noisyCrop: a mock-up larger than one board (at 15 mm, n = 133 is the
+ * 2 x 2 m local grid). */
+inline fill::HeightRaster tiledRaster(const std::vector<Board>& boards, int n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> sig(0.002, 0.004);
+    std::normal_distribution<double> unit(0.0, 1.0);
+    const int t = boards[0].n;
+    fill::HeightRaster r(n, n, boards[0].cell_m);
+    for (int iy = 0; iy < n; iy++)
+        for (int ix = 0; ix < n; ix++) {
+            const Board& b = boards[size_t((ix / t + iy / t) % int(boards.size()))];
+            const double s = sig(rng);
+            r.setMeasured(ix, iy, float(b.at(ix % t, iy % t) + s * unit(rng)), float(s));
+        }
+    return r;
+}
+
 /** One hidden square gap on one board crop. */
 struct GapCase {
     int board = 0;                 //!< index into the loaded boards

@@ -225,27 +225,25 @@ std::vector<double> mrfFill(const HeightRaster& r) {
     return out;
 }
 
+std::vector<double> heights(const FillResult& f) {
+    return std::vector<double>(f.height_m.begin(), f.height_m.end());
+}
+
 int accuracy(const std::vector<Board>& boards, bool withMrf) {
     using Method = std::function<std::vector<double>(const HeightRaster&)>;
     const FillOptions opt;
-    FillOptions pure;
+    FillOptions pure, bic;
     pure.residualCorrection = false;
+    bic.criterion = ModelCriterion::BIC;
     std::vector<std::pair<std::string, Method>> methods{
-        {"Gaussian eq 16 + harmonic rim residuals (this library, default)",
-         [&](const HeightRaster& r) {
-             const auto f = fillGaps(r, opt);
-             return std::vector<double>(f.height_m.begin(), f.height_m.end());
-         }},
+        {"Gaussian eq 16 + harmonic rim residuals (default)",
+         [&](const HeightRaster& r) { return heights(fillGaps(r, opt)); }},
         {"Gaussian eq 16 alone (paper; fill_residual_correction = false)",
-         [&](const HeightRaster& r) {
-             const auto f = fillGaps(r, pure);
-             return std::vector<double>(f.height_m.begin(), f.height_m.end());
-         }},
+         [&](const HeightRaster& r) { return heights(fillGaps(r, pure)); }},
+        {"Gaussian eq 16 + rim residuals, m by BIC",
+         [&](const HeightRaster& r) { return heights(fillGaps(r, bic)); }},
         {"weighted median, repeated rim-inwards",
-         [&](const HeightRaster& r) {
-             const auto f = weightedMedianFill(r, opt, true);
-             return std::vector<double>(f.height_m.begin(), f.height_m.end());
-         }},
+         [&](const HeightRaster& r) { return heights(weightedMedianFill(r, opt, true)); }},
         {"cv::inpaint TELEA, float, radius 3",
          [](const HeightRaster& r) { return inpaintFloat(r, cv::INPAINT_TELEA, 3); }},
         {"cv::inpaint TELEA, 16-bit scaled, radius 3",
@@ -256,7 +254,19 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
     if (withMrf) methods.push_back({"MRPT CHeightGridMap2D_MRF (GMRF_SD)", mrfFill});
     // The MRF solve takes seconds per crop: one placement per size and board with it.
     const auto cases = makeGapCases(int(boards.size()), kLargeSizes, withMrf ? 1 : 4, 4, 3);
-    std::map<std::string, std::map<int, std::pair<double, int>>> sse;  // method -> size -> (sse, n)
+    struct Acc {
+        double sse = 0;
+        int n = 0, missing = 0;
+        void add(double e) {
+            if (std::isfinite(e))
+                sse += e * e, n++;
+            else
+                missing++;
+        }
+        double rmse_mm() const { return 1000 * std::sqrt(sse / std::max(n, 1)); }
+    };
+    std::map<std::string, std::map<int, Acc>> bySize, byBoard;
+    std::map<std::string, Acc> total;
     std::map<std::string, double> seconds;
     for (const auto& c : cases) {
         const auto r = caseRaster(boards, c);
@@ -268,31 +278,35 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
             for (int iy = c.gy; iy < c.gy + c.size; iy++)
                 for (int ix = c.gx; ix < c.gx + c.size; ix++) {
                     const double e = h[r.index(ix, iy)] - caseTruth(boards, c, ix, iy);
-                    auto& acc = sse[name][c.size];
-                    if (std::isfinite(e))
-                        acc.first += e * e, acc.second++;
-                    else
-                        acc.first = std::numeric_limits<double>::infinity();
+                    bySize[name][c.size].add(e);
+                    byBoard[name][c.board].add(e);
+                    total[name].add(e);
                 }
         }
     }
     std::printf(
-        "%zu gaps (%s placement(s) per board and size, seed 3), 35 x 35-cell crops at 15 mm\n\n",
-        cases.size(), withMrf ? "1" : "4");
+        "%zu gaps (%d placement(s) per board and size, seed 3), 35 x 35-cell crops at 15 mm\n\n",
+        cases.size(), withMrf ? 1 : 4);
     std::printf(
-        "| method | RMSE [mm] gap 6 | gap 10 | gap 14 | gap 18 | all | time per crop [ms] |\n"
-        "|---|---|---|---|---|---|---|\n");
+        "| method | RMSE [mm] gap 6 | gap 10 | gap 14 | gap 18 | all | cells not filled | time per "
+        "crop [ms] |\n"
+        "|---|---|---|---|---|---|---|---|\n");
     for (const auto& [name, fn] : methods) {
         std::printf("| %s ", name.c_str());
-        double all = 0;
-        int n = 0;
-        for (int s : kLargeSizes) {
-            const auto [e, k] = sse[name][s];
-            std::printf("| %.1f ", 1000 * std::sqrt(e / std::max(k, 1)));
-            all += e, n += k;
-        }
-        std::printf("| %.1f | %.1f |\n", 1000 * std::sqrt(all / std::max(n, 1)),
+        for (int s : kLargeSizes) std::printf("| %.1f ", bySize[name][s].rmse_mm());
+        std::printf("| %.1f | %d | %.1f |\n", total[name].rmse_mm(), total[name].missing,
                     1000 * seconds[name] / double(cases.size()));
+    }
+    std::printf("\nRMSE [mm] per board, all gap sizes:\n\n| method |");
+    for (const auto& b : boards) std::printf(" %s |", b.name.c_str());
+    std::printf("\n|---|");
+    for (size_t b = 0; b < boards.size(); b++) std::printf("---|");
+    std::printf("\n");
+    for (const auto& [name, fn] : methods) {
+        std::printf("| %s |", name.c_str());
+        for (size_t b = 0; b < boards.size(); b++)
+            std::printf(" %.1f |", byBoard[name][int(b)].rmse_mm());
+        std::printf("\n");
     }
     return 0;
 }

@@ -1,2 +1,366 @@
+/* Unit tests of gap filling: particle swarm, eq 16 fit and AIC model size, weighted median,
+ * gap components, semivariogram, fillGaps routing, options. */
 #include <gtest/gtest.h>
-TEST(Fill, Placeholder) {}
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "multibin/StrictConfigSection.h"
+#include "multibin/fill/GapFilling.h"
+#include "multibin/fill/GaussianSurface.h"
+#include "multibin/fill/ParticleSwarm.h"
+
+using namespace multibin::fill;
+
+namespace {
+
+/** A raster with every cell measured from f(ix, iy) [m], sigma s [m]. */
+template <class F>
+HeightRaster rasterFrom(int n, F f, float s = 0.002f) {
+    HeightRaster r(n, n, 0.015);
+    for (int iy = 0; iy < n; iy++)
+        for (int ix = 0; ix < n; ix++) r.setMeasured(ix, iy, float(f(ix, iy)), s);
+    return r;
+}
+
+void hide(HeightRaster& r, int x0, int y0, int w, int h) {
+    for (int iy = y0; iy < y0 + h; iy++)
+        for (int ix = x0; ix < x0 + w; ix++) r.setUnknown(ix, iy);
+}
+
+/** Samples of a sum of Gaussians on a side x side area with a hole, plus noise. */
+std::vector<SurfaceSample> gaussianSamples(const std::vector<GaussianTerm>& terms, double c0,
+                                           int side, double noise_m, unsigned seed) {
+    GaussianSurface truth;
+    truth.c0_m = c0;
+    truth.terms = terms;
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> n(0.0, noise_m);
+    std::vector<SurfaceSample> s;
+    for (int j = 0; j < side; j++)
+        for (int i = 0; i < side; i++)
+            if (!(i >= 10 && i < 14 && j >= 10 && j < 14))
+                s.push_back({i, j, truth(i, j) + n(rng), noise_m});
+    return s;
+}
+
+GaussianTerm term(double c, double a1, double a2, double width_cells) {
+    const double l = -0.5 / (width_cells * width_cells);
+    return GaussianTerm{c, l, a1, l, a2};
+}
+
+}  // namespace
+
+// ----- Particle swarm -----
+TEST(ParticleSwarm, FindsMinimumOfRosenbrockAndIsDeterministic) {
+    auto rosen = [](const std::vector<double>& x) {
+        return 100 * std::pow(x[1] - x[0] * x[0], 2) + std::pow(1 - x[0], 2);
+    };
+    ParticleSwarmOptions o;
+    o.particles = 30;
+    o.iterations = 300;
+    const auto a = minimizeParticleSwarm(rosen, {-2, -2}, {2, 2}, o);
+    EXPECT_NEAR(a.x[0], 1.0, 0.05);
+    EXPECT_NEAR(a.x[1], 1.0, 0.1);
+    EXPECT_LT(a.value, 1e-3);
+    EXPECT_EQ(a.evaluations, 30 * 301);
+    const auto b = minimizeParticleSwarm(rosen, {-2, -2}, {2, 2}, o);
+    EXPECT_EQ(a.x, b.x);  // same seed, same swarm
+    o.seed = 2;
+    const auto c = minimizeParticleSwarm(rosen, {-2, -2}, {2, 2}, o);
+    EXPECT_NE(a.x, c.x);
+}
+
+TEST(ParticleSwarm, StaysInBoxAndUsesInitialGuess) {
+    // Unconstrained minimum at (5, 5), outside the box: the answer is the corner.
+    auto f = [](const std::vector<double>& x) {
+        return std::pow(x[0] - 5, 2) + std::pow(x[1] - 5, 2);
+    };
+    ParticleSwarmOptions o;
+    o.iterations = 50;
+    const auto r = minimizeParticleSwarm(f, {0, 0}, {1, 2}, o);
+    EXPECT_DOUBLE_EQ(r.x[0], 1.0);
+    EXPECT_DOUBLE_EQ(r.x[1], 2.0);
+    o.iterations = 0;  // only the initial swarm: the given guess must be evaluated
+    const auto g = minimizeParticleSwarm(f, {0, 0}, {1, 2}, o, {{1.0, 2.0}});
+    EXPECT_DOUBLE_EQ(g.value, 16 + 9);
+    EXPECT_THROW(minimizeParticleSwarm(f, {0}, {1, 2}, o), std::invalid_argument);
+    EXPECT_THROW(minimizeParticleSwarm(f, {1, 0}, {0, 2}, o), std::invalid_argument);
+}
+
+// ----- Eq 16 and the Akaike criterion -----
+TEST(GaussianSurface, CorrectedAicByHand) {
+    // n ln(chi2/n) + 2k + 2k(k+1)/(n-k-1) with n = 100, k = 6, chi2 = 50.
+    EXPECT_NEAR(correctedAic(50, 100, 6), 100 * std::log(0.5) + 12 + 84.0 / 93.0, 1e-12);
+    EXPECT_TRUE(std::isinf(correctedAic(1, 7, 6)));
+    EXPECT_NEAR(bayesianCriterion(50, 100, 6), 100 * std::log(0.5) + 6 * std::log(100.0), 1e-12);
+}
+
+TEST(GaussianSurface, RecoversOneGaussianExactly) {
+    const auto samples = gaussianSamples({term(0.05, 9.0, 15.0, 3.0)}, 0.02, 24, 1e-4, 1);
+    GaussianFitOptions o;
+    o.swarm.iterations = 80;
+    const auto g = fitGaussianSurfaceFixed(samples, 24, 1, o);
+    ASSERT_EQ(g.terms.size(), 1u);
+    EXPECT_NEAR(g.c0_m, 0.02, 2e-4);
+    EXPECT_NEAR(g.terms[0].c_m, 0.05, 5e-4);
+    EXPECT_NEAR(g.terms[0].a1, 9.0, 0.05);
+    EXPECT_NEAR(g.terms[0].a2, 15.0, 0.05);
+    EXPECT_NEAR(g.terms[0].lambda1, -0.5 / 9.0, 0.002);
+    EXPECT_NEAR(g.rmsResidual_m, 1e-4, 3e-5);                                   // down to the noise
+    EXPECT_NEAR(g(12, 12), 0.02 + 0.05 * std::exp(-(9.0 + 9.0) / 18.0), 3e-4);  // in the hole
+}
+
+TEST(GaussianSurface, CriteriaChooseTheTrueNumberOfGaussians) {
+    // Surfaces of 0..4 well-separated Gaussians (2-5 cm high, 2-3.5 cells wide) plus 2 mm noise
+    // on a 24 x 24 area with a 4 x 4 hole, four noise draws each.
+    const std::vector<GaussianTerm> pool{term(0.04, 5, 6, 2.5), term(-0.03, 18, 17, 3.0),
+                                         term(0.05, 17, 5, 2.0), term(0.03, 6, 18, 3.5)};
+    GaussianFitOptions aic, bic;
+    aic.maxTerms = bic.maxTerms = 6;
+    bic.criterion = ModelCriterion::BIC;
+    int aicExact = 0, cases = 0;
+    for (int m = 0; m <= 4; m++)
+        for (unsigned seed = 1; seed <= 4; seed++) {
+            const std::vector<GaussianTerm> terms(pool.begin(), pool.begin() + m);
+            const auto samples = gaussianSamples(terms, 0.01, 24, 0.002, seed);
+            const auto a = fitGaussianSurface(samples, 24, aic);
+            const auto b = fitGaussianSurface(samples, 24, bic);
+            const int ma = int(a.terms.size());
+            // AIC never misses a real term; its known weakness is one extra term that fits
+            // noise (the optimised centre and width make a term worth more than 5 parameters).
+            EXPECT_GE(ma, m) << "AICc, true m = " << m << ", seed " << seed;
+            EXPECT_LE(ma, m + 1) << "AICc, true m = " << m << ", seed " << seed;
+            aicExact += ma == m;
+            cases++;
+            EXPECT_EQ(int(b.terms.size()), m) << "BIC, true m = " << m << ", seed " << seed;
+            EXPECT_LT(a.rmsResidual_m, 0.0022) << "m = " << m;  // at the noise level
+        }
+    EXPECT_GE(aicExact, cases / 2) << aicExact << " of " << cases;
+    std::printf("AICc chose the true m in %d of %d cases, BIC in all\n", aicExact, cases);
+}
+
+TEST(GaussianSurface, RejectsBadSamples) {
+    GaussianFitOptions o;
+    EXPECT_THROW(fitGaussianSurface({}, 10, o), std::invalid_argument);
+    EXPECT_THROW(fitGaussianSurface({{10, 0, 0.1, 0.01}}, 10, o), std::invalid_argument);
+    EXPECT_THROW(fitGaussianSurface({{1, 1, 0.1, 0.0}}, 10, o), std::invalid_argument);
+}
+
+// ----- Weighted median -----
+TEST(WeightedMedian, OuterCellsOutweighInnerOnes) {
+    // Centre unknown; the 8 inner cells at 0.10 m (weights 1 and sqrt 2, total 9.66); six outer
+    // cells at 0.20 m: four corners (2 sqrt 2) and two edge centres (2), total 15.3. The plain
+    // median (8 against 6) would say 0.10; the skeleton says 0.20.
+    HeightRaster r(5, 5, 0.015);
+    for (int iy = 1; iy <= 3; iy++)
+        for (int ix = 1; ix <= 3; ix++)
+            if (ix != 2 || iy != 2) r.setMeasured(ix, iy, 0.10f, 0.002f);
+    for (auto [x, y] : {std::pair{0, 0}, {4, 0}, {0, 4}, {4, 4}, {2, 0}, {0, 2}})
+        r.setMeasured(x, y, 0.20f, 0.004f);
+    FillOptions o;
+    o.sigmaModel = FillSigmaModel::Paper;
+    const auto f = weightedMedianFill(r, o);
+    const size_t c = f.index(2, 2);
+    EXPECT_EQ(f.source[c], FillSource::Median);
+    EXPECT_FLOAT_EQ(f.height_m[c], 0.20f);
+    // Paper sigma: the same weights over the neighbours' sigma.
+    const double wIn = 4 + 4 * std::sqrt(2.0), wOut = 4 * 2 * std::sqrt(2.0) + 2 * 2;
+    EXPECT_NEAR(f.sigma_m[c], (0.002 * wIn + 0.004 * wOut) / (wIn + wOut), 1e-7);
+    EXPECT_DOUBLE_EQ(medianSkeletonWeight(2, 1), std::sqrt(5.0));
+
+    // Calibrated sigma: neighbour noise plus gain * weighted spread about the median.
+    o.sigmaModel = FillSigmaModel::Calibrated;
+    const auto g = weightedMedianFill(r, o);
+    const double var = (4e-6 * wIn + 16e-6 * wOut) / (wIn + wOut);
+    const double spread = 0.01 * wIn / (wIn + wOut);
+    EXPECT_NEAR(g.sigma_m[c], std::sqrt(var + std::pow(o.medianSigmaGain, 2) * spread), 1e-6);
+}
+
+TEST(WeightedMedian, FillsOnlyNeverObservedCellsAndNeverWritesZero) {
+    auto r = rasterFrom(12, [](int ix, int iy) { return 0.05 + 0.001 * ix + 0.002 * iy; });
+    hide(r, 3, 3, 2, 1);
+    r.certainty[r.index(8, 8)] = 0;  // certainty 0 but a height: still "never observed"
+    FillOptions o;
+    const auto f = weightedMedianFill(r, o);
+    for (size_t k = 0; k < r.size(); k++) {
+        if (r.isMeasured(k)) {
+            EXPECT_EQ(f.source[k], FillSource::Measured);
+            EXPECT_EQ(f.height_m[k], r.height_m[k]);
+            EXPECT_EQ(f.sigma_m[k], r.sigma_m[k]);
+        } else {
+            EXPECT_EQ(f.source[k], FillSource::Median);
+            EXPECT_GT(f.height_m[k], 0.05f);
+        }
+    }
+    EXPECT_EQ(f.stats.median, 3);
+
+    // Nothing to fill from: NaN stays NaN, never zero.
+    HeightRaster empty(10, 10, 0.015);
+    const auto e = fillGaps(empty, o);
+    for (size_t k = 0; k < empty.size(); k++) {
+        EXPECT_EQ(e.source[k], FillSource::Unfilled);
+        EXPECT_TRUE(std::isnan(e.height_m[k]));
+    }
+    // One lonely measurement, too few for medianMinKnown = 3: still NaN.
+    HeightRaster lonely(10, 10, 0.015);
+    lonely.setMeasured(5, 5, 0.1f, 0.002f);
+    o.maxGapCells = 10;  // the whole rest is one big gap: left Unfilled
+    const auto l = fillGaps(lonely, o);
+    EXPECT_EQ(l.stats.unfilled, 99);
+}
+
+TEST(WeightedMedian, RepeatedPassesFillALargeGapFromTheRim) {
+    auto r = rasterFrom(20, [](int, int) { return 0.07; });
+    hide(r, 5, 5, 10, 10);
+    FillOptions o;
+    const auto once = weightedMedianFill(r, o, false);
+    EXPECT_EQ(once.stats.median, 100 - 36);  // the 6 x 6 core is beyond a 5 x 5 window
+    const auto all = weightedMedianFill(r, o, true);
+    EXPECT_EQ(all.stats.median, 100);
+    for (size_t k = 0; k < r.size(); k++) EXPECT_NEAR(all.height_m[k], 0.07, 1e-7);
+}
+
+// ----- Gap components and semivariogram -----
+TEST(GapComponents, LabelsFourConnectedGaps) {
+    auto r = rasterFrom(6, [](int, int) { return 0.0; });
+    hide(r, 0, 0, 2, 2);  // 4 cells
+    hide(r, 2, 2, 1, 1);  // diagonal only: a separate gap
+    hide(r, 4, 0, 1, 6);  // a column of 6
+    std::vector<int> sizes;
+    const auto label = labelGaps(r, sizes);
+    ASSERT_EQ(sizes.size(), 3u);
+    EXPECT_EQ(sizes[label[r.index(0, 0)]], 4);
+    EXPECT_EQ(sizes[label[r.index(2, 2)]], 1);
+    EXPECT_EQ(sizes[label[r.index(4, 5)]], 6);
+    EXPECT_EQ(label[r.index(3, 3)], -1);
+}
+
+TEST(Semivariogram, LinearRampByHand) {
+    // z = 0.01 ix: pairs along rows differ by 0.01 h, along columns by 0; in a square box both
+    // directions have the same number of pairs, so gamma(h) = 0.5 * (0.01 h)^2 / 2.
+    const auto r = rasterFrom(10, [](int ix, int) { return 0.01 * ix; });
+    const auto g = semivariogram(r, 0, 0, 10, 10, 4);
+    ASSERT_EQ(g.size(), 5u);
+    EXPECT_EQ(g[0], 0.0);
+    for (int h = 1; h <= 4; h++) EXPECT_NEAR(g[h], 0.25 * 1e-4 * h * h, 1e-9) << "lag " << h;
+}
+
+// ----- fillGaps routing -----
+TEST(FillGaps, SmallGapsByMedianLargeByGaussianHugeUnfilled) {
+    // A smooth hill on a slope: eq 16 fits it well, so the large gap is filled accurately.
+    auto hill = [](int ix, int iy) {
+        return 0.02 + 0.001 * ix +
+               0.06 *
+                   std::exp(-((ix - 20.0) * (ix - 20.0) + (iy - 18.0) * (iy - 18.0)) / (2 * 36.0));
+    };
+    auto r = rasterFrom(40, hill, 0.001f);
+    hide(r, 2, 2, 2, 2);      // small: median
+    hide(r, 15, 13, 10, 10);  // large: Gaussian
+    FillOptions o;
+    const auto f = fillGaps(r, o);
+    EXPECT_EQ(f.stats.gapComponents, 2);
+    EXPECT_EQ(f.stats.median, 4);
+    EXPECT_EQ(f.stats.gaussian, 100);
+    EXPECT_EQ(f.stats.supportAreas, 1);
+    double worst = 0;
+    for (int iy = 13; iy < 23; iy++)
+        for (int ix = 15; ix < 25; ix++) {
+            const size_t k = f.index(ix, iy);
+            EXPECT_EQ(f.source[k], FillSource::Gaussian);
+            worst = std::max(worst, std::abs(f.height_m[k] - hill(ix, iy)));
+            EXPECT_GE(f.sigma_m[k], o.sigmaFloor_m);
+        }
+    EXPECT_LT(worst, 0.004);  // 6 cm hill, top hidden: within 4 mm
+
+    // Deterministic: the swarm is seeded.
+    const auto again = fillGaps(r, o);
+    EXPECT_EQ(f.height_m, again.height_m);
+
+    // A gap above fill_max_gap_cells stays unknown; disabled filling fills nothing.
+    o.maxGapCells = 50;
+    const auto capped = fillGaps(r, o);
+    EXPECT_EQ(capped.stats.unfilled, 100);
+    EXPECT_EQ(capped.stats.median, 4);
+    o.enabled = false;
+    EXPECT_EQ(fillGaps(r, o).stats.unfilled, 104);
+}
+
+TEST(FillGaps, SigmaGrowsTowardsTheMiddleOfAGap) {
+    // A rolling surface (wavelengths 12-20 cells): heights drift apart with distance, so the
+    // semivariogram grows and so does the sigma of cells farther from the rim.
+    auto rolling = [](int ix, int iy) {
+        return 0.05 + 0.02 * std::sin(0.31 * ix + 0.2) * std::cos(0.45 * iy) +
+               0.01 * std::sin(0.52 * (ix + iy));
+    };
+    auto r = rasterFrom(36, rolling, 0.002f);
+    hide(r, 10, 10, 16, 16);
+    const auto f = fillGaps(r, FillOptions{});
+    EXPECT_LT(f.sigma_m[f.index(10, 18)], f.sigma_m[f.index(14, 18)]);
+    EXPECT_LT(f.sigma_m[f.index(14, 18)], f.sigma_m[f.index(18, 18)]);
+}
+
+TEST(FillGaps, RejectsInconsistentRaster) {
+    HeightRaster r(4, 4, 0.015);
+    r.sigma_m.pop_back();
+    try {
+        fillGaps(r, FillOptions{});
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("sigma_m"), std::string::npos);
+    }
+    HeightRaster bad(4, 4, 0.0);
+    EXPECT_THROW(fillGaps(bad, FillOptions{}), std::invalid_argument);
+}
+
+// ----- Options -----
+TEST(FillOptions, IniRoundTripAndStrictErrors) {
+    FillOptions a;
+    a.enabled = false;
+    a.medianWindow_cells = 7;
+    a.maxGapCells = 1234;
+    a.sigmaModel = FillSigmaModel::Paper;
+    a.gaussianSigmaGain = 1.25;
+    a.swarmSeed = 42;
+    a.residualCorrection = false;
+    mrpt::config::CConfigFileMemory ini;
+    a.saveToConfigFile(ini, "insertOpts");
+    FillOptions b;
+    b.loadFromConfigFile(ini, "insertOpts");
+    EXPECT_EQ(b.enabled, false);
+    EXPECT_EQ(b.medianWindow_cells, 7);
+    EXPECT_EQ(b.maxGapCells, 1234);
+    EXPECT_EQ(b.sigmaModel, FillSigmaModel::Paper);
+    EXPECT_DOUBLE_EQ(b.gaussianSigmaGain, 1.25);
+    EXPECT_EQ(b.swarmSeed, 42u);
+    EXPECT_FALSE(b.residualCorrection);
+
+    // Keys shared with the map's own section: the caller's strict reader owns finish().
+    mrpt::config::CConfigFileMemory shared;
+    shared.write("s", "fill_median_window", 3);
+    shared.write("s", "certainty_increment", 1.0);
+    multibin::StrictConfigSection sec(shared, "s");
+    FillOptions c;
+    c.read(sec);
+    EXPECT_EQ(c.medianWindow_cells, 3);
+    EXPECT_THROW(sec.finish(), std::invalid_argument);  // certainty_increment was not read here
+
+    auto expectError = [](const std::string& key, const std::string& value) {
+        mrpt::config::CConfigFileMemory m;
+        m.write("s", key, value);
+        FillOptions o;
+        try {
+            o.loadFromConfigFile(m, "s");
+            ADD_FAILURE() << key << " = " << value << " accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+        }
+    };
+    expectError("fill_median_window", "4");
+    expectError("fill_median_window", "five");
+    expectError("fill_sigma_model", "bayes");
+    expectError("fill_max_gap_cells", "0");
+    expectError("fill_medain_window", "5");  // typo: unknown key
+}

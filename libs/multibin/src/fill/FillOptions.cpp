@@ -18,6 +18,7 @@ const char* sigmaModelName(FillSigmaModel m) {
 
 GaussianFitOptions FillOptions::gaussianFitOptions() const {
     GaussianFitOptions g;
+    g.criterion = criterion;
     g.maxTerms = maxTerms;
     g.minWidth_cells = minWidth_cells;
     g.swarm.particles = swarmParticles;
@@ -35,6 +36,14 @@ void FillOptions::read(StrictConfigSection& s) {
     s.read("fill_support_margin", supportMargin_cells);
     s.read("fill_max_training_points", maxTrainingPoints);
     s.read("fill_residual_correction", residualCorrection);
+    std::string crit = criterion == ModelCriterion::BIC ? "bic" : "aic";
+    s.read("fill_model_criterion", crit);
+    if (crit == "aic")
+        criterion = ModelCriterion::AICc;
+    else if (crit == "bic")
+        criterion = ModelCriterion::BIC;
+    else
+        s.fail("fill_model_criterion", "expected aic or bic, got '" + crit + "'");
     s.read("fill_max_terms", maxTerms);
     s.read("fill_min_width", minWidth_cells);
     s.read("fill_pso_particles", swarmParticles);
@@ -71,6 +80,8 @@ void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
     c.write(section, "fill_support_margin", supportMargin_cells);
     c.write(section, "fill_max_training_points", maxTrainingPoints);
     c.write(section, "fill_residual_correction", residualCorrection);
+    c.write(section, "fill_model_criterion",
+            std::string(criterion == ModelCriterion::BIC ? "bic" : "aic"));
     c.write(section, "fill_max_terms", maxTerms);
     c.write(section, "fill_min_width", minWidth_cells);
     c.write(section, "fill_pso_particles", swarmParticles);

@@ -26,6 +26,10 @@ double correctedAic(double chi2, int n, int k) {
     return n * std::log(meanChi2) + 2.0 * k + 2.0 * k * (k + 1.0) / (n - k - 1.0);
 }
 
+double bayesianCriterion(double chi2, int n, int k) {
+    return n * std::log(std::max(chi2 / n, 1e-12)) + k * std::log(double(n));
+}
+
 namespace {
 
 /** Shape parameters of one term in normalised coordinates u = (i - centre) / halfSide:
@@ -42,6 +46,10 @@ struct Fitter {
     Eigen::MatrixXd rowTab, colTab;  // per term: exp factor for each column / row index
     Eigen::VectorXd c;
     double amplitudePrior = 0;  // 1 / sigma_c^2 [1/m^2]
+    double yy = 0;              // |y|^2
+    Eigen::MatrixXd G;
+    Eigen::VectorXd rhs;
+    Eigen::LDLT<Eigen::MatrixXd, Eigen::Lower> ldlt;
 
     Fitter(const std::vector<SurfaceSample>& s, int sideCells)
         : samples(s),
@@ -63,6 +71,7 @@ struct Fitter {
         // column almost zero at every sample) from taking an arbitrary amplitude.
         const double sigmaC = std::max(hi - lo, 3 * maxSigma);
         amplitudePrior = 1.0 / (sigmaC * sigmaC);
+        yy = y.squaredNorm();
     }
 
     /** Amplitudes by weighted least squares for the given shapes; returns chi2. */
@@ -88,11 +97,70 @@ struct Fitter {
             for (int q = 0; q < m; q++) A(k, q + 1) = sqrtW[k] * rowTab(s.i, q) * colTab(s.j, q);
         }
         // Gram matrix plus the amplitude prior (also keeps coincident terms solvable).
-        Eigen::MatrixXd G = A.transpose() * A;
+        // With c the least-squares solution, |y - A c|^2 + prior |c|^2 = |y|^2 - b^T c: no
+        // second pass over the samples. Buffers are members: no allocation per evaluation.
+        G.setZero(m + 1, m + 1);
+        G.selfadjointView<Eigen::Lower>().rankUpdate(A.transpose());
         G.diagonal().tail(m).array() += amplitudePrior;
         G(0, 0) += 1e-12 * G(0, 0);
-        c = G.ldlt().solve(A.transpose() * y);
-        return (y - A * c).squaredNorm() + amplitudePrior * c.tail(m).squaredNorm();
+        rhs.noalias() = A.transpose() * y;
+        ldlt.compute(G);  // reads the lower triangle only
+        c = ldlt.solve(rhs);
+        return std::max(yy - rhs.dot(c), 0.0);
+    }
+
+    /** The residual vector whose squared norm solve() returns (data, then amplitude prior). */
+    Eigen::VectorXd residual(const double* shape, int m) {
+        solve(shape, m);
+        Eigen::VectorXd r(A.rows() + m);
+        r.head(A.rows()) = y - A * c;
+        r.tail(m) = std::sqrt(amplitudePrior) * c.tail(m);
+        return r;
+    }
+
+    /** Levenberg-Marquardt polish of the swarm's best shapes (forward-difference Jacobian of the
+     * variable-projection residual), kept inside the box. The swarm finds the basin; this finds
+     * its bottom, which the swarm alone reaches slowly in 8+ dimensions. */
+    void polish(std::vector<double>& shape, double& cost, int m, const std::vector<double>& lo,
+                const std::vector<double>& hi, int maxIterations) {
+        const int d = int(shape.size());
+        double mu = 1e-3;
+        Eigen::VectorXd r = residual(shape.data(), m);
+        cost = r.squaredNorm();
+        Eigen::MatrixXd J(r.size(), d);
+        std::vector<double> trial(shape);
+        for (int it = 0; it < maxIterations; it++) {
+            for (int k = 0; k < d; k++) {
+                constexpr double kStep = 1e-6;
+                trial = shape;
+                trial[k] += kStep;
+                J.col(k) = (residual(trial.data(), m) - r) / kStep;
+            }
+            const Eigen::MatrixXd JtJ = J.transpose() * J;
+            const Eigen::VectorXd g = J.transpose() * r;
+            bool improved = false;
+            for (int tries = 0; tries < 8 && !improved; tries++) {
+                Eigen::MatrixXd H = JtJ;
+                H.diagonal() += mu * (JtJ.diagonal().array() + 1e-12).matrix();
+                const Eigen::VectorXd step = H.ldlt().solve(-g);
+                for (int k = 0; k < d; k++)
+                    trial[k] = std::clamp(shape[k] + step[k], lo[size_t(k)], hi[size_t(k)]);
+                Eigen::VectorXd rt = residual(trial.data(), m);
+                const double ct = rt.squaredNorm();
+                if (ct < cost) {
+                    const double gain = (cost - ct) / cost;
+                    shape = trial;
+                    r = rt;
+                    cost = ct;
+                    mu = std::max(mu / 3, 1e-9);
+                    improved = true;
+                    if (gain < 1e-7) return;  // converged
+                } else {
+                    mu *= 4;
+                }
+            }
+            if (!improved) return;
+        }
     }
 
     GaussianSurface build(const double* shape, int m) {
@@ -109,6 +177,7 @@ struct Fitter {
         g.samples = int(samples.size());
         g.chi2 = chi2;
         g.aicc = correctedAic(chi2, g.samples, g.parameters());
+        g.bic = bayesianCriterion(chi2, g.samples, g.parameters());
         double sw = 0, swr = 0;
         for (const auto& s : samples) {
             const double w = 1.0 / (s.sigma_m * s.sigma_m), r = s.h_m - g(s.i, s.j);
@@ -185,18 +254,23 @@ GaussianSurface fitGaussianSurfaceFixed(const std::vector<SurfaceSample>& sample
     auto objective = [&](const std::vector<double>& p) { return f.solve(p.data(), m); };
     ParticleSwarmOptions swarm = options.swarm;
     swarm.seed = options.swarm.seed + 7919u * unsigned(m);  // distinct, reproducible per m
-    const auto best = minimizeParticleSwarm(objective, lo, hi, swarm, initial);
+    auto best = minimizeParticleSwarm(objective, lo, hi, swarm, initial);
+    if (options.polishIterations > 0)
+        f.polish(best.x, best.value, m, lo, hi, options.polishIterations);
     return f.build(best.x.data(), m);
 }
 
 GaussianSurface fitGaussianSurface(const std::vector<SurfaceSample>& samples, int side,
                                    const GaussianFitOptions& options) {
+    auto score = [&](const GaussianSurface& g) {
+        return options.criterion == ModelCriterion::BIC ? g.bic : g.aicc;
+    };
     GaussianSurface best = fitGaussianSurfaceFixed(samples, side, 0, options);
     GaussianSurface prev = best;
     for (int m = 1; m <= options.maxTerms; m++) {
         if (int(samples.size()) <= 1 + 5 * m + 1) break;  // AICc undefined: too few samples
         GaussianSurface g = fitGaussianSurfaceFixed(samples, side, m, options, &prev);
-        if (!(g.aicc < best.aicc)) break;  // the criterion stopped improving
+        if (!(score(g) < score(best))) break;  // the criterion stopped improving
         best = g;
         prev = g;
     }

@@ -52,17 +52,19 @@ struct FillOptions {
     /** [fill_residual_correction] beyond the paper: add to the fitted surface the residuals of
      * the rim cells, carried into the gap as a harmonic function, so the fill meets the rim. */
     bool residualCorrection = true;
+    /** [fill_model_criterion] aic (the paper's, as AICc) or bic: how m is chosen. */
+    ModelCriterion criterion = ModelCriterion::AICc;
     int maxTerms = 4;             //!< [fill_max_terms] largest m tried by AIC [-]
     double minWidth_cells = 1.0;  //!< [fill_min_width] narrowest Gaussian sigma [cells]
     int swarmParticles = 20;      //!< [fill_pso_particles]
-    int swarmIterations = 40;     //!< [fill_pso_iterations]
+    int swarmIterations = 25;     //!< [fill_pso_iterations]
     unsigned swarmSeed = 1;       //!< [fill_pso_seed]
 
     // --- Sigma of filled cells ---
     FillSigmaModel sigmaModel =
         FillSigmaModel::Calibrated;   //!< [fill_sigma_model] calibrated|paper
     double medianSigmaGain = 0.77;    //!< [fill_median_sigma_gain] calibrated gain [-]
-    double gaussianSigmaGain = 0.89;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
+    double gaussianSigmaGain = 0.87;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
     double sigmaFloor_m = 0.002;      //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
 
     /** The Gaussian-fit settings these options imply. */

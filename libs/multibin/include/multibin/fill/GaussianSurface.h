@@ -34,6 +34,7 @@ struct GaussianSurface {
     int samples = 0;                  //!< training points n
     double chi2 = 0;  //!< squared Mahalanobis distance to the samples, sum ((h - f)/sigma)^2 [-]
     double aicc = 0;  //!< corrected Akaike criterion of this fit [-] (lower is better)
+    double bic = 0;   //!< Bayesian (Schwarz) criterion of this fit [-] (lower is better)
     double rmsResidual_m = 0;  //!< weighted RMS of (h - f) over the samples [m]
 
     /** Height of the surface at (i, j) [m], in support-area cells (fractional allowed). */
@@ -42,30 +43,45 @@ struct GaussianSurface {
     int parameters() const { return 1 + 5 * int(terms.size()); }
 };
 
+/** How the model size m is chosen. */
+enum class ModelCriterion {
+    AICc,  //!< corrected Akaike criterion (the paper's AIC; default)
+    BIC    //!< Bayesian criterion: a stronger penalty, k ln n instead of about 2 k
+};
+
 /** How eq 16 is fitted. */
 struct GaussianFitOptions {
-    int maxTerms = 4;             //!< largest m tried by the AIC search [-]
+    ModelCriterion criterion = ModelCriterion::AICc;  //!< how m is chosen
+    int maxTerms = 4;                                 //!< largest m tried by the AIC search [-]
     double minWidth_cells = 1.0;  //!< narrowest Gaussian, as a standard deviation [cells]
     /** Widest Gaussian, as a multiple of the support-area side [-] (wide terms act as slopes). */
     double maxWidthFactor = 2.0;
     ParticleSwarmOptions swarm;  //!< PSO settings for each m
+    /** Levenberg-Marquardt iterations that refine the swarm's best centres and widths (0: the
+     * swarm's answer as is) [-]. */
+    int polishIterations = 20;
 };
 
 /** Corrected Akaike criterion of a weighted least-squares fit with an unknown common scale of
  * the weights: n ln(chi2 / n) + 2 k + 2 k (k + 1) / (n - k - 1). Infinite if n <= k + 1. */
 double correctedAic(double chi2, int n, int k);
 
+/** Bayesian criterion of a weighted least-squares fit with an unknown common scale of the
+ * weights: n ln(chi2 / n) + k ln n. */
+double bayesianCriterion(double chi2, int n, int k);
+
 /** Fits eq 16 with exactly m Gaussians to samples on a side x side support area: amplitudes by
  * weighted linear least squares (Gram matrix, Eigen LDLT), centres and widths by particle
- * swarm minimising chi2. `seed` (may be empty) is a fit with m - 1 terms: the swarm then starts
- * from it plus one term at the largest residual. Throws std::invalid_argument on empty samples,
- * side < 2, a sample outside the area, m < 0 or a non-positive sigma. */
+ * swarm minimising chi2, then refined by Levenberg-Marquardt from the swarm's best. `seed` (may be
+ * empty) is a fit with m - 1 terms: the swarm then starts from it plus one term at the largest
+ * residual. Throws std::invalid_argument on empty samples, side < 2, a sample outside the area, m <
+ * 0 or a non-positive sigma. */
 GaussianSurface fitGaussianSurfaceFixed(const std::vector<SurfaceSample>& samples, int side, int m,
                                         const GaussianFitOptions& options,
                                         const GaussianSurface* seed = nullptr);
 
-/** Fits eq 16 choosing m = 0, 1, ... maxTerms by the corrected Akaike criterion: m grows while
- * the criterion improves (each fit seeded by the previous one) and the best fit is returned. */
+/** Fits eq 16 choosing m = 0, 1, ... maxTerms by options.criterion: m grows while the criterion
+ * improves (each fit seeded by the previous one) and the best fit is returned. */
 GaussianSurface fitGaussianSurface(const std::vector<SurfaceSample>& samples, int side,
                                    const GaussianFitOptions& options);
 
