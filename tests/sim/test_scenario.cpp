@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "Scenario.h"
+#include "sim_fixtures.h"
 
 namespace fs = std::filesystem;
 using namespace terrain_sim;
@@ -246,3 +247,43 @@ TEST_P(ShippedScenario, StockRawlogEditReadsIt) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Rawlogs, ShippedScenario, ::testing::Values("mockup", "walk"));
+
+// The pose errors follow the stated covariances: k frames after a correction, the error of each
+// pose parameter, normalised by the written sigma, has unit variance (chi-square over 2000
+// independent correction periods, 99.9 %), for k = 0 and for the last frame before a correction.
+// The mock-up's errors are independent draws from its constant covariance.
+TEST(TerrainSimTrajectory, PoseErrorsFollowTheWrittenCovariance) {
+    const Terrain t = Terrain::fromBoards({sim_test::flatBoard(11, 0.01, 0.0)}, 1, 1, 0.0);
+    TrajectoryOptions o;
+    o.walkSpeed_mps = 1e-6;
+    o.mockupStep_m = 1e-6;
+    o.maxFrames = 40000;
+    for (const bool walk : {true, false}) {
+        std::mt19937_64 rng(walk ? 17 : 18);
+        const auto frames = walk ? walkTrajectory(t, o, rng) : mockupTrajectory(t, o, rng);
+        ASSERT_EQ(frames.size(), 40000u);
+        const int period = walk ? 20 : 1;
+        for (const int k : {0, period - 1}) {
+            std::array<double, 6> chi2{};
+            size_t n = 0;
+            for (size_t f = k; f < frames.size(); f += period) {
+                const auto& e = frames[f].estimate;
+                const auto& p = frames[f].truth;
+                const double err[6] = {e.mean.x() - p.x(),         e.mean.y() - p.y(),
+                                       e.mean.z() - p.z(),         e.mean.yaw() - p.yaw(),
+                                       e.mean.pitch() - p.pitch(), e.mean.roll() - p.roll()};
+                for (int i = 0; i < 6; ++i) chi2[i] += err[i] * err[i] / e.cov(i, i);
+                ++n;
+            }
+            for (int i = 0; i < 6; ++i)
+                EXPECT_NEAR(chi2[i], double(n), 3.29 * std::sqrt(2.0 * n))
+                    << (walk ? "walk" : "mockup") << " k " << k << " param " << i;
+        }
+        if (walk) {  // the covariance grows between corrections, as stated
+            const auto m = walkErrorModel();
+            EXPECT_NEAR(frames[19].estimate.cov(0, 0),
+                        m.sigma0[0] * m.sigma0[0] + 19 * m.sigmaStep[0] * m.sigmaStep[0], 1e-15);
+            EXPECT_NEAR(frames[20].estimate.cov(0, 0), m.sigma0[0] * m.sigma0[0], 1e-15);
+        }
+    }
+}

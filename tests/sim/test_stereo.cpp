@@ -137,3 +137,36 @@ TEST(StereoSim, DisparityImageNoiseAndTexturelessBlobs) {
         EXPECT_LT(valid, size_t(0.05 * cfg.width_px * cfg.height_px));
     }
 }
+
+// Halos: next to a depth edge the background takes the foreground's disparity, within the halo
+// width, and only there.
+TEST(StereoSim, HalosFattenTheForegroundAtDepthEdges) {
+    // Textured ground with a 0.15 m high textured block in front of the camera.
+    auto low = sim_test::flatBoard(61, 0.01, 0.0), high = sim_test::flatBoard(61, 0.01, 0.15);
+    const Terrain t =
+        Terrain::fromBoards({low, low, low, low, high, low, low, low, low}, 3, 3, 0.0);
+    const SurfaceTexture tex(t, 4, 0);
+    StereoConfig cfg;
+    cfg.blobsPerFrame = 0;
+    const StereoSim stereo(cfg, t, tex);
+    std::mt19937_64 rng(8);
+    const StereoRender r = stereo.render(mrpt::poses::CPose3D(0.0, 0, 0, 0, 0, 0), rng);
+    size_t halo = 0;
+    for (int v = 0; v < cfg.height_px; ++v)
+        for (int u = 0; u < cfg.width_px; ++u) {
+            const uint16_t raw = r.disparity16.at<uint16_t>(v, u);
+            if (raw == 0) continue;
+            const double d = raw / 16.0, dt = r.trueDisparity.at<float>(v, u);
+            double dmax = dt;  // the nearest surface within the halo width
+            for (int k = std::max(0, u - cfg.haloWidth_px);
+                 k <= std::min(cfg.width_px - 1, u + cfg.haloWidth_px); ++k)
+                dmax = std::max(dmax, double(r.trueDisparity.at<float>(v, k)));
+            if (dmax - dt > cfg.haloJump_px) {
+                ++halo;  // background next to a nearer surface: takes the foreground's disparity
+                EXPECT_NEAR(d, dmax, 5 * cfg.matchingSigma_px) << u << "," << v;
+            } else {
+                EXPECT_NEAR(d, dt, 5 * cfg.matchingSigma_px) << u << "," << v;
+            }
+        }
+    EXPECT_GT(halo, 50u);
+}
