@@ -121,6 +121,15 @@ TEST(LaserModel, ThinObjectAndCleanEdgeAreKept) {
     opts.mixedPixelJump_m = 0.25;
     mixed = findMixedPixels(r, opts);
     EXPECT_FALSE(mixed[19] || mixed[20] || mixed[21]);
+    // Ground at a grazing angle: every step (5 cm) exceeds the jump, but the slope is steady.
+    std::vector<float> grazing(30);
+    for (size_t i = 0; i < grazing.size(); i++)
+        grazing[i] = 1.0f + 0.05f * float(i) + 0.001f * float(i * i);
+    for (bool m : findMixedPixels(grazing, LaserModelOptions())) EXPECT_FALSE(m);
+    // ... while a mixed beam at the far end of such a slope, against a wall behind, is found.
+    grazing[20] = grazing[19] + 0.5f;
+    for (size_t i = 21; i < grazing.size(); i++) grazing[i] = grazing[19] + 1.0f;
+    EXPECT_TRUE(findMixedPixels(grazing, LaserModelOptions())[20]);
     // Smooth ground (small steps) is one cluster.
     std::vector<float> ground(50);
     for (size_t i = 0; i < ground.size(); i++) ground[i] = 0.4f + 0.002f * float(i);

@@ -48,7 +48,16 @@ std::vector<bool> findMixedPixels(const std::vector<float>& ranges_m,
             for (size_t k = i; k < j; k++)
                 between = between && ranges_m[k] > lo + opts.mixedPixelJump_m &&
                           ranges_m[k] < hi - opts.mixedPixelJump_m;
-            if (between)
+            // A surface seen at a grazing angle has steps larger than the jump between every
+            // pair of beams, but a steady slope of range: a cluster that continues the trend of
+            // the two beams before it, or of the two after it, is a surface, not an edge.
+            const bool trendBefore =
+                i >= 2 && std::abs(ranges_m[i] - (2.0 * ranges_m[i - 1] - ranges_m[i - 2])) <=
+                              opts.mixedPixelJump_m;
+            const bool trendAfter =
+                j + 1 < n && std::abs(ranges_m[j - 1] - (2.0 * ranges_m[j] - ranges_m[j + 1])) <=
+                                 opts.mixedPixelJump_m;
+            if (between && !trendBefore && !trendAfter)
                 for (size_t k = i; k < j; k++) mixed[k] = true;
         }
         i = j;

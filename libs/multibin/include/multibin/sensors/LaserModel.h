@@ -35,8 +35,10 @@ double restoredIntensity(double rawIntensity, double agcVoltage);
  * `opts.mixedPixelJump_m` form a cluster; a cluster of at most `opts.mixedPixelMaxBeams` beams
  * whose ranges all lie strictly between the ranges of the beams just before and just after it
  * (no return counting as infinitely far) is a mixed measurement: the beam straddled a foreground
- * edge and the background. A small cluster nearer (or farther) than both neighbours is a thin
- * object and is kept. Returns one flag per beam, true = mixed. */
+ * edge and the background; unless the cluster continues the linear trend of the two beams
+ * before it or of the two beams after it (a surface seen at a grazing angle: large steps, steady
+ * slope). A small cluster nearer (or farther) than both neighbours is a thin object and is kept.
+ * Returns one flag per beam, true = mixed. */
 std::vector<bool> findMixedPixels(const std::vector<float>& ranges_m,
                                   const LaserModelOptions& opts);
 

@@ -1,0 +1,94 @@
+/* The sensor models on terrain-sim's mock-up scenario (rawlogs/mockup.*): the reader side of the
+ * sensor contract end to end, with the scenario's own ini (laser AGC, stereo calibration sigmas).
+ * Heights are compared with the ground truth; the figures printed here are quoted in
+ * doc/sensor-models.md. */
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "multibin/EsriAsciiGrid.h"
+
+namespace {
+const std::string kPrefix = MULTIBIN_SOURCE_DIR "/rawlogs/mockup";
+
+struct Outcome {
+    size_t cells = 0, within3Sigma = 0;
+    double sumSq = 0;
+    mrpt::maps::CMultiBinElevationMap::TInsertionOptions opts;
+    multibin::sensors::SensorModelStats stats;
+    multibin::InsertStats core;
+};
+
+Outcome run(const std::vector<std::string>& labels) {
+    mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
+    c.resolution_m = 0.015;
+    mrpt::maps::CMultiBinElevationMap map(c);
+    mrpt::config::CConfigFile ini(kPrefix + ".ini");
+    map.insertionOptions.loadFromConfigFile(
+        ini, "MappingApplication_multiBinElevationMap_00_insertOpts");
+    map.insertionOptions.sensor_labels = labels;
+    mrpt::maps::CSimpleMap sm;
+    mrpt::io::CFileGZInputStream f(kPrefix + ".simplemap");
+    mrpt::serialization::archiveFrom(f) >> sm;
+    map.insertSimpleMapWithPosePdfs(sm);
+
+    const auto gt = multibin::EsriAsciiGrid::load(kPrefix + "_gt.asc");
+    Outcome o;
+    o.opts = map.insertionOptions;
+    o.stats = map.sensorModelStats();
+    o.core = map.insertStats();
+    for (int r = 0; r < gt.rows(); r++)
+        for (int k = 0; k < gt.cols(); k++) {
+            const double x = gt.xllcenter_m + k * gt.cellsize_m,
+                         y = gt.yllcenter_m + r * gt.cellsize_m;
+            double h, s;
+            if (!std::isfinite(gt.heights_m(r, k)) || !map.getHeight(x, y, h, s)) continue;
+            const double e = h - gt.heights_m(r, k);
+            o.cells++;
+            o.sumSq += e * e;
+            if (std::abs(e) <= 3 * s) o.within3Sigma++;
+        }
+    std::printf("%-12s cells %6zu  RMSE %.4f m  within 3 sigma %.1f %%\n",
+                labels.empty() ? "LASER+STEREO" : labels[0].c_str(), o.cells,
+                std::sqrt(o.sumSq / double(o.cells)),
+                100.0 * double(o.within3Sigma) / double(o.cells));
+    return o;
+}
+}  // namespace
+
+TEST(SimMockup, ContractIniLoadsAndEverySensorPathInserts) {
+    const Outcome laser = run({"LASER"});
+    const auto& L = laser.stats.laser;
+    std::printf(
+        "laser: %zu beams, %zu kept, %zu no return, %zu low intensity, %zu mixed, "
+        "%zu continuity-rejected\n",
+        L.beams, L.kept, L.noReturn, L.lowIntensity, L.mixedPixel, laser.core.continuityRejected);
+    EXPECT_DOUBLE_EQ(laser.opts.sensors.laser.agcByLabel.at("LASER"), 512);
+    EXPECT_GT(L.kept, 10000u);
+    EXPECT_GT(L.lowIntensity, 0u);  // the scenario's dark patches
+    EXPECT_GT(L.mixedPixel, 0u);    // the simulator's mixed pixels at board edges
+    EXPECT_GT(laser.cells, 5000u);
+
+    const Outcome stereo = run({"STEREO"});
+    const auto& S = stereo.stats.stereo;
+    std::printf(
+        "stereo: %zu pairs, %zu table builds, %zu px visited, %zu kept, %zu no disparity, "
+        "%zu halo, %zu near-cluster, %zu too near\n",
+        S.pairs, S.tableBuilds, S.pixels, S.kept, S.noDisparity, S.halo, S.nearCluster, S.tooNear);
+    EXPECT_EQ(S.tableBuilds, 1u);  // one calibration: one table
+    EXPECT_GT(S.kept, 10000u);
+    EXPECT_GT(S.halo, 0u);
+    EXPECT_GT(stereo.cells, 5000u);
+
+    const Outcome both = run({});
+    EXPECT_GT(both.cells, laser.cells);
+    // Honest sigmas: most observed cells hold the truth within 3 sigma.
+    for (const Outcome* o : {&laser, &stereo, &both})
+        EXPECT_GT(double(o->within3Sigma) / double(o->cells), 0.8);
+}
