@@ -77,12 +77,29 @@ public:
     double cellSize_m() const { return m_cellSize_m; }
     const CellWindow& window() const { return m_window; }
     /** Index of the cell containing a coordinate [m]; clamped far outside any window, so
-     * absurd coordinates never overflow. */
+     * absurd coordinates never overflow (NaN gives the upper limit). */
     int cellIndex(double coord_m) const {
         constexpr double kLimit = std::numeric_limits<int>::max() / 4;
-        const double f = std::floor(coord_m * m_invCellSize);
-        if (std::isnan(f)) return static_cast<int>(kLimit);
-        return static_cast<int>(f < -kLimit ? -kLimit : (f > kLimit ? kLimit : f));
+        double f = coord_m * m_invCellSize;
+        if (!(f < kLimit)) f = kLimit;  // also NaN
+        if (f < -kLimit) f = -kLimit;
+        return floorToInt(f);
+    }
+    /** Vertical bin index of a height [m]: floor(height / binHeight); false if it does not fit
+     * the int16 bin index (or is NaN). */
+    static bool binIndexOf(double height_m, double binHeight_m, int16_t& n) {
+        const double q = height_m / binHeight_m;
+        if (!(q >= std::numeric_limits<int16_t>::min() &&
+              q < double(std::numeric_limits<int16_t>::max()) + 1.0))
+            return false;
+        n = static_cast<int16_t>(floorToInt(q));
+        return true;
+    }
+    /** floor(v) for finite |v| < 2^31, without a libm call (baseline x86-64 has no SSE4.1
+     * rounding instruction). */
+    static int floorToInt(double v) {
+        const int t = static_cast<int>(v);  // truncates towards zero
+        return t - (v < double(t) ? 1 : 0);
     }
     double cellCenter_m(int index) const { return (index + 0.5) * m_cellSize_m; }
 
@@ -142,7 +159,9 @@ public:
     void beginCycle();
     const std::vector<UpdatedCell>& updatedCells() const { return m_updated; }
     bool updatedThisCycle(int ix, int iy) const {
-        return m_window.contains(ix, iy) && m_stamp[slot(ix, iy)] == m_cycle;
+        if (!m_window.contains(ix, iy)) return false;
+        const uint32_t k = m_updatedIndex[slot(ix, iy)];
+        return k < m_updated.size() && m_updated[k].ix == ix && m_updated[k].iy == iy;
     }
     /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
     double maxHeight_m() const { return m_maxHeight_m; }
@@ -155,9 +174,13 @@ public:
 
     /** Number of bins in use, over all cells. */
     size_t binCount() const { return m_pool.size() - m_freeCount; }
-    /** Memory held by the grid [bytes]: cell heads plus the bin pool. */
+    /** Memory held by the grid [bytes]: per cell of the window a bin-chain head and an
+     * update-cycle index (8 B), the bin pool (24 B per bin, with the vector's spare capacity)
+     * and the list of cells updated in the current cycle. Independent of the vertical extent. */
     size_t memoryBytes() const {
-        return m_heads.capacity() * sizeof(uint32_t) + m_pool.capacity() * sizeof(Bin);
+        return m_heads.capacity() * sizeof(uint32_t) +
+               m_updatedIndex.capacity() * sizeof(uint32_t) + m_pool.capacity() * sizeof(Bin) +
+               m_updated.capacity() * sizeof(UpdatedCell);
     }
     bool empty() const { return binCount() == 0; }
 
@@ -170,15 +193,33 @@ private:
     /** Storage slot of a cell inside the window: (ix mod nx) + (iy mod ny) nx, computed from the
      * window origin's residues without a division. */
     size_t slot(int ix, int iy) const {
-        int sx = ix - m_window.ix0 + m_originSlotX, sy = iy - m_window.iy0 + m_originSlotY;
-        if (sx >= m_window.nx) sx -= m_window.nx;
-        if (sy >= m_window.ny) sy -= m_window.ny;
-        return size_t(sx) + size_t(sy) * size_t(m_window.nx);
+        return slotIn(m_window, m_originSlotX, m_originSlotY, ix, iy);
     }
+    static size_t slotIn(const CellWindow& w, int originSlotX, int originSlotY, int ix, int iy) {
+        int sx = ix - w.ix0 + originSlotX, sy = iy - w.iy0 + originSlotY;
+        if (sx >= w.nx) sx -= w.nx;
+        if (sy >= w.ny) sy -= w.ny;
+        return size_t(sx) + size_t(sy) * size_t(w.nx);
+    }
+    /** d mod n in [0, n) for n > 0; no division for |d| < 2n (every overlapping move). */
+    static int wrap(int d, int n) {
+        if (d >= n) d -= n;
+        if (d < 0) d += n;
+        return d >= 0 && d < n ? d : ((d % n) + n) % n;
+    }
+    /** i mod n in [0, n) (0 for an empty axis). */
+    static int residue(int i, int n) { return n > 0 ? ((i % n) + n) % n : 0; }
     void setWindow(const CellWindow& w);
     uint32_t allocateBin();
     void releaseChain(uint32_t head);
-    void noteUpdate(size_t slot, int ix, int iy, double height_m);
+    /** The bin of index n in the cell at `slot`, appended to its chain if missing. */
+    uint32_t findOrAddBin(size_t slot, int16_t n);
+    /** Records `points` accepted points into cell (ix, iy), the highest at `height_m` [m]. */
+    void noteUpdate(size_t slot, int ix, int iy, double height_m, uint32_t points);
+    /** Gates 13 and bin range passed: eq 14 and the per-point Kalman update (eq 15). */
+    bool fuseMeasurement(size_t slot, int ix, int iy, int16_t n, double height_m,
+                         double variance_m2, const BinUpdateParams& params,
+                         double continuityBound_m, InsertStats& stats);
 
     double m_cellSize_m;
     double m_invCellSize = 1.0;  //!< 1 / cell size [1/m]
@@ -186,10 +227,11 @@ private:
     int m_originSlotX = 0, m_originSlotY = 0;  //!< ix0 mod nx, iy0 mod ny
     std::vector<uint32_t> m_heads;             //!< per slot: first bin of the cell or kNoBin
     std::vector<Bin> m_pool;                   //!< all bins; free ones are chained from m_freeHead
-    std::vector<uint32_t> m_stamp;             //!< per slot: the cycle that last updated the cell
-    std::vector<uint32_t> m_updatedIndex;      //!< per slot: index into m_updated, this cycle
+    /** Cells updated in this cycle as a sparse set: the cell at a slot was updated iff
+     * m_updatedIndex[slot] indexes an entry of m_updated naming that cell, so starting a cycle
+     * or moving the window needs no per-cell clearing. */
+    std::vector<uint32_t> m_updatedIndex;
     std::vector<UpdatedCell> m_updated;
-    uint32_t m_cycle = 1;
     double m_maxHeight_m = -std::numeric_limits<double>::infinity();
     uint32_t m_freeHead = kNoBin;
     size_t m_freeCount = 0;
@@ -210,19 +252,21 @@ void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
     // window, not in the old one) and clearing the leaver stored there does all the work.
     const bool disjoint = ix0 >= oldW.ix0 + oldW.nx || ix0 + oldW.nx <= oldW.ix0 ||
                           iy0 >= oldW.iy0 + oldW.ny || iy0 + oldW.ny <= oldW.iy0;
+    const int newOriginX = residue(ix0, newW.nx), newOriginY = residue(iy0, newW.ny);
     auto leaverOf = [&](int ix, int iy, int& lx, int& ly) {
         // The old-window cell sharing this slot.
-        lx = oldW.ix0 + (((ix - oldW.ix0) % oldW.nx) + oldW.nx) % oldW.nx;
-        ly = oldW.iy0 + (((iy - oldW.iy0) % oldW.ny) + oldW.ny) % oldW.ny;
+        lx = oldW.ix0 + wrap(ix - oldW.ix0, oldW.nx);
+        ly = oldW.iy0 + wrap(iy - oldW.iy0, oldW.ny);
     };
     auto handleEntering = [&](int ix, int iy) {
+        // The entering cell's slot in the new window is the leaver's slot in the old one.
+        const size_t s = slotIn(newW, newOriginX, newOriginY, ix, iy);
+        if (m_heads[s] == kNoBin) return;
         int lx, ly;
         leaverOf(ix, iy, lx, ly);
-        m_stamp[slot(lx, ly)] = 0;
-        if (m_heads[slot(lx, ly)] != kNoBin) {
-            onLeave(lx, ly);
-            clearCell(lx, ly);
-        }
+        onLeave(lx, ly);
+        releaseChain(m_heads[s]);
+        m_heads[s] = kNoBin;
     };
     if (disjoint) {
         for (int iy = iy0; iy < iy0 + oldW.ny; iy++)

@@ -20,8 +20,12 @@ namespace multibin {
  * (rigid, calibrated off-line); C_S the point's covariance in the sensor frame.
  *
  * J_R = [I_3 | dRot/dyaw p_r, dRot/dpitch p_r, dRot/droll p_r] with p_r the point in the robot
- * frame, so the per-point cost is a few 3x3 products: the rotation derivatives are computed once
- * per pose. */
+ * frame. J_R is affine in the sensor-frame point, so every entry of J_R C_R J_R^T is a quadratic
+ * polynomial in (x, y, z) of the sensor-frame point, and every entry of J_S C_S J_S^T (J_S the
+ * sensor-to-map rotation) is linear in the six entries of C_S. The constructor folds the pose, its
+ * covariance and the sensor pose into those polynomial coefficients (in double); per point what
+ * is left is about a hundred single-precision multiply-adds, evaluated over blocks of points in
+ * structure-of-arrays form so the compiler vectorises them. */
 class PosePropagator {
 public:
     PosePropagator(const mrpt::poses::CPose3DPDFGaussian& robotPoseInMap,
@@ -30,8 +34,12 @@ public:
     /** One point; `in.cov_m2` is the sensor-frame covariance. */
     PointWithCov apply(const PointWithCov& in) const;
 
-    /** A batch; `out` is resized to match `in`. */
+    /** A batch; `out` is resized to match `in` (no allocation once it has the capacity). */
     void apply(const PointsWithCov& in, PointsWithCov& out) const;
+
+    /** A batch from `in[0 .. n)` into `out[0 .. n)`; the ranges may be the same (in place) but
+     * must not otherwise overlap. */
+    void apply(const PointWithCov* in, PointWithCov* out, size_t n) const;
 
     /** d p_map / d (x, y, z, yaw, pitch, roll) of the robot pose, at a point given in the robot
      * frame [m]. */
@@ -40,16 +48,22 @@ public:
     /** Sensor origin in the map frame [m]. */
     const Eigen::Vector3d& sensorOriginInMap_m() const { return m_sensorOrigin_m; }
 
+    /** Coefficients of the per-point evaluation (single precision), public for the kernel. */
+    struct Coefficients {
+        float rot[9];    //!< sensor-to-map rotation, row-major
+        float trans[3];  //!< sensor origin in the map [m]
+        /** Per covariance entry (xx, xy, xz, yy, yz, zz) of J_R C_R J_R^T: coefficients of the
+         * monomials 1, x, y, z, xx, xy, xz, yy, yz, zz of the sensor-frame point [m^2 / m^k]. */
+        float robot[6][10];
+        /** Per covariance entry of J_S C_S J_S^T: coefficients of the six sensor-frame
+         * covariance entries (xx, xy, xz, yy, yz, zz) [1]. */
+        float sensor[6][6];
+    };
+
 private:
-    Eigen::Matrix3d m_rotSensorToRobot, m_rotSensorToMap, m_rotRobotToMap;
-    Eigen::Vector3d m_tSensorOnRobot_m, m_tRobot_m, m_sensorOrigin_m;
+    Eigen::Vector3d m_sensorOrigin_m;
     Eigen::Matrix3d m_dRot[3];  //!< dRot/dyaw, dRot/dpitch, dRot/droll of the robot pose
-    Eigen::Matrix3d m_covTT, m_covTA, m_covAA;  //!< blocks of C_R: translation / angles
-    // Single-precision copies for the per-point work (covariances need no more).
-    Eigen::Matrix3f m_rotSensorToRobotF, m_rotRobotToMapF, m_rotSensorToMapF, m_covTTF, m_covATF,
-        m_covAAF;
-    Eigen::Vector3f m_tSensorOnRobotF, m_tRobotF;
-    Eigen::Matrix3f m_dRotF[3];
+    Coefficients m_k;
 };
 
 }  // namespace multibin

@@ -16,6 +16,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     auto conflictMargin = [&](const Bin& b) {
         return vis.margin_m + 3.0 * BinGrid::sigma_m(b, binParams);
     };
+    // The smallest conflict margin any bin can have (its variance at the floor), computed the
+    // same way: a bin no higher than this above the line is kept without the square root.
+    const double minConflictMargin = conflictMargin(Bin{});
+    auto conflicts = [&](const Bin& b, double lineHeight_m) {
+        const double above = b.height_m - lineHeight_m;
+        return above > minConflictMargin && above > conflictMargin(b);
+    };
 
     for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
         const Bin* winner = grid.winningBin(u.ix, u.iy);
@@ -25,7 +32,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
 
         // Bins of the updated cell above all that was measured in it now.
         grid.editBins(u.ix, u.iy, [&](Bin& b) {
-            if (b.height_m - tz <= conflictMargin(b)) return true;
+            if (!conflicts(b, tz)) return true;
             b.certainty -= decrement;
             stats.binsWeakened++;
             if (b.certainty > 0) return true;
@@ -42,12 +49,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const double slope = (sensor_m.z() - tz) / length;  // ray height gained per metre back
         // The ray's highest point within a cell lies at most half a diagonal from a sample.
         const double inCellRise = std::abs(slope) * 0.7072 * cell;
+        const double ux = dx / length, uy = dy / length;  // unit direction towards the sensor
         int lastIx = u.ix, lastIy = u.iy;
         for (double d = step; d < length; d += step) {
             const double rayZ = tz + slope * d;
             if (slope > 0 && rayZ - inCellRise > maxStoredHeight + vis.margin_m) break;
-            const int ix = grid.cellIndex(tx + dx * d / length);
-            const int iy = grid.cellIndex(ty + dy * d / length);
+            const int ix = grid.cellIndex(tx + ux * d);
+            const int iy = grid.cellIndex(ty + uy * d);
             if (ix == lastIx && iy == lastIy) continue;
             lastIx = ix;
             lastIy = iy;
@@ -55,7 +63,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             stats.cellsVisited++;
             const double rayHigh = rayZ + inCellRise;
             grid.editBins(ix, iy, [&](Bin& b) {
-                if (b.height_m - rayHigh <= conflictMargin(b)) return true;
+                if (!conflicts(b, rayHigh)) return true;
                 if (b.certainty < targetCertainty) {
                     stats.binsRemoved++;
                     return false;
