@@ -76,6 +76,7 @@ ScenarioSummary runScenario(const ScenarioConfig& cfg) {
     std::vector<multibin::EsriAsciiGrid> boards;
     for (const auto& f : cfg.terrainFiles) boards.push_back(multibin::EsriAsciiGrid::load(f));
     const Terrain terrain = Terrain::fromBoards(boards, cfg.tilesX, cfg.tilesY, cfg.margin_m);
+    const multibin::EsriAsciiGrid groundTruth = terrain.groundTruth(cfg.gtCell_m);  // fail early
     const SurfaceTexture texture(terrain, cfg.seed, cfg.darkPatches);
     const LaserSim laser(cfg.laser, terrain, texture, cfg.seed);
     const StereoSim stereo(cfg.stereo, terrain, texture);
@@ -150,7 +151,7 @@ ScenarioSummary runScenario(const ScenarioConfig& cfg) {
         a << simplemap;
     }
     sum.files.push_back(smPath);
-    terrain.groundTruth(cfg.gtCell_m).save(cfg.outPrefix + "_gt.asc");
+    groundTruth.save(cfg.outPrefix + "_gt.asc");
     sum.files.push_back(cfg.outPrefix + "_gt.asc");
     writeText(cfg.outPrefix + ".ini", mapperIni(cfg));
     sum.files.push_back(cfg.outPrefix + ".ini");

@@ -257,7 +257,9 @@ multibin::EsriAsciiGrid Terrain::groundTruth(double cell_m) const {
     const int i1 = static_cast<int>(std::floor(xMax_m() / cell_m + 1e-9));  // exclusive
     const int j0 = static_cast<int>(std::ceil(y0_ / cell_m - 1e-9));
     const int j1 = static_cast<int>(std::floor(yMax_m() / cell_m + 1e-9));
-    if (i1 <= i0 || j1 <= j0) throw std::invalid_argument("ground truth: cell larger than terrain");
+    if (i1 <= i0 || j1 <= j0)
+        throw std::invalid_argument("ground-truth cell size " + std::to_string(cell_m) +
+                                    " m is larger than the terrain");
     Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(j1 - j0, i1 - i0);
     Eigen::MatrixXi count = Eigen::MatrixXi::Zero(j1 - j0, i1 - i0);
     for (int r = 0; r < h_.rows(); ++r) {

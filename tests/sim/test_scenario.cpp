@@ -196,6 +196,9 @@ TEST(TerrainSimCli, BadArgumentsGiveOneLineErrorAndExit1) {
         {"--terrain " + board + " --tiles 3y3 --scenario walk --out x", "--tiles"},
         {"--terrain " + board + " --scenario walk --seed -4 --out x", "--seed"},
         {"--terrain " + board + " --scenario walk --bogus 1 --out x", "unknown option"},
+        {"--terrain " + board + " --scenario walk --gt-cell 5 --out " + (d / "g").string(),
+         "larger than the terrain"},
+        {"--terrain " + board + " --scenario walk --out /nonexistent/dir/x", "cannot write"},
     };
     for (const auto& [args, expect] : cases) {
         std::string out;
