@@ -328,6 +328,29 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
     const int ex = std::min(sx + side, r.nx), ey = std::min(sy + side, r.ny);
 
     // Training points: measured cells of the area, the ones nearest the gap first if capped.
+    // Distance to the gap itself (multi-source breadth-first search, 8-neighbour steps), not to
+    // its bounding box: for a long or L-shaped gap the box says little.
+    const int bw = ex - sx, bh = ey - sy;
+    std::vector<int> gapDist(size_t(bw) * size_t(bh), -1);
+    std::vector<int> queue;
+    queue.reserve(gapDist.size());
+    for (int k : cells) {
+        const size_t b = size_t(k / r.nx - sy) * size_t(bw) + size_t(k % r.nx - sx);
+        gapDist[b] = 0;
+        queue.push_back(int(b));
+    }
+    for (size_t head = 0; head < queue.size(); head++) {
+        const int b = queue[head], bx = b % bw, by = b / bw;
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++) {
+                const int nx = bx + dx, ny = by + dy;
+                if (nx < 0 || ny < 0 || nx >= bw || ny >= bh) continue;
+                const size_t nb = size_t(ny) * size_t(bw) + size_t(nx);
+                if (gapDist[nb] >= 0) continue;
+                gapDist[nb] = gapDist[size_t(b)] + 1;
+                queue.push_back(int(nb));
+            }
+    }
     struct Cand {
         SurfaceSample s;
         int gapDist;
@@ -337,10 +360,8 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
         for (int ix = sx; ix < ex; ix++) {
             const size_t k = r.index(ix, iy);
             if (!r.isMeasured(k)) continue;
-            const int dx = ix < x0 ? x0 - ix : (ix > x1 ? ix - x1 : 0);
-            const int dy = iy < y0 ? y0 - iy : (iy > y1 ? iy - y1 : 0);
-            cand.push_back(
-                {SurfaceSample{ix - sx, iy - sy, r.height_m[k], r.sigma_m[k]}, std::max(dx, dy)});
+            cand.push_back({SurfaceSample{ix - sx, iy - sy, r.height_m[k], r.sigma_m[k]},
+                            gapDist[size_t(iy - sy) * size_t(bw) + size_t(ix - sx)]});
         }
     if (int(cand.size()) > o.maxTrainingPoints) {
         std::stable_sort(cand.begin(), cand.end(),
