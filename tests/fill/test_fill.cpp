@@ -302,6 +302,29 @@ TEST(FillGaps, SigmaGrowsTowardsTheMiddleOfAGap) {
     EXPECT_LT(f.sigma_m[f.index(14, 18)], f.sigma_m[f.index(18, 18)]);
 }
 
+TEST(FillGaps, CappedTrainingPointsHugALongGap) {
+    // An L-shaped gap (two 4 x 40 strips) whose square support area covers most of the raster,
+    // with training points capped at 200: they must be the cells along the gap, including those
+    // beside the hill that the vertical strip climbs, not the first 200 of the area.
+    auto hill = [](int ix, int iy) {
+        return 0.02 + 0.04 * std::exp(-((ix - 50.0) * (ix - 50.0) + (iy - 40.0) * (iy - 40.0)) /
+                                      (2 * 64.0));
+    };
+    auto r = rasterFrom(60, hill, 0.001f);
+    hide(r, 10, 10, 40, 4);
+    hide(r, 46, 14, 4, 36);
+    FillOptions o;
+    o.maxTrainingPoints = 200;
+    o.residualCorrection = false;  // judge the fitted surface alone
+    const auto f = fillGaps(r, o);
+    ASSERT_EQ(f.stats.gaussian, 160 + 144);
+    double worst = 0;
+    for (int iy = 14; iy < 50; iy++)
+        for (int ix = 46; ix < 50; ix++)
+            worst = std::max(worst, std::abs(f.height_m[f.index(ix, iy)] - hill(ix, iy)));
+    EXPECT_LT(worst, 0.005);
+}
+
 TEST(FillGaps, RejectsInconsistentRaster) {
     HeightRaster r(4, 4, 0.015);
     r.sigma_m.pop_back();
