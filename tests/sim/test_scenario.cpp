@@ -106,10 +106,13 @@ Counts checkRawlogLayout(const std::string& path) {
     return c;
 }
 
+/** Runs a shell command, its stdout and stderr captured in the build tree. */
 int run(const std::string& cmd, std::string* out = nullptr) {
-    const std::string full = cmd + " > rawlog_tool_out.txt 2>&1";
+    const fs::path log = fs::path(MULTIBIN_BINARY_DIR) / "test_sim_tmp" / "command_output.txt";
+    fs::create_directories(log.parent_path());
+    const std::string full = cmd + " > " + log.string() + " 2>&1";
     const int rc = std::system(full.c_str());
-    if (out) *out = readBytes("rawlog_tool_out.txt");
+    if (out) *out = readBytes(log.string());
     return rc;
 }
 
