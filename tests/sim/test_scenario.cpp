@@ -10,6 +10,7 @@
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -108,7 +109,11 @@ Counts checkRawlogLayout(const std::string& path) {
 
 /** Runs a shell command, its stdout and stderr captured in the build tree. */
 int run(const std::string& cmd, std::string* out = nullptr) {
-    const fs::path log = fs::path(MULTIBIN_BINARY_DIR) / "test_sim_tmp" / "command_output.txt";
+    // One file per test: ctest may run the tests in parallel.
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = std::string(info->test_suite_name()) + "." + info->name() + ".txt";
+    std::replace(name.begin(), name.end(), '/', '_');
+    const fs::path log = fs::path(MULTIBIN_BINARY_DIR) / "test_sim_tmp" / name;
     fs::create_directories(log.parent_path());
     const std::string full = cmd + " > " + log.string() + " 2>&1";
     const int rc = std::system(full.c_str());
