@@ -150,12 +150,18 @@ public:
             if (!m_r.inside(x, y)) continue;
             const size_t k = m_r.index(x, y);
             if (!usable[k]) continue;
-            m_vals.push_back({out.height_m[k], out.sigma_m[k], o.w});
+            // Insertion into a sorted list: at most window^2 - 1 values, cheaper than a sort.
+            const Sample v{out.height_m[k], out.sigma_m[k], float(o.w)};
+            size_t at = m_vals.size();
+            m_vals.push_back(v);
+            while (at > 0 && m_vals[at - 1].h > v.h) {
+                m_vals[at] = m_vals[at - 1];
+                at--;
+            }
+            m_vals[at] = v;
             wSum += o.w;
         }
         if (int(m_vals.size()) < m_o.medianMinKnown) return false;
-        std::sort(m_vals.begin(), m_vals.end(),
-                  [](const Sample& a, const Sample& b) { return a.h < b.h; });
         double acc = 0, med = m_vals.back().h;
         for (const auto& s : m_vals) {
             acc += s.w;
@@ -217,7 +223,7 @@ private:
         double w;
     };
     struct Sample {
-        double h, s, w;
+        float h, s, w;  // height [m], sigma [m], skeleton weight [cells]
     };
     const HeightRaster& m_r;
     const FillOptions& m_o;
