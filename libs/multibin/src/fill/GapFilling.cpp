@@ -137,7 +137,10 @@ public:
         const int half = o.medianWindow_cells / 2;
         for (int dj = -half; dj <= half; dj++)
             for (int di = -half; di <= half; di++)
-                if (di || dj) m_offsets.push_back({di, dj, medianSkeletonWeight(di, dj)});
+                if (di || dj)
+                    m_offsets.push_back(
+                        {di, dj, dj * std::ptrdiff_t(r.nx) + di, medianSkeletonWeight(di, dj)});
+        m_half = half;
     }
 
     /** Fills cell (ix, iy) of `out` from the cells of `out` flagged in `usable`; false (and the
@@ -145,10 +148,13 @@ public:
     bool fillCell(int ix, int iy, FillResult& out, const std::vector<char>& usable) {
         m_vals.clear();
         double wSum = 0;
+        // Away from the border the whole window is inside: no per-neighbour bounds check.
+        const bool interior =
+            ix >= m_half && iy >= m_half && ix < m_r.nx - m_half && iy < m_r.ny - m_half;
+        const std::ptrdiff_t centre = std::ptrdiff_t(m_r.index(ix, iy));
         for (const auto& o : m_offsets) {
-            const int x = ix + o.di, y = iy + o.dj;
-            if (!m_r.inside(x, y)) continue;
-            const size_t k = m_r.index(x, y);
+            if (!interior && !m_r.inside(ix + o.di, iy + o.dj)) continue;
+            const size_t k = size_t(centre + o.linear);
             if (!usable[k]) continue;
             // Insertion into a sorted list: at most window^2 - 1 values, cheaper than a sort.
             const Sample v{out.height_m[k], out.sigma_m[k], float(o.w)};
@@ -220,8 +226,10 @@ public:
 private:
     struct Offset {
         int di, dj;
+        std::ptrdiff_t linear;  // di + dj * nx
         double w;
     };
+    int m_half = 2;
     struct Sample {
         float h, s, w;  // height [m], sigma [m], skeleton weight [cells]
     };
