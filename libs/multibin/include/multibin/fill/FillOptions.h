@@ -46,8 +46,8 @@ struct FillOptions {
      * Unfilled: beyond the sensors' reach there is nothing to interpolate from [cells]. */
     int maxGapCells = 2500;
     int supportMargin_cells = 4;  //!< [fill_support_margin] margin of the square support [cells]
-    /** [fill_max_training_points] known cells used per support area at most (regular
-     * subsampling beyond it, to bound the fitting time) [-]. */
+    /** [fill_max_training_points] measured cells used per support area at most: beyond it, the
+     * ones nearest the gap are kept (bounds the fitting time) [-]. */
     int maxTrainingPoints = 600;
     /** [fill_residual_correction] beyond the paper: add to the fitted surface the residuals of
      * the rim cells, carried into the gap as a harmonic function, so the fill meets the rim. */
