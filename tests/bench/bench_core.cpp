@@ -205,7 +205,7 @@ static void BM_VisibilityShare(benchmark::State& state) {
         sensor = Eigen::Vector3d(0, 0, 0.26);
     }
     double tUpdate = 0, tVis = 0;
-    size_t cells = 0;
+    size_t cells = 0, cellsVisited = 0;
     for (auto _ : state) {
         if (!frame)
             for (auto& p : pts) p.point_m.z() = 0.02f + noise(rng);
@@ -213,14 +213,17 @@ static void BM_VisibilityShare(benchmark::State& state) {
         grid.beginCycle();
         benchmark::DoNotOptimize(grid.insertPoints(pts, params));
         const auto t1 = Clock::now();
-        benchmark::DoNotOptimize(applyVisibilityConstraint(grid, sensor, vis, params));
+        const VisibilityStats vs = applyVisibilityConstraint(grid, sensor, vis, params);
         const auto t2 = Clock::now();
+        cellsVisited = vs.cellsVisited;
         tUpdate += seconds(t0, t1);
         tVis += seconds(t1, t2);
         cells = grid.updatedCells().size();
     }
     state.counters["points"] = double(pts.size());
     state.counters["updated_cells"] = double(cells);
+    state.counters["cells_visited"] = double(cellsVisited);
+    state.counters["max_height_m"] = grid.maxHeight_m();
     state.counters["visibility_us"] = 1e6 * tVis / double(state.iterations());
     state.counters["bin_update_us"] = 1e6 * tUpdate / double(state.iterations());
     state.counters["visibility_share"] = tVis / (tUpdate + tVis);

@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -67,7 +68,8 @@ struct CellWindow {
  *
  * Storage is a circular buffer over the cell window (grid_map style): cell (ix, iy) lives in slot
  * (ix mod nx) + (iy mod ny) nx, so moving the window only clears the slots of the cells that enter,
- * and growing it re-slots the cell heads without touching any bin. */
+ * and growing it re-slots the cell heads without touching any bin. Memory: 12 B per cell of the
+ * window (chain head, update-cycle stamp and index) and 24 B per bin. */
 class BinGrid {
 public:
     static constexpr uint32_t kNoBin = std::numeric_limits<uint32_t>::max();
@@ -139,7 +141,7 @@ public:
     template <typename F>
     void forEachBin(int ix, int iy, F&& f) const {
         if (!m_window.contains(ix, iy)) return;
-        for (uint32_t b = m_heads[slot(ix, iy)]; b != kNoBin; b = m_pool[b].next) f(m_pool[b]);
+        for (uint32_t b = m_cells[slot(ix, iy)].head; b != kNoBin; b = m_pool[b].next) f(m_pool[b]);
     }
 
     /** Calls f(Bin&) for every bin of the cell; a bin for which f returns false is removed.
@@ -160,8 +162,7 @@ public:
     const std::vector<UpdatedCell>& updatedCells() const { return m_updated; }
     bool updatedThisCycle(int ix, int iy) const {
         if (!m_window.contains(ix, iy)) return false;
-        const uint32_t k = m_updatedIndex[slot(ix, iy)];
-        return k < m_updated.size() && m_updated[k].ix == ix && m_updated[k].iy == iy;
+        return m_cells[slot(ix, iy)].cycle == m_cycle;
     }
     /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
     double maxHeight_m() const { return m_maxHeight_m; }
@@ -178,8 +179,7 @@ public:
      * update-cycle index (8 B), the bin pool (24 B per bin, with the vector's spare capacity)
      * and the list of cells updated in the current cycle. Independent of the vertical extent. */
     size_t memoryBytes() const {
-        return m_heads.capacity() * sizeof(uint32_t) +
-               m_updatedIndex.capacity() * sizeof(uint32_t) + m_pool.capacity() * sizeof(Bin) +
+        return m_cells.capacity() * sizeof(CellSlot) + m_pool.capacity() * sizeof(Bin) +
                m_updated.capacity() * sizeof(UpdatedCell);
     }
     bool empty() const { return binCount() == 0; }
@@ -225,17 +225,50 @@ private:
     double m_invCellSize = 1.0;  //!< 1 / cell size [1/m]
     CellWindow m_window;
     int m_originSlotX = 0, m_originSlotY = 0;  //!< ix0 mod nx, iy0 mod ny
-    std::vector<uint32_t> m_heads;             //!< per slot: first bin of the cell or kNoBin
-    std::vector<Bin> m_pool;                   //!< all bins; free ones are chained from m_freeHead
-    /** Cells updated in this cycle as a sparse set: the cell at a slot was updated iff
-     * m_updatedIndex[slot] indexes an entry of m_updated naming that cell, so starting a cycle
-     * or moving the window needs no per-cell clearing. */
-    std::vector<uint32_t> m_updatedIndex;
-    std::vector<UpdatedCell> m_updated;
+    /** Everything kept per cell, together so one cache line serves a cell's every test. */
+    struct CellSlot {
+        uint32_t head = kNoBin;     //!< first bin of the cell, or kNoBin
+        uint32_t cycle = 0;         //!< the update cycle that last updated the cell
+        uint32_t updatedIndex = 0;  //!< its entry in m_updated, valid in that cycle
+    };
+    std::vector<CellSlot> m_cells;       //!< per slot
+    std::vector<Bin> m_pool;             //!< all bins; free ones are chained from m_freeHead
+    std::vector<UpdatedCell> m_updated;  //!< cells updated in this cycle, in first-update order
+    uint32_t m_cycle = 1;
     double m_maxHeight_m = -std::numeric_limits<double>::infinity();
     uint32_t m_freeHead = kNoBin;
     size_t m_freeCount = 0;
 };
+
+// Inline: called per run of points; out of line they would go through the PLT.
+inline void BinGrid::noteUpdate(size_t s, int ix, int iy, double height_m, uint32_t points) {
+    m_maxHeight_m = std::max(m_maxHeight_m, height_m);
+    CellSlot& cs = m_cells[s];
+    if (cs.cycle == m_cycle) {
+        UpdatedCell& u = m_updated[cs.updatedIndex];
+        u.maxHeight_m = std::max(u.maxHeight_m, float(height_m));
+        u.points += points;
+    } else {
+        cs.cycle = m_cycle;
+        cs.updatedIndex = static_cast<uint32_t>(m_updated.size());
+        m_updated.push_back({ix, iy, float(height_m), points});
+    }
+}
+
+inline uint32_t BinGrid::findOrAddBin(size_t s, int16_t n) {
+    uint32_t prev = kNoBin, b = m_cells[s].head;
+    while (b != kNoBin && m_pool[b].index != n) {
+        prev = b;
+        b = m_pool[b].next;
+    }
+    if (b == kNoBin) {
+        b = allocateBin();  // may reallocate the pool: hold indices, not pointers
+        m_pool[b].index = n;
+        m_pool[b].next = kNoBin;
+        (prev == kNoBin ? m_cells[s].head : m_pool[prev].next) = b;
+    }
+    return b;
+}
 
 template <typename OnLeave>
 void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
@@ -261,12 +294,13 @@ void BinGrid::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
     auto handleEntering = [&](int ix, int iy) {
         // The entering cell's slot in the new window is the leaver's slot in the old one.
         const size_t s = slotIn(newW, newOriginX, newOriginY, ix, iy);
-        if (m_heads[s] == kNoBin) return;
+        m_cells[s].cycle = 0;  // the entering cell was not updated in this cycle
+        if (m_cells[s].head == kNoBin) return;
         int lx, ly;
         leaverOf(ix, iy, lx, ly);
         onLeave(lx, ly);
-        releaseChain(m_heads[s]);
-        m_heads[s] = kNoBin;
+        releaseChain(m_cells[s].head);
+        m_cells[s].head = kNoBin;
     };
     if (disjoint) {
         for (int iy = iy0; iy < iy0 + oldW.ny; iy++)
@@ -291,13 +325,13 @@ size_t BinGrid::editBins(int ix, int iy, F&& f) {
     if (!m_window.contains(ix, iy)) return 0;
     size_t removed = 0;
     const size_t s = slot(ix, iy);
-    uint32_t prev = kNoBin, b = m_heads[s];
+    uint32_t prev = kNoBin, b = m_cells[s].head;
     while (b != kNoBin) {
         const uint32_t next = m_pool[b].next;
         if (f(m_pool[b])) {
             prev = b;
         } else {
-            (prev == kNoBin ? m_heads[s] : m_pool[prev].next) = next;
+            (prev == kNoBin ? m_cells[s].head : m_pool[prev].next) = next;
             m_pool[b].next = m_freeHead;
             m_freeHead = b;
             m_freeCount++;

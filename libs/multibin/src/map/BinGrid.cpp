@@ -30,8 +30,7 @@ void BinGrid::reset(double cellSize_m, const CellWindow& window) {
     m_cellSize_m = cellSize_m;
     m_invCellSize = 1.0 / cellSize_m;
     setWindow(window);
-    m_heads.assign(window.cellCount(), kNoBin);
-    m_updatedIndex.assign(window.cellCount(), 0);
+    m_cells.assign(window.cellCount(), CellSlot{});
     m_updated.clear();
     m_maxHeight_m = -std::numeric_limits<double>::infinity();
     m_pool.clear();
@@ -51,21 +50,21 @@ void BinGrid::growToInclude(const CellWindow& w) {
         nw.ny = std::max(m_window.iy0 + m_window.ny, w.iy0 + w.ny) - nw.iy0;
     }
     if (nw == m_window) return;
-    std::vector<uint32_t> heads(nw.cellCount(), kNoBin);
+    std::vector<CellSlot> cells(nw.cellCount());
     const CellWindow old = m_window;
     for (int iy = old.iy0; iy < old.iy0 + old.ny; iy++)
         for (int ix = old.ix0; ix < old.ix0 + old.nx; ix++) {
-            const uint32_t h = m_heads[slot(ix, iy)];
+            const uint32_t h = m_cells[slot(ix, iy)].head;
             if (h == kNoBin) continue;
             int sx = ix % nw.nx, sy = iy % nw.ny;
             if (sx < 0) sx += nw.nx;
             if (sy < 0) sy += nw.ny;
-            heads[size_t(sx) + size_t(sy) * size_t(nw.nx)] = h;
+            cells[size_t(sx) + size_t(sy) * size_t(nw.nx)].head = h;
         }
-    m_heads.swap(heads);
+    m_cells.swap(cells);
     setWindow(nw);
-    // Growth happens between update cycles: the cycle bookkeeping starts afresh.
-    m_updatedIndex.assign(nw.cellCount(), 0);
+    // Growth happens between update cycles: the cycle bookkeeping starts afresh (the new slots
+    // carry no stamp).
     m_updated.clear();
 }
 
@@ -75,18 +74,11 @@ void BinGrid::setWindow(const CellWindow& w) {
     m_originSlotY = residue(w.iy0, w.ny);
 }
 
-void BinGrid::beginCycle() { m_updated.clear(); }
-
-void BinGrid::noteUpdate(size_t s, int ix, int iy, double height_m, uint32_t points) {
-    m_maxHeight_m = std::max(m_maxHeight_m, height_m);
-    const uint32_t k = m_updatedIndex[s];
-    if (k < m_updated.size() && m_updated[k].ix == ix && m_updated[k].iy == iy) {
-        UpdatedCell& u = m_updated[k];
-        u.maxHeight_m = std::max(u.maxHeight_m, float(height_m));
-        u.points += points;
-    } else {
-        m_updatedIndex[s] = static_cast<uint32_t>(m_updated.size());
-        m_updated.push_back({ix, iy, float(height_m), points});
+void BinGrid::beginCycle() {
+    m_updated.clear();
+    if (++m_cycle == 0) {  // wrapped: no stale stamp may match the new cycle
+        for (CellSlot& cs : m_cells) cs.cycle = 0;
+        m_cycle = 1;
     }
 }
 
@@ -115,7 +107,7 @@ void BinGrid::releaseChain(uint32_t head) {
 
 void BinGrid::clearCell(int ix, int iy) {
     if (!m_window.contains(ix, iy)) return;
-    uint32_t& head = m_heads[slot(ix, iy)];
+    uint32_t& head = m_cells[slot(ix, iy)].head;
     releaseChain(head);
     head = kNoBin;
 }
@@ -128,9 +120,9 @@ void BinGrid::appendBin(int ix, int iy, const Bin& bin) {
     m_pool[b].next = kNoBin;
     m_maxHeight_m = std::max(m_maxHeight_m, double(bin.height_m));
     const size_t s = slot(ix, iy);
-    uint32_t last = m_heads[s];
+    uint32_t last = m_cells[s].head;
     if (last == kNoBin) {
-        m_heads[s] = b;
+        m_cells[s].head = b;
         return;
     }
     while (m_pool[last].next != kNoBin) last = m_pool[last].next;
@@ -143,7 +135,7 @@ void BinGrid::fuseBin(int ix, int iy, const Bin& other, const BinUpdateParams& p
     int16_t n;
     if (!binIndexOf(other.height_m, params.binHeight_m, n)) return;
     const size_t s = slot(ix, iy);
-    uint32_t prev = kNoBin, b = m_heads[s];
+    uint32_t prev = kNoBin, b = m_cells[s].head;
     while (b != kNoBin && m_pool[b].index != n) {
         prev = b;
         b = m_pool[b].next;
@@ -153,7 +145,7 @@ void BinGrid::fuseBin(int ix, int iy, const Bin& other, const BinUpdateParams& p
         m_pool[b] = other;
         m_pool[b].index = n;
         m_pool[b].next = kNoBin;
-        (prev == kNoBin ? m_heads[s] : m_pool[prev].next) = b;
+        (prev == kNoBin ? m_cells[s].head : m_pool[prev].next) = b;
         m_maxHeight_m = std::max(m_maxHeight_m, double(other.height_m));
         return;
     }
@@ -170,7 +162,7 @@ void BinGrid::fuseBin(int ix, int iy, const Bin& other, const BinUpdateParams& p
 const Bin* BinGrid::winningBin(int ix, int iy) const {
     if (!m_window.contains(ix, iy)) return nullptr;
     const Bin* best = nullptr;
-    for (uint32_t b = m_heads[slot(ix, iy)]; b != kNoBin; b = m_pool[b].next) {
+    for (uint32_t b = m_cells[slot(ix, iy)].head; b != kNoBin; b = m_pool[b].next) {
         const Bin& bin = m_pool[b];
         if (!(bin.certainty > 0)) continue;
         if (!best || bin.certainty > best->certainty ||
@@ -178,21 +170,6 @@ const Bin* BinGrid::winningBin(int ix, int iy) const {
             best = &bin;
     }
     return best;
-}
-
-uint32_t BinGrid::findOrAddBin(size_t s, int16_t n) {
-    uint32_t prev = kNoBin, b = m_heads[s];
-    while (b != kNoBin && m_pool[b].index != n) {
-        prev = b;
-        b = m_pool[b].next;
-    }
-    if (b == kNoBin) {
-        b = allocateBin();  // may reallocate the pool: hold indices, not pointers
-        m_pool[b].index = n;
-        m_pool[b].next = kNoBin;
-        (prev == kNoBin ? m_heads[s] : m_pool[prev].next) = b;
-    }
-    return b;
 }
 
 bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
@@ -310,11 +287,12 @@ InsertStats BinGrid::insertPoints(const PointsWithCov& mapPoints, const BinUpdat
         for (size_t i = 0; i < m; i++) {
             const PointWithCov& p = pts[i];
             const SymmetricCov3& c = p.cov_m2;
-            const bool finite = std::isfinite(p.point_m.x()) && std::isfinite(p.point_m.y()) &&
-                                std::isfinite(p.point_m.z()) && std::isfinite(c.xx) &&
-                                std::isfinite(c.xy) && std::isfinite(c.xz) && std::isfinite(c.yy) &&
-                                std::isfinite(c.yz) && std::isfinite(c.zz);
-            if (!finite) {
+            // All nine values finite iff their sum in double is (nine floats cannot overflow a
+            // double; a NaN or infinity makes the sum NaN or infinite): one test, no branches.
+            const double sum = double(p.point_m.x()) + double(p.point_m.y()) +
+                               double(p.point_m.z()) + double(c.xx) + double(c.xy) + double(c.xz) +
+                               double(c.yy) + double(c.yz) + double(c.zz);
+            if (!(sum - sum == 0.0)) {
                 cb.status[i] = kNotFinite;
                 continue;
             }
