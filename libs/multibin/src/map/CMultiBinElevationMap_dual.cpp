@@ -35,6 +35,7 @@ void CMultiBinElevationMap::writeBackLocalCell(int ix, int iy) {
 
 void CMultiBinElevationMap::recenter(double x_m, double y_m) {
     if (!isDualGrid()) return;
+    m_fillStale = true;
     // Global first, so that local cells written back land inside it.
     for (multibin::BinGrid* g : {&m_grid, &m_local}) {
         const multibin::CellWindow& w = g->window();

@@ -125,6 +125,7 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
     const multibin::BinUpdateParams params = binUpdateParams();
     grid.beginCycle();
+    m_fillStale = true;
     const multibin::InsertStats s = grid.insertPoints(mapPoints, params, continuityBound_m);
     m_stats += s;
     if (sensorOrigin_m) {

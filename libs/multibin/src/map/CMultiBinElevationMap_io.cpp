@@ -8,6 +8,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "multibin/RasterExport.h"
+
 using namespace mrpt::maps;
 
 namespace {
@@ -112,25 +114,42 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
     }
 }
 
-multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(bool sigma) const {
+multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
     const multibin::CellWindow& w = m_grid.window();
     multibin::EsriAsciiGrid g;
     g.cellsize_m = m_grid.cellSize_m();
     g.xllcenter_m = m_grid.cellCenter_m(w.ix0);
     g.yllcenter_m = m_grid.cellCenter_m(w.iy0);
     g.heights_m.setConstant(w.ny, w.nx, NAN);
-    const multibin::BinUpdateParams p = binUpdateParams();
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
-            const multibin::Bin* b = m_grid.winningBin(w.ix0 + c, w.iy0 + r);
-            if (b)
-                g.heights_m(r, c) = sigma ? float(multibin::BinGrid::sigma_m(*b, p)) : b->height_m;
+            const int ix = w.ix0 + c, iy = w.iy0 + r;
+            double h, s;
+            const HeightSource src = getElevation(m_grid.cellCenter_m(ix), m_grid.cellCenter_m(iy),
+                                                  h, s, insertionOptions.dem_return_filled);
+            if (src == HeightSource::Unknown) continue;
+            float& out = g.heights_m(r, c);
+            switch (layer) {
+                case RasterLayer::Height:
+                    out = float(h);
+                    break;
+                case RasterLayer::Sigma:
+                    out = float(s);
+                    break;
+                case RasterLayer::Source:
+                    out = float(static_cast<int>(src));
+                    break;
+                case RasterLayer::Certainty: {
+                    const multibin::Bin* b = m_grid.winningBin(ix, iy);
+                    out = b ? b->certainty : 0.f;
+                } break;
+            }
         }
     return g;
 }
 
 void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
-    const multibin::EsriAsciiGrid g = toRaster(sigma);
+    const multibin::EsriAsciiGrid g = toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height);
     const int rows = g.rows(), cols = g.cols();
     img.resize(std::max(cols, 1), std::max(rows, 1), mrpt::img::CH_RGB);
     img.filledRectangle(0, 0, std::max(cols, 1) - 1, std::max(rows, 1) - 1,
@@ -165,7 +184,15 @@ void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
         if (!img.saveToFile(filNamePrefix + layer + ".png"))
             throw std::runtime_error("CMultiBinElevationMap: cannot write " + filNamePrefix +
                                      layer + ".png");
-        toRaster(sigma).save(filNamePrefix + layer + ".asc");
+        toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height)
+            .save(filNamePrefix + layer + ".asc");
+    }
+    toRaster(RasterLayer::Certainty).save(filNamePrefix + "_certainty.asc");
+    toRaster(RasterLayer::Source).save(filNamePrefix + "_source.asc");
+    const multibin::EsriAsciiGrid heights = toRaster(RasterLayer::Height);
+    if (heights.rows() > 0 && heights.cols() > 0) {
+        multibin::saveFloatTiff(heights, filNamePrefix + "_height.tif");
+        multibin::saveMeshPly(heights, filNamePrefix + ".ply");
     }
     mrpt::opengl::COpenGLScene scene;
     auto obj = mrpt::opengl::CSetOfObjects::Create();

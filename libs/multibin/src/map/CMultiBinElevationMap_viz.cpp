@@ -11,7 +11,7 @@ using namespace mrpt::maps;
 
 void CMultiBinElevationMap::getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const {
     if (!genericMapParams.enableSaveAs3DObject) return;
-    const multibin::EsriAsciiGrid heights = toRaster(false);
+    const multibin::EsriAsciiGrid heights = toRaster(RasterLayer::Height);
     const int nx = heights.cols(), ny = heights.rows();
     if (nx < 2 || ny < 2) return;
 

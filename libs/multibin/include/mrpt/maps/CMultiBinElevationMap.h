@@ -19,6 +19,8 @@
 #include "multibin/BinGrid.h"
 #include "multibin/EsriAsciiGrid.h"
 #include "multibin/VisibilityConstraint.h"
+#include "multibin/fill/FillOptions.h"
+#include "multibin/fill/HeightRaster.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 namespace mrpt::maps {
@@ -113,6 +115,17 @@ public:
         multibin::sensors::SensorModelOptions sensors;
         mrpt::img::TColormap colormap = mrpt::img::cmJET;
         bool color_by_sigma = false;  //!< 3D view coloured by sigma instead of height
+        /** Gap filling (keys `fill_*`, see multibin::fill::FillOptions); it runs lazily in
+         * dem_update_map(). */
+        multibin::fill::FillOptions fill;
+        /** DEM queries (dem_get_z, dem_get_z_by_cell) and rasters also return filled heights
+         * (key `dem_return_filled`). MRPT documents dem_get_z as false for unobserved cells; set
+         * false for that behaviour. */
+        bool dem_return_filled = true;
+        /** The reported sigma of a cell includes its relief, (g s)^2 / 12 with g the local slope
+         * from the neighbours and s the cell size (key `relief_sigma`): the cell's one height
+         * stands for a sloped patch. Off: the bins' Kalman sigma alone (the paper's). */
+        bool relief_sigma = true;
 
         void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                 const std::string& section) override;
@@ -154,6 +167,23 @@ public:
     /** @name Queries @{ */
     const multibin::BinGrid& grid() const { return m_grid; }
     multibin::BinUpdateParams binUpdateParams() const;
+    /** Where a height comes from (getElevation()). */
+    enum class HeightSource : uint8_t {
+        Unknown = 0,   //!< never observed and not filled
+        Measured,      //!< the winning bin of an observed cell
+        FilledMedian,  //!< never observed; weighted median of the neighbours
+        FilledSurface  //!< never observed; Gaussian surface of eq 16 over its support area
+    };
+    /** Height [m] and sigma [m] at (x, y): measured (the winning bin, as getHeight()) or, with
+     * includeFilled, the result of the last gap filling (dem_update_map()) for a cell that is
+     * still unobserved. Filled cells keep certainty 0. */
+    HeightSource getElevation(double x_m, double y_m, double& height_m, double& sigma_m,
+                              bool includeFilled = true) const;
+    /** True when observations arrived after the last gap filling (dem_update_map() refills). */
+    bool fillIsStale() const { return m_fillStale; }
+    /** The last gap filling's result over the grid window it was run on. */
+    const multibin::fill::FillResult& lastFill() const { return m_fill; }
+
     /** Height [m] and sigma [m] at (x, y) from the winning bin; false if unobserved. With the
      * dual grid, where both grids know the place and agree within 3 sigma, their independent
      * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
@@ -170,11 +200,18 @@ public:
      * global grid holds the whole run (for evaluation and export). */
     void flushLocalToGlobal();
     /** @} */
-    /** Winning-bin heights (or sigmas) of the window as a raster [m], NaN where unobserved;
-     * row 0 is the southernmost row. */
-    multibin::EsriAsciiGrid toRaster(bool sigma = false) const;
+    /** Layers of toRaster(). */
+    enum class RasterLayer {
+        Height,     //!< [m]
+        Sigma,      //!< [m]
+        Certainty,  //!< winning bin's certainty c [-]; 0 for filled cells
+        Source      //!< HeightSource as a number: 1 measured, 2 median-filled, 3 surface-filled
+    };
+    /** One layer over the grid window as a raster, NaN where unknown; row 0 is the southernmost
+     * row. Filled cells are included when insertionOptions.dem_return_filled is set. */
+    multibin::EsriAsciiGrid toRaster(RasterLayer layer = RasterLayer::Height) const;
     /** Colour image of the heights (or sigmas) with insertionOptions.colormap, north up; black
-     * where unobserved. */
+     * where unknown. */
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
     /** Sums of what every insertion did with its points. */
     const multibin::InsertStats& insertStats() const { return m_stats; }
@@ -195,8 +232,10 @@ public:
     bool isEmpty() const override;
     std::string asString() const override;
     void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
-    /** Writes PREFIX_height.png and PREFIX_sigma.png (colour images, north up), PREFIX_height.asc
-     * and PREFIX_sigma.asc (ESRI ASCII rasters [m]) and PREFIX.3Dscene. */
+    /** Writes PREFIX_height.png and PREFIX_sigma.png (colour images, north up); ESRI ASCII
+     * rasters PREFIX_height.asc, PREFIX_sigma.asc [m], PREFIX_certainty.asc and
+     * PREFIX_source.asc (see RasterLayer); PREFIX_height.tif (float32 TIFF with a .tfw world
+     * file); PREFIX.ply (triangle mesh [m]) and PREFIX.3Dscene. */
     void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
     float compute3DMatchingRatio(const mrpt::maps::CMetricMap* otherMap,
                                  const mrpt::poses::CPose3D& otherMapPose,
@@ -212,6 +251,7 @@ public:
     size_t dem_get_size_y() const override;
     bool dem_get_z_by_cell(const size_t cx, const size_t cy, double& z_out) const override;
     bool dem_get_z(const double x, const double y, double& z_out) const override;
+    /** Runs gap filling if observations arrived since the last one (lazy: never per point). */
     void dem_update_map() override;
     /** @} */
 
@@ -263,6 +303,10 @@ private:
     mrpt::Clock::time_point m_lastRobotPoseTime;
     /** Previous laser scans (eq 14), stereo covariance table, sensor statistics. */
     multibin::sensors::SensorModelState m_sensorState;
+    /** The last gap filling, over m_fillWindow of m_grid (absolute cell indices). */
+    multibin::fill::FillResult m_fill;
+    multibin::CellWindow m_fillWindow;
+    bool m_fillStale = true;
 };
 
 }  // namespace mrpt::maps

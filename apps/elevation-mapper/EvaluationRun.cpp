@@ -1,0 +1,277 @@
+/* Part of the multibin elevation-mapping library: the elevation-mapper program. */
+#include "EvaluationRun.h"
+
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationRobotPose.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "multibin/RasterExport.h"
+
+namespace fs = std::filesystem;
+using mrpt::maps::CMultiBinElevationMap;
+using multibin::eval::CellArray;
+using multibin::eval::EvalLattice;
+using multibin::eval::MethodEstimate;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point t0) {
+    return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+CellArray loadTruth(const std::string& path, double cellSize_m, EvalLattice& lattice) {
+    if (!fs::exists(path)) throw std::runtime_error("ground truth '" + path + "' not found");
+    return multibin::eval::groundTruthOnLattice(multibin::EsriAsciiGrid::load(path), cellSize_m,
+                                                lattice);
+}
+
+/** Cell size of the evaluated map's (global) grid [m]. */
+double evaluatedCellSize_m(const CMultiBinElevationMap& map) {
+    const auto& c = map.creationOptions;
+    return c.dual_grid ? c.global_resolution_m : c.resolution_m;
+}
+
+multibin::EsriAsciiGrid rasterOf(const EvalLattice& L, const CellArray& values) {
+    multibin::EsriAsciiGrid g;
+    g.cellsize_m = L.cellSize_m;
+    g.xllcenter_m = L.cellCenterX_m(0);
+    g.yllcenter_m = L.cellCenterY_m(0);
+    g.heights_m = values.matrix();
+    return g;
+}
+
+}  // namespace
+
+EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& evaluated)
+    : m_options(options),
+      m_evaluated(evaluated),
+      m_laserOnly(evaluated.creationOptions),
+      m_truth(loadTruth(options.groundTruthPath, evaluatedCellSize_m(evaluated), m_lattice)),
+      m_rawLaser(m_lattice),
+      m_rawAll(m_lattice),
+      m_heightGrid(mrpt::maps::CHeightGridMap2D::mrSimpleAverage, m_lattice.area_m()[0],
+                   m_lattice.area_m()[1], m_lattice.area_m()[2], m_lattice.area_m()[3],
+                   m_lattice.cellSize_m) {
+    m_laserOnly.insertionOptions = evaluated.insertionOptions;
+    if (options.withMrf) {
+        // A centred crop: MRPT's GMRF solve grows as about n^2.6 in cells.
+        const int side = std::min({options.mrfMaxCells, m_lattice.nx, m_lattice.ny});
+        m_mrfLattice = m_lattice;
+        m_mrfLattice.ix0 = m_lattice.ix0 + (m_lattice.nx - side) / 2;
+        m_mrfLattice.iy0 = m_lattice.iy0 + (m_lattice.ny - side) / 2;
+        m_mrfLattice.nx = m_mrfLattice.ny = side;
+        const auto a = m_mrfLattice.area_m();
+        m_mrf = std::make_unique<mrpt::maps::CHeightGridMap2D_MRF>(
+            mrpt::maps::CHeightGridMap2D_MRF::mrGMRF_SD, a[0], a[1], a[2], a[3],
+            m_mrfLattice.cellSize_m, false);
+    }
+    // The raw map's points: the same sensor geometry with every rejection rule off.
+    m_rawSensorOptions = evaluated.insertionOptions.sensors;
+    auto& laser = m_rawSensorOptions.laser;
+    laser.agcByLabel.clear();  // no eq 1 intensity check
+    laser.mixedPixelFilter = false;
+    laser.continuity = false;
+    auto& stereo = m_rawSensorOptions.stereo;
+    stereo.haloFilter = false;
+    stereo.nearClusterFilter = false;
+}
+
+void EvaluationRun::insertRawPoints(const mrpt::obs::CObservation& obs,
+                                    const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    multibin::sensors::SensorPoints sp;
+    multibin::InsertStats ignored;
+    const auto& io = m_evaluated.insertionOptions;
+    if (!multibin::sensors::observationToSensorPoints(obs, robotPose, m_rawSensorOptions,
+                                                      io.min_range_m, io.max_range_m,
+                                                      m_rawSensorState, ignored, sp))
+        return;
+    const mrpt::poses::CPose3D sensorInMap = robotPose.mean + sp.sensorPose;
+    std::vector<mrpt::math::TPoint3D> points(sp.points.size());
+    for (size_t i = 0; i < sp.points.size(); i++) {
+        const auto& p = sp.points[i].point_m;
+        sensorInMap.composePoint(p.x(), p.y(), p.z(), points[i].x, points[i].y, points[i].z);
+    }
+
+    const bool isLaser = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs) != nullptr;
+    auto t0 = Clock::now();
+    for (const auto& p : points) {
+        m_rawAll.addPoint(p.x, p.y, p.z);
+        if (isLaser) m_rawLaser.addPoint(p.x, p.y, p.z);
+    }
+    m_raw_s += secondsSince(t0);
+
+    t0 = Clock::now();
+    mrpt::maps::CHeightGridMap2D_Base::TPointInsertParams ip;
+    ip.update_map_after_insertion = false;
+    for (const auto& p : points) m_heightGrid.insertIndividualPoint(p.x, p.y, p.z, ip);
+    m_heightGrid_s += secondsSince(t0);
+
+    if (m_mrf) {
+        t0 = Clock::now();
+        int col, row;
+        for (const auto& p : points)
+            if (m_mrfLattice.cellOf(p.x, p.y, col, row))
+                m_mrf->insertIndividualPoint(p.x, p.y, p.z, ip);
+        m_mrf_s += secondsSince(t0);
+    }
+}
+
+void EvaluationRun::observe(const mrpt::obs::CObservation& obs,
+                            const mrpt::poses::CPose3DPDFGaussian& robotPose,
+                            bool poseHasCovariance) {
+    if (m_evaluated.insertionOptions.sensor_labels.empty() ||
+        std::count(m_evaluated.insertionOptions.sensor_labels.begin(),
+                   m_evaluated.insertionOptions.sensor_labels.end(), obs.sensorLabel) > 0)
+        insertRawPoints(obs, robotPose);
+    if (!dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs) &&
+        !dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs))
+        return;
+    const auto t0 = Clock::now();
+    if (poseHasCovariance)
+        m_laserOnly.insertObservation(obs, robotPose);
+    else
+        m_laserOnly.insertObservation(obs, robotPose.mean);
+    m_laserOnly_s += secondsSince(t0);
+}
+
+MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBinElevationMap& map,
+                                        bool filled) const {
+    MethodEstimate m;
+    m.name = name;
+    m.height_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
+    m.sigma_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
+    for (int r = 0; r < m_lattice.ny; r++)
+        for (int c = 0; c < m_lattice.nx; c++) {
+            double h, s;
+            if (map.getElevation(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), h, s,
+                                 filled) != CMultiBinElevationMap::HeightSource::Unknown) {
+                m.height_m(r, c) = float(h);
+                m.sigma_m(r, c) = float(s);
+            }
+        }
+    return m;
+}
+
+std::string EvaluationRun::finish(const std::string& outDir, double multibinInsert_s) {
+    for (CMultiBinElevationMap* map : {&m_evaluated, &m_laserOnly}) map->flushLocalToGlobal();
+
+    std::vector<MethodEstimate> methods;
+    MethodEstimate rawLaser{"raw_laser", m_rawLaser.heights_m(), {}, "raw_laser", m_raw_s, 0};
+    MethodEstimate rawAll{"raw_all", m_rawAll.heights_m(), {}, "raw_all", m_raw_s, 0};
+    methods.push_back(rawLaser);
+    methods.push_back(rawAll);
+
+    MethodEstimate laserOnly = sampleMap("laser_only", m_laserOnly, false);
+    laserOnly.baseline = "raw_laser";
+    laserOnly.insert_s = m_laserOnly_s;
+    methods.push_back(laserOnly);
+
+    MethodEstimate multibin = sampleMap("multibin", m_evaluated, false);
+    multibin.baseline = "raw_all";
+    multibin.insert_s = multibinInsert_s;
+    methods.push_back(multibin);
+
+    const auto fill0 = Clock::now();
+    m_evaluated.dem_update_map();  // gap filling runs here (lazily, once)
+    MethodEstimate filled = sampleMap("multibin_filled", m_evaluated, true);
+    filled.baseline = "raw_all";
+    filled.insert_s = multibin.insert_s;
+    filled.fill_s = secondsSince(fill0);
+    methods.push_back(filled);
+
+    MethodEstimate heightGrid;
+    heightGrid.name = "mrpt_height_grid";
+    heightGrid.baseline = "raw_all";
+    heightGrid.insert_s = m_heightGrid_s;
+    heightGrid.height_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
+    for (int r = 0; r < m_lattice.ny; r++)
+        for (int c = 0; c < m_lattice.nx; c++) {
+            double z;
+            if (m_heightGrid.dem_get_z(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), z))
+                heightGrid.height_m(r, c) = float(z);
+        }
+    methods.push_back(heightGrid);
+
+    if (m_mrf) {
+        const auto t0 = Clock::now();
+        m_mrf->dem_update_map();  // one GMRF solve over the crop
+        MethodEstimate mrf;
+        mrf.name = "mrpt_height_grid_mrf";
+        mrf.baseline = "raw_all";
+        mrf.insert_s = m_mrf_s;
+        mrf.fill_s = secondsSince(t0);
+        mrf.height_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
+        for (int r = 0; r < m_lattice.ny; r++)
+            for (int c = 0; c < m_lattice.nx; c++) {
+                int cc, rr;
+                const double x = m_lattice.cellCenterX_m(c), y = m_lattice.cellCenterY_m(r);
+                double z;
+                if (m_mrfLattice.cellOf(x, y, cc, rr) && m_mrf->dem_get_z(x, y, z))
+                    mrf.height_m(r, c) = float(z);
+            }
+        methods.push_back(mrf);
+    }
+
+    const auto scores = multibin::eval::scoreMethods(m_truth, methods);
+    std::vector<std::string> order;
+    for (const auto& m : methods) order.push_back(m.name);
+
+    const fs::path out = outDir;
+    {
+        std::ofstream f(out / "report.json");
+        f << multibin::eval::reportJson(scores, order, m_lattice);
+        if (!f) throw std::runtime_error("cannot write '" + (out / "report.json").string() + "'");
+    }
+    rasterOf(m_lattice, m_truth).save((out / "eval_truth.asc").string());
+    for (const auto& m : methods)
+        rasterOf(m_lattice, m.height_m).save((out / ("eval_" + m.name + ".asc")).string());
+    writeProfile((out / "profile.csv").string(), m_truth, methods);
+    return multibin::eval::reportTable(scores, order);
+}
+
+void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth,
+                                 const std::vector<MethodEstimate>& methods) const {
+    std::vector<double> line = m_options.profile_m;
+    if (line.empty()) {
+        const auto a = m_lattice.area_m();
+        const double yMid = 0.5 * (a[2] + a[3]);
+        line = {a[0], yMid, a[1], yMid};
+    }
+    if (line.size() != 4) throw std::invalid_argument("--profile needs x0,y0,x1,y1 [m]");
+    const auto find = [&](const std::string& name) -> const MethodEstimate* {
+        for (const auto& m : methods)
+            if (m.name == name) return &m;
+        return nullptr;
+    };
+    const MethodEstimate* measured = find("multibin");
+    const MethodEstimate* filled = find("multibin_filled");
+    const MethodEstimate* raw = find("raw_all");
+
+    std::ofstream f(path);
+    f << "s_m,x_m,y_m,truth_m,multibin_m,multibin_sigma_m,filled_m,filled_sigma_m,raw_m\n";
+    const double dx = line[2] - line[0], dy = line[3] - line[1];
+    const double length_m = std::hypot(dx, dy);
+    const int samples = std::max(2, int(std::ceil(length_m / (0.5 * m_lattice.cellSize_m))) + 1);
+    auto value = [](const CellArray& a, int r, int c) -> std::string {
+        if (a.size() == 0 || !std::isfinite(a(r, c))) return "";
+        return std::to_string(a(r, c));
+    };
+    for (int k = 0; k < samples; k++) {
+        const double t = double(k) / (samples - 1);
+        const double x = line[0] + t * dx, y = line[1] + t * dy;
+        int c, r;
+        if (!m_lattice.cellOf(x, y, c, r)) continue;
+        f << t * length_m << ',' << x << ',' << y << ',' << value(truth, r, c) << ','
+          << value(measured->height_m, r, c) << ',' << value(measured->sigma_m, r, c) << ','
+          << value(filled->height_m, r, c) << ',' << value(filled->sigma_m, r, c) << ','
+          << value(raw->height_m, r, c) << '\n';
+    }
+    if (!f) throw std::runtime_error("cannot write '" + path + "'");
+}

@@ -1,0 +1,63 @@
+/* The reported surface of a cell: adjacent bins of one surface merged, relief in sigma. */
+#include <gtest/gtest.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+
+#include <cmath>
+
+using mrpt::maps::CMultiBinElevationMap;
+
+namespace {
+CMultiBinElevationMap fixedMap(double cell_m) {
+    CMultiBinElevationMap::TCreationOptions c;
+    c.resolution_m = cell_m;
+    c.grow = false;
+    c.min_x = c.min_y = 0;
+    c.max_x = c.max_y = 1;
+    CMultiBinElevationMap map(c);
+    map.insertionOptions.height_sigma_floor_m = 0.001;
+    return map;
+}
+void insert(CMultiBinElevationMap& map, double x, double y, double z, double sigma) {
+    CMultiBinElevationMap::TPointInsertParams ip;
+    ip.pt_z_std = sigma;
+    ASSERT_TRUE(map.insertIndividualPoint(x, y, z, ip));
+}
+}  // namespace
+
+TEST(CellSurface, AdjacentBinsThatAgreeAreOneSurface) {
+    // A surface at 0.05 m (a bin boundary) measured with sigma 3 mm: points fall in bins 0 and 1.
+    CMultiBinElevationMap map = fixedMap(0.1);
+    map.insertionOptions.relief_sigma = false;
+    const double heights[] = {0.048, 0.052, 0.047, 0.053, 0.049, 0.051};
+    for (double z : heights) insert(map, 0.55, 0.55, z, 0.003);
+    double h, s;
+    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    EXPECT_NEAR(h, 0.05, 1e-6) << "the mean of all six points, not of one bin's share";
+    EXPECT_NEAR(s, 0.003 / std::sqrt(6.0), 1e-5);
+
+    // Two surfaces 0.1 m apart stay two hypotheses: the more certain one wins alone.
+    CMultiBinElevationMap two = fixedMap(0.1);
+    two.insertionOptions.relief_sigma = false;
+    for (int i = 0; i < 3; i++) insert(two, 0.55, 0.55, 0.01, 0.003);
+    for (int i = 0; i < 2; i++) insert(two, 0.55, 0.55, 0.11, 0.003);
+    ASSERT_TRUE(two.getHeight(0.55, 0.55, h, s));
+    EXPECT_NEAR(h, 0.01, 1e-6);
+}
+
+TEST(CellSurface, ReliefOfASlopeAddsItsHeightSpreadToSigma) {
+    // A plane z = 0.2 x over 2 cm cells, one exact-ish point per cell at the cell centre.
+    const double cell = 0.02, slope = 0.2, sigma = 0.001;
+    CMultiBinElevationMap map = fixedMap(cell);
+    for (int iy = 0; iy < 10; iy++)
+        for (int ix = 0; ix < 10; ix++) {
+            const double x = (ix + 0.5) * cell, y = (iy + 0.5) * cell;
+            insert(map, x, y, 0.3 + slope * x, sigma);
+        }
+    double h, s;
+    ASSERT_TRUE(map.getHeight(0.05, 0.05, h, s));
+    // sigma^2 = max(Kalman, floor) + (g s)^2 / 12; Kalman = floor = 1 mm here.
+    EXPECT_NEAR(s, std::sqrt(sigma * sigma + std::pow(slope * cell, 2) / 12.0), 1e-6);
+    map.insertionOptions.relief_sigma = false;
+    ASSERT_TRUE(map.getHeight(0.05, 0.05, h, s));
+    EXPECT_NEAR(s, sigma, 1e-6);
+}
