@@ -35,6 +35,13 @@ TEST(SensorOptions, ReadsContractKeys) {
     EXPECT_DOUBLE_EQ(o.stereo.extrinsicsSigma[5], 0.006);
     EXPECT_DOUBLE_EQ(o.stereo.matchingSigma_px, 0.3);
     EXPECT_EQ(o.stereo.sgbmNumDisparities, 64);
+    EXPECT_EQ(o.stereo.numDisparitiesFor(1282), 64);
+    // Automatic: width / 4 in multiples of 16, within [16, 256].
+    const SensorModelOptions autoOpts = load("stereo_sgbm_num_disparities = 0\n");
+    EXPECT_EQ(autoOpts.stereo.numDisparitiesFor(1282), 256);  // 320 -> 256
+    EXPECT_EQ(autoOpts.stereo.numDisparitiesFor(640), 160);
+    EXPECT_EQ(autoOpts.stereo.numDisparitiesFor(320), 80);
+    EXPECT_EQ(autoOpts.stereo.numDisparitiesFor(40), 16);
     EXPECT_DOUBLE_EQ(o.depth.axialSigmaQuadratic_per_m, 0.003);
 }
 
@@ -53,6 +60,7 @@ TEST(SensorOptions, BadValuesNameTheKey) {
     fails("laser_agc = LASER:-3\n", "laser_agc");
     fails("stereo_extrinsics_sigma = 1 2 3\n", "stereo_extrinsics_sigma");
     fails("stereo_sgbm_num_disparities = 20\n", "stereo_sgbm_num_disparities");
+    fails("stereo_sgbm_num_disparities = -16\n", "stereo_sgbm_num_disparities");
     fails("stereo_sgbm_block_size = 4\n", "stereo_sgbm_block_size");
     fails("stereo_sgbm_mode = fast\n", "stereo_sgbm_mode");
     fails("depth_lateral_sigma = 0\n", "depth_lateral_sigma");

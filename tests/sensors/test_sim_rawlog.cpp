@@ -7,6 +7,7 @@
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
@@ -25,7 +26,9 @@ struct Outcome {
     multibin::InsertStats core;
 };
 
-Outcome run(const std::vector<std::string>& labels) {
+/** Inserts the scenario with the sensors of `labels` (all if empty); `sgbm`: drop the simulator's
+ * disparity images so the model runs StereoSGBM on the rendered pairs. */
+Outcome run(const std::vector<std::string>& labels, bool sgbm = false) {
     mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
     c.resolution_m = 0.015;
     mrpt::maps::CMultiBinElevationMap map(c);
@@ -36,6 +39,11 @@ Outcome run(const std::vector<std::string>& labels) {
     mrpt::maps::CSimpleMap sm;
     mrpt::io::CFileGZInputStream f(kPrefix + ".simplemap");
     mrpt::serialization::archiveFrom(f) >> sm;
+    if (sgbm)
+        for (size_t i = 0; i < sm.size(); i++)
+            for (auto& obs : *std::get<1>(sm.get(i)))
+                if (auto st = std::dynamic_pointer_cast<mrpt::obs::CObservationStereoImages>(obs))
+                    st->hasImageDisparity = false;
     map.insertSimpleMapWithPosePdfs(sm);
 
     const auto gt = multibin::EsriAsciiGrid::load(kPrefix + "_gt.asc");
@@ -55,8 +63,8 @@ Outcome run(const std::vector<std::string>& labels) {
             if (std::abs(e) <= 3 * s) o.within3Sigma++;
         }
     std::printf("%-12s cells %6zu  RMSE %.4f m  within 3 sigma %.1f %%\n",
-                labels.empty() ? "LASER+STEREO" : labels[0].c_str(), o.cells,
-                std::sqrt(o.sumSq / double(o.cells)),
+                labels.empty() ? "LASER+STEREO" : (labels[0] + (sgbm ? "/SGBM" : "")).c_str(),
+                o.cells, std::sqrt(o.sumSq / double(o.cells)),
                 100.0 * double(o.within3Sigma) / double(o.cells));
     return o;
 }
@@ -86,9 +94,18 @@ TEST(SimMockup, ContractIniLoadsAndEverySensorPathInserts) {
     EXPECT_GT(S.halo, 0u);
     EXPECT_GT(stereo.cells, 5000u);
 
+    const Outcome sgbm = run({"STEREO"}, true);
+    const auto& G = sgbm.stats.stereo;
+    std::printf(
+        "stereo/SGBM: %zu px visited, %zu kept, %zu no disparity, %zu halo, "
+        "%zu near-cluster\n",
+        G.pixels, G.kept, G.noDisparity, G.halo, G.nearCluster);
+    EXPECT_GT(G.kept, 10000u);
+    EXPECT_GT(sgbm.cells, 5000u);
+
     const Outcome both = run({});
     EXPECT_GT(both.cells, laser.cells);
     // Honest sigmas: most observed cells hold the truth within 3 sigma.
-    for (const Outcome* o : {&laser, &stereo, &both})
+    for (const Outcome* o : {&laser, &stereo, &sgbm, &both})
         EXPECT_GT(double(o->within3Sigma) / double(o->cells), 0.8);
 }

@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/SensorModelOptions.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -49,6 +50,11 @@ std::map<std::string, double> parseAgc(StrictConfigSection& s, const std::string
     return out;
 }
 }  // namespace
+
+int StereoModelOptions::numDisparitiesFor(int width_px) const {
+    if (sgbmNumDisparities > 0) return sgbmNumDisparities;
+    return std::clamp(width_px / 4 / 16 * 16, 16, 256);
+}
 
 void SensorModelOptions::load(StrictConfigSection& s) {
     // Laser
@@ -180,8 +186,8 @@ void SensorModelOptions::validate() const {
     if (!(stereo.matchingSigma_px >= 0)) bad("stereo_matching_sigma", "must be >= 0 [px]");
     if (stereo.subsample < 1) bad("stereo_subsample", "must be >= 1 [px]");
     if (!(stereo.minDepth_m >= 0)) bad("stereo_min_depth", "must be >= 0 [m]");
-    if (stereo.sgbmNumDisparities < 16 || stereo.sgbmNumDisparities % 16 != 0)
-        bad("stereo_sgbm_num_disparities", "must be a positive multiple of 16");
+    if (stereo.sgbmNumDisparities < 0 || stereo.sgbmNumDisparities % 16 != 0)
+        bad("stereo_sgbm_num_disparities", "must be 0 (automatic) or a positive multiple of 16");
     if (stereo.sgbmBlockSize < 1 || stereo.sgbmBlockSize % 2 == 0)
         bad("stereo_sgbm_block_size", "must be odd and >= 1");
     if (stereo.sgbmP1 < 0 || stereo.sgbmP2 < 0) bad("stereo_sgbm_p1/p2", "must be >= 0");

@@ -62,8 +62,8 @@ DisparityImage computeDisparitySGBM(const mrpt::img::CImage& left, const mrpt::i
     if (o.sgbmMode == "hh") mode = cv::StereoSGBM::MODE_HH;
     if (o.sgbmMode == "sgbm_3way") mode = cv::StereoSGBM::MODE_SGBM_3WAY;
     if (o.sgbmMode == "hh4") mode = cv::StereoSGBM::MODE_HH4;
-    auto sgbm = cv::StereoSGBM::create(o.sgbmMinDisparity, o.sgbmNumDisparities, o.sgbmBlockSize,
-                                       o.sgbmP1 > 0 ? o.sgbmP1 : 8 * area,
+    auto sgbm = cv::StereoSGBM::create(o.sgbmMinDisparity, o.numDisparitiesFor(lg.cols),
+                                       o.sgbmBlockSize, o.sgbmP1 > 0 ? o.sgbmP1 : 8 * area,
                                        o.sgbmP2 > 0 ? o.sgbmP2 : 32 * area, o.sgbmDisp12MaxDiff, 0,
                                        o.sgbmUniquenessRatio, o.sgbmSpeckleWindowSize,
                                        o.sgbmSpeckleRange, mode);

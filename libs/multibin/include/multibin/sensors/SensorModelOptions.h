@@ -62,8 +62,12 @@ struct StereoModelOptions {
     /** @name OpenCV StereoSGBM, used when the observation has no disparity image (keys
      * `stereo_sgbm_*`). p1/p2 = 0 means OpenCV's usual 8 and 32 * block_size^2. @{ */
     int sgbmMinDisparity = 0;
-    int sgbmNumDisparities = 256;  //!< multiple of 16
-    int sgbmBlockSize = 5;         //!< odd
+    /** The number of disparities searched for an image `width_px` wide. */
+    int numDisparitiesFor(int width_px) const;
+    /** Multiple of 16; 0 = from the image width: width / 4 rounded down to a multiple of 16,
+     * between 16 and 256 (the leftmost numDisparities columns get no disparity). */
+    int sgbmNumDisparities = 0;
+    int sgbmBlockSize = 5;  //!< odd
     int sgbmP1 = 0, sgbmP2 = 0;
     int sgbmDisp12MaxDiff = 1;
     int sgbmUniquenessRatio = 15;
