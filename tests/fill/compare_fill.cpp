@@ -235,6 +235,10 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
     FillOptions pure, bic;
     pure.residualCorrection = false;
     bic.criterion = ModelCriterion::BIC;
+    FillOptions holdout = opt;
+    holdout.criterion = ModelCriterion::Holdout;
+    FillOptions flat = opt;  // m = 0: a constant plus the harmonic rim residuals
+    flat.maxTerms = 0;
     std::vector<std::pair<std::string, Method>> methods{
         {"Gaussian eq 16 + harmonic rim residuals (default)",
          [&](const HeightRaster& r) { return heights(fillGaps(r, opt)); }},
@@ -242,6 +246,10 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
          [&](const HeightRaster& r) { return heights(fillGaps(r, pure)); }},
         {"Gaussian eq 16 + rim residuals, m by BIC",
          [&](const HeightRaster& r) { return heights(fillGaps(r, bic)); }},
+        {"Gaussian eq 16 + rim residuals, m by held-out rim (fill_model_criterion = holdout)",
+         [&](const HeightRaster& r) { return heights(fillGaps(r, holdout)); }},
+        {"eq 16 with m = 0 + rim residuals (harmonic interpolation; fill_max_terms = 0)",
+         [&](const HeightRaster& r) { return heights(fillGaps(r, flat)); }},
         {"weighted median, repeated rim-inwards",
          [&](const HeightRaster& r) { return heights(weightedMedianFill(r, opt, true)); }},
         {"cv::inpaint TELEA, float, radius 3",

@@ -325,6 +325,41 @@ TEST(FillGaps, CappedTrainingPointsHugALongGap) {
     EXPECT_LT(worst, 0.005);
 }
 
+TEST(FillGaps, HoldoutCriterionKeepsRealTermsAndDropsNoise) {
+    // A hill whose top is hidden: predicting the hidden rim needs the Gaussian term.
+    auto hill = [](int ix, int iy) {
+        return 0.02 + 0.06 * std::exp(-((ix - 20.0) * (ix - 20.0) + (iy - 18.0) * (iy - 18.0)) /
+                                      (2 * 36.0));
+    };
+    auto r = rasterFrom(40, hill, 0.001f);
+    hide(r, 15, 13, 10, 10);
+    FillOptions o;
+    o.criterion = ModelCriterion::Holdout;
+    // The default clamp (visible range + 25 %) flattens this top, which rises 18 mm above the
+    // highest visible cell (0.0624 m at (20, 23)).
+    const auto clamped = fillGaps(r, o);
+    EXPECT_LT(clamped.height_m[clamped.index(20, 18)], hill(20, 18) - 0.005);
+    o.extrapolationMargin = 1.0;
+    const auto f = fillGaps(r, o);
+    ASSERT_EQ(f.stats.termsChosen.size(), 1u);
+    EXPECT_GE(f.stats.termsChosen[0], 1);
+    double worst = 0;
+    for (int iy = 13; iy < 23; iy++)
+        for (int ix = 15; ix < 25; ix++)
+            worst = std::max(worst, std::abs(f.height_m[f.index(ix, iy)] - hill(ix, iy)));
+    EXPECT_LT(worst, 0.004);
+
+    // White noise on a plane: no term predicts held-out cells better than the constant.
+    std::mt19937 rng(5);
+    std::normal_distribution<double> n(0, 0.003);
+    auto flat = rasterFrom(
+        30, [&](int, int) { return 0.04 + n(rng); }, 0.003f);
+    hide(flat, 10, 10, 10, 10);
+    const auto g = fillGaps(flat, o);
+    ASSERT_EQ(g.stats.termsChosen.size(), 1u);
+    EXPECT_EQ(g.stats.termsChosen[0], 0);
+}
+
 TEST(FillGaps, RejectsInconsistentRaster) {
     HeightRaster r(4, 4, 0.015);
     r.sigma_m.pop_back();
@@ -348,6 +383,7 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
     a.gaussianSigmaGain = 1.25;
     a.swarmSeed = 42;
     a.residualCorrection = false;
+    a.criterion = ModelCriterion::Holdout;
     mrpt::config::CConfigFileMemory ini;
     a.saveToConfigFile(ini, "insertOpts");
     FillOptions b;
@@ -359,6 +395,7 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
     EXPECT_DOUBLE_EQ(b.gaussianSigmaGain, 1.25);
     EXPECT_EQ(b.swarmSeed, 42u);
     EXPECT_FALSE(b.residualCorrection);
+    EXPECT_EQ(b.criterion, ModelCriterion::Holdout);
 
     // Keys shared with the map's own section: the caller's strict reader owns finish().
     mrpt::config::CConfigFileMemory shared;
@@ -384,6 +421,7 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
     expectError("fill_median_window", "4");
     expectError("fill_median_window", "five");
     expectError("fill_sigma_model", "bayes");
+    expectError("fill_model_criterion", "cv");
     expectError("fill_max_gap_cells", "0");
     expectError("fill_medain_window", "5");  // typo: unknown key
 }

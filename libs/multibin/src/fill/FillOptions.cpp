@@ -11,6 +11,10 @@
 namespace multibin::fill {
 
 namespace {
+const char* criterionName(ModelCriterion c) {
+    return c == ModelCriterion::BIC ? "bic" : c == ModelCriterion::Holdout ? "holdout" : "aic";
+}
+
 const char* sigmaModelName(FillSigmaModel m) {
     return m == FillSigmaModel::Paper ? "paper" : "calibrated";
 }
@@ -36,14 +40,17 @@ void FillOptions::read(StrictConfigSection& s) {
     s.read("fill_support_margin", supportMargin_cells);
     s.read("fill_max_training_points", maxTrainingPoints);
     s.read("fill_residual_correction", residualCorrection);
-    std::string crit = criterion == ModelCriterion::BIC ? "bic" : "aic";
+    s.read("fill_extrapolation_margin", extrapolationMargin);
+    std::string crit = criterionName(criterion);
     s.read("fill_model_criterion", crit);
     if (crit == "aic")
         criterion = ModelCriterion::AICc;
     else if (crit == "bic")
         criterion = ModelCriterion::BIC;
+    else if (crit == "holdout")
+        criterion = ModelCriterion::Holdout;
     else
-        s.fail("fill_model_criterion", "expected aic or bic, got '" + crit + "'");
+        s.fail("fill_model_criterion", "expected aic, bic or holdout, got '" + crit + "'");
     s.read("fill_max_terms", maxTerms);
     s.read("fill_min_width", minWidth_cells);
     s.read("fill_pso_particles", swarmParticles);
@@ -80,8 +87,8 @@ void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
     c.write(section, "fill_support_margin", supportMargin_cells);
     c.write(section, "fill_max_training_points", maxTrainingPoints);
     c.write(section, "fill_residual_correction", residualCorrection);
-    c.write(section, "fill_model_criterion",
-            std::string(criterion == ModelCriterion::BIC ? "bic" : "aic"));
+    c.write(section, "fill_extrapolation_margin", extrapolationMargin);
+    c.write(section, "fill_model_criterion", std::string(criterionName(criterion)));
     c.write(section, "fill_max_terms", maxTerms);
     c.write(section, "fill_min_width", minWidth_cells);
     c.write(section, "fill_pso_particles", swarmParticles);
@@ -106,6 +113,8 @@ void FillOptions::validate() const {
         bad("fill_support_margin", "must be from 1 to 100 [cells]");
     if (maxTrainingPoints < 10) bad("fill_max_training_points", "must be >= 10");
     if (maxTerms < 0 || maxTerms > 20) bad("fill_max_terms", "must be from 0 to 20");
+    if (!(extrapolationMargin >= 0) || !std::isfinite(extrapolationMargin))
+        bad("fill_extrapolation_margin", "must be >= 0");
     if (!(minWidth_cells >= 0.3) || !std::isfinite(minWidth_cells))
         bad("fill_min_width", "must be >= 0.3 [cells]");
     if (swarmParticles < 1 || swarmParticles > 1000) bad("fill_pso_particles", "must be 1..1000");

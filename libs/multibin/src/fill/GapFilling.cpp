@@ -388,12 +388,60 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
     samples.reserve(cand.size());
     for (const auto& c : cand) samples.push_back(c.s);
 
-    const GaussianSurface g = fitGaussianSurface(samples, side, o.gaussianFitOptions());
-    // The surface never leaves the heights of its data by more than a quarter of their range:
-    // far from the rim the model is an extrapolation, and the data say nothing beyond that.
+    const GaussianFitOptions fitOptions = o.gaussianFitOptions();
+    GaussianSurface g;
+    if (o.criterion == ModelCriterion::Holdout) {
+        // Hide the two rings of measured cells nearest the gap, fit on the rest, fill the
+        // hidden cells as the gap would be filled, and keep the m that predicts them best.
+        std::vector<SurfaceSample> fitSet, heldOut;
+        std::vector<int> hidden = cells;
+        for (const auto& c : cand)
+            if (c.gapDist <= 2) {
+                heldOut.push_back(c.s);
+                hidden.push_back(int(r.index(sx + c.s.i, sy + c.s.j)));
+            } else {
+                fitSet.push_back(c.s);
+            }
+        if (fitSet.size() >= 12 && heldOut.size() >= 4) {
+            auto heldOutError = [&](const GaussianSurface& s) {
+                const auto res = o.residualCorrection
+                                     ? harmonicResiduals(r, s, hidden, sx, sy, ex, ey)
+                                     : std::vector<double>(hidden.size(), 0.0);
+                double e = 0;
+                for (size_t h = 0; h < heldOut.size(); h++) {
+                    const auto& v = heldOut[h];
+                    const double d = v.h_m - (s(v.i, v.j) + res[cells.size() + h]);
+                    e += d * d / (v.sigma_m * v.sigma_m);
+                }
+                return e;
+            };
+            GaussianSurface prev = fitGaussianSurfaceFixed(fitSet, side, 0, fitOptions);
+            double bestErr = heldOutError(prev);
+            int bestM = 0;
+            GaussianSurface bestFit = prev;
+            for (int m = 1; m <= o.maxTerms && int(fitSet.size()) > 2 + 5 * m; m++) {
+                GaussianSurface trial = fitGaussianSurfaceFixed(fitSet, side, m, fitOptions, &prev);
+                const double err = heldOutError(trial);
+                if (!(err < bestErr)) break;
+                bestErr = err, bestM = m, bestFit = trial, prev = trial;
+            }
+            // Refit on every training point with the chosen size, starting from the held-out
+            // fit's terms (m - 1 of them seed the swarm; the LM polish does the rest).
+            GaussianSurface seed = bestFit;
+            if (bestM > 0) seed.terms.pop_back();
+            g = fitGaussianSurfaceFixed(samples, side, bestM, fitOptions,
+                                        bestM > 0 ? &seed : nullptr);
+        } else {
+            g = fitGaussianSurface(samples, side, fitOptions);  // too little data: AICc
+        }
+    } else {
+        g = fitGaussianSurface(samples, side, fitOptions);
+    }
+    // The surface never leaves the heights of its data by more than extrapolationMargin times
+    // their range: far from the rim the model extrapolates, and the data say little there.
     double hLo = samples[0].h_m, hHi = hLo;
     for (const auto& s : samples) hLo = std::min(hLo, s.h_m), hHi = std::max(hHi, s.h_m);
-    const double slack = 0.25 * (hHi - hLo);
+    const double slack = o.extrapolationMargin * (hHi - hLo);
     out.stats.supportAreas++;
     out.stats.termsChosen.push_back(int(g.terms.size()));
 

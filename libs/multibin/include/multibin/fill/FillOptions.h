@@ -52,7 +52,12 @@ struct FillOptions {
     /** [fill_residual_correction] beyond the paper: add to the fitted surface the residuals of
      * the rim cells, carried into the gap as a harmonic function, so the fill meets the rim. */
     bool residualCorrection = true;
-    /** [fill_model_criterion] aic (the paper's, as AICc) or bic: how m is chosen. */
+    /** [fill_extrapolation_margin] Gaussian-filled heights are kept within the training heights'
+     * range widened by this fraction of it on each side [-]. 0.25 cut overshoot into rock-board
+     * gaps (doc/gap-filling.md) but also flattens a hidden hill top higher than that. */
+    double extrapolationMargin = 0.25;
+    /** [fill_model_criterion] aic (the paper's, as AICc), bic or holdout: how m is chosen
+     * (see ModelCriterion). */
     ModelCriterion criterion = ModelCriterion::AICc;
     int maxTerms = 4;             //!< [fill_max_terms] largest m tried by AIC [-]
     double minWidth_cells = 1.0;  //!< [fill_min_width] narrowest Gaussian sigma [cells]

@@ -46,7 +46,12 @@ struct GaussianSurface {
 /** How the model size m is chosen. */
 enum class ModelCriterion {
     AICc,  //!< corrected Akaike criterion (the paper's AIC; default)
-    BIC    //!< Bayesian criterion: a stronger penalty, k ln n instead of about 2 k
+    BIC,   //!< Bayesian criterion: a stronger penalty, k ln n instead of about 2 k
+    /** Prediction of held-out data: the cells within 2 cells of the gap are hidden, the model is
+     * fitted on the rest and m minimises the weighted error of the fill (surface plus rim
+     * residuals) on them. Needs the gap, so only fillGaps() applies it; fitGaussianSurface()
+     * treats it as AICc. */
+    Holdout
 };
 
 /** How eq 16 is fitted. */
