@@ -16,7 +16,7 @@
 #include "multibin/EsriAsciiGrid.h"
 
 namespace {
-const std::string kPrefix = MULTIBIN_SOURCE_DIR "/rawlogs/mockup";
+const std::string kRawlogs = MULTIBIN_SOURCE_DIR "/rawlogs/";
 
 struct Outcome {
     size_t cells = 0, within3Sigma = 0;
@@ -28,7 +28,9 @@ struct Outcome {
 
 /** Inserts the scenario with the sensors of `labels` (all if empty); `sgbm`: drop the simulator's
  * disparity images so the model runs StereoSGBM on the rendered pairs. */
-Outcome run(const std::vector<std::string>& labels, bool sgbm = false) {
+Outcome run(const std::string& scenario, const std::vector<std::string>& labels, bool sgbm = false,
+            double poseCorrelation = 0.0) {
+    const std::string kPrefix = kRawlogs + scenario;
     mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
     c.resolution_m = 0.015;
     mrpt::maps::CMultiBinElevationMap map(c);
@@ -36,6 +38,7 @@ Outcome run(const std::vector<std::string>& labels, bool sgbm = false) {
     map.insertionOptions.loadFromConfigFile(
         ini, "MappingApplication_multiBinElevationMap_00_insertOpts");
     map.insertionOptions.sensor_labels = labels;
+    map.insertionOptions.sensors.laser.continuityPoseCorrelation = poseCorrelation;
     mrpt::maps::CSimpleMap sm;
     mrpt::io::CFileGZInputStream f(kPrefix + ".simplemap");
     mrpt::serialization::archiveFrom(f) >> sm;
@@ -71,7 +74,7 @@ Outcome run(const std::vector<std::string>& labels, bool sgbm = false) {
 }  // namespace
 
 TEST(SimMockup, ContractIniLoadsAndEverySensorPathInserts) {
-    const Outcome laser = run({"LASER"});
+    const Outcome laser = run("mockup", {"LASER"});
     const auto& L = laser.stats.laser;
     std::printf(
         "laser: %zu beams, %zu kept, %zu no return, %zu low intensity, %zu mixed, "
@@ -83,7 +86,7 @@ TEST(SimMockup, ContractIniLoadsAndEverySensorPathInserts) {
     EXPECT_GT(L.mixedPixel, 0u);    // the simulator's mixed pixels at board edges
     EXPECT_GT(laser.cells, 5000u);
 
-    const Outcome stereo = run({"STEREO"});
+    const Outcome stereo = run("mockup", {"STEREO"});
     const auto& S = stereo.stats.stereo;
     std::printf(
         "stereo: %zu pairs, %zu table builds, %zu px visited, %zu kept, %zu no disparity, "
@@ -94,7 +97,7 @@ TEST(SimMockup, ContractIniLoadsAndEverySensorPathInserts) {
     EXPECT_GT(S.halo, 0u);
     EXPECT_GT(stereo.cells, 5000u);
 
-    const Outcome sgbm = run({"STEREO"}, true);
+    const Outcome sgbm = run("mockup", {"STEREO"}, true);
     const auto& G = sgbm.stats.stereo;
     std::printf(
         "stereo/SGBM: %zu px visited, %zu kept, %zu no disparity, %zu halo, "
@@ -103,9 +106,29 @@ TEST(SimMockup, ContractIniLoadsAndEverySensorPathInserts) {
     EXPECT_GT(G.kept, 10000u);
     EXPECT_GT(sgbm.cells, 5000u);
 
-    const Outcome both = run({});
+    const Outcome both = run("mockup", {});
     EXPECT_GT(both.cells, laser.cells);
     // Honest sigmas: most observed cells hold the truth within 3 sigma.
     for (const Outcome* o : {&laser, &stereo, &sgbm, &both})
+        EXPECT_GT(double(o->within3Sigma) / double(o->cells), 0.8);
+}
+
+TEST(SimWalk, DriftingPosesStillInsertConsistently) {
+    // The walk: pose errors drift between corrections, so consecutive scans' pose covariances
+    // differ and eq 14's bound follows them.
+    const Outcome laser = run("walk", {"LASER"});
+    std::printf("laser: %zu kept, %zu low intensity, %zu mixed, %zu continuity-rejected\n",
+                laser.stats.laser.kept, laser.stats.laser.lowIntensity,
+                laser.stats.laser.mixedPixel, laser.core.continuityRejected);
+    // Its pose errors are a random walk between corrections: consecutive scans' errors are
+    // strongly correlated, which laser_continuity_pose_correlation can state.
+    const Outcome correlated = run("walk", {"LASER"}, false, 0.95);
+    std::printf("laser, pose correlation 0.95: %zu continuity-rejected\n",
+                correlated.core.continuityRejected);
+    EXPECT_GE(correlated.core.continuityRejected, laser.core.continuityRejected);
+    const Outcome both = run("walk", {});
+    EXPECT_GT(laser.cells, 5000u);
+    EXPECT_LT(double(laser.core.continuityRejected), 0.05 * double(laser.stats.laser.kept));
+    for (const Outcome* o : {&laser, &correlated, &both})
         EXPECT_GT(double(o->within3Sigma) / double(o->cells), 0.8);
 }
