@@ -4,7 +4,10 @@
  *   tests/fill/compare_fill coverage       sigma coverage on held-out gaps (other placements)
  *   tests/fill/compare_fill accuracy       RMSE: Gaussian vs median vs cv::inpaint
  *   tests/fill/compare_fill accuracy-mrf   the same plus MRPT's CHeightGridMap2D_MRF (minutes)
+ * Further arguments `fill_key=value` (ini keys of FillOptions) change the options every mode
+ * starts from, e.g. `compare_fill accuracy fill_extrapolation_margin=1.0`.
  * Every figure of doc/gap-filling.md comes from these commands. */
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CHeightGridMap2D_MRF.h>
 
 #include <algorithm>
@@ -120,15 +123,18 @@ std::vector<Err> flatten(const std::map<int, std::vector<Err>>& m) {
     return all;
 }
 
+/** The options every mode starts from: the defaults, changed by `fill_key=value` arguments. */
+FillOptions g_base;
+
 int calibrate(const std::vector<Board>& boards) {
-    FillOptions o0, o1;
+    FillOptions o0 = g_base, o1 = g_base;
     o0.sigmaFloor_m = o1.sigmaFloor_m = 0;
     o0.medianSigmaGain = o0.gaussianSigmaGain = 0;
     o1.medianSigmaGain = o1.gaussianSigmaGain = 1;
     std::map<int, std::vector<Err>> g0, m0, g1, m1;
     runCalibrationSet(boards, o0, 1, g0, m0);
     runCalibrationSet(boards, o1, 1, g1, m1);
-    const FillOptions def;
+    const FillOptions def = g_base;
     std::printf("calibration set (seed 1): %zu Gaussian cells, %zu median cells\n",
                 flatten(g0).size(), flatten(m0).size());
     std::printf("fill_gaussian_sigma_gain = %.3f\n",
@@ -140,7 +146,7 @@ int calibrate(const std::vector<Board>& boards) {
 
 int coverage(const std::vector<Board>& boards) {
     for (auto model : {FillSigmaModel::Calibrated, FillSigmaModel::Paper}) {
-        FillOptions opt;
+        FillOptions opt = g_base;
         opt.sigmaModel = model;
         std::map<int, std::vector<Err>> gauss, med;
         runCalibrationSet(boards, opt, 2, gauss, med);  // seed 2: placements unseen by calibrate
@@ -231,8 +237,8 @@ std::vector<double> heights(const FillResult& f) {
 
 int accuracy(const std::vector<Board>& boards, bool withMrf) {
     using Method = std::function<std::vector<double>(const HeightRaster&)>;
-    const FillOptions opt;
-    FillOptions pure, bic;
+    const FillOptions opt = g_base;
+    FillOptions pure = opt, bic = opt;
     pure.residualCorrection = false;
     bic.criterion = ModelCriterion::BIC;
     FillOptions holdout = opt;
@@ -324,6 +330,15 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
 int main(int argc, char** argv) {
     const std::string mode = argc > 1 ? argv[1] : "";
     try {
+        mrpt::config::CConfigFileMemory ini;
+        for (int a = 2; a < argc; a++) {
+            const std::string kv = argv[a];
+            const auto eq = kv.find('=');
+            if (eq == std::string::npos)
+                throw std::invalid_argument("expected fill_key=value, got '" + kv + "'");
+            ini.write("fill", kv.substr(0, eq), kv.substr(eq + 1));
+        }
+        g_base.loadFromConfigFile(ini, "fill");
         const auto boards = loadBoards();
         if (mode == "calibrate") return calibrate(boards);
         if (mode == "coverage") return coverage(boards);
@@ -333,6 +348,8 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "compare_fill: %s\n", e.what());
         return 1;
     }
-    std::fprintf(stderr, "usage: compare_fill calibrate|coverage|accuracy|accuracy-mrf\n");
+    std::fprintf(
+        stderr,
+        "usage: compare_fill calibrate|coverage|accuracy|accuracy-mrf [fill_key=value ...]\n");
     return 2;
 }
