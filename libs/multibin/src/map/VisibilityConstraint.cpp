@@ -13,6 +13,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     const double cell = grid.cellSize_m();
     const double step = 0.5 * cell;
     const double maxStoredHeight = grid.maxHeight_m();
+    const double stopHeight = maxStoredHeight + vis.margin_m;  // hoisted: editBins writes memory
+    const double invCell = 1.0 / cell;                         // computed as BinGrid's own [1/m]
+    constexpr double kNoClamp = 1e8;  // [cells]; cellIndex() clamps beyond 5.3e8
     auto conflictMargin = [&](const Bin& b) {
         return vis.margin_m + 3.0 * BinGrid::sigma_m(b, binParams);
     };
@@ -50,12 +53,22 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         // The ray's highest point within a cell lies at most half a diagonal from a sample.
         const double inCellRise = std::abs(slope) * 0.7072 * cell;
         const double ux = dx / length, uy = dy / length;  // unit direction towards the sensor
+        // Every sample lies between the cell centre and the sensor; unless the sensor is absurdly
+        // far away, no sample reaches the range where BinGrid::cellIndex() clamps, and its floor
+        // alone gives the same index.
+        const bool unclamped = std::abs(sensor_m.x() * invCell) < kNoClamp &&
+                               std::abs(sensor_m.y() * invCell) < kNoClamp &&
+                               std::abs(tx * invCell) < kNoClamp &&
+                               std::abs(ty * invCell) < kNoClamp;
+        auto cellOf = [&](double coord_m) {
+            return unclamped ? BinGrid::floorToInt(coord_m * invCell) : grid.cellIndex(coord_m);
+        };
         int lastIx = u.ix, lastIy = u.iy;
         for (double d = step; d < length; d += step) {
             const double rayZ = tz + slope * d;
-            if (slope > 0 && rayZ - inCellRise > maxStoredHeight + vis.margin_m) break;
-            const int ix = grid.cellIndex(tx + ux * d);
-            const int iy = grid.cellIndex(ty + uy * d);
+            if (slope > 0 && rayZ - inCellRise > stopHeight) break;
+            const int ix = cellOf(tx + ux * d);
+            const int iy = cellOf(ty + uy * d);
             if (ix == lastIx && iy == lastIy) continue;
             lastIx = ix;
             lastIy = iy;
