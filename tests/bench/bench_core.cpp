@@ -140,6 +140,43 @@ static void BM_InsertWithCovariancePropagation(benchmark::State& state) {
 }
 BENCHMARK(BM_InsertWithCovariancePropagation)->Arg(307200)->Unit(benchmark::kMillisecond);
 
+// The same with BinGrid::insertSensorPoints: propagation and bin update fused block by block, so
+// the 11 MB of map-frame points are never written out and read back.
+static void BM_InsertSensorPointsFused(benchmark::State& state) {
+    const Frame f(size_t(state.range(0)));
+    BinGrid grid = frameGrid();
+    const BinUpdateParams params;
+    {  // The fused path must give the two-step result (to rounding) before it is timed.
+        BinGrid twoStep = frameGrid();
+        twoStep.insertPoints(f.mapPoints, params);
+        const InsertStats s = grid.insertSensorPoints(f.propagator, f.sensorPoints, params);
+        const CellWindow& w = grid.window();
+        size_t differ = grid.binCount() == twoStep.binCount() ? 0 : 1;
+        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+                const Bin *a = grid.winningBin(ix, iy), *b = twoStep.winningBin(ix, iy);
+                if (!a || !b) {
+                    differ += (a != nullptr) != (b != nullptr);
+                    continue;
+                }
+                differ += a->pointCount != b->pointCount ||
+                          std::abs(a->height_m - b->height_m) > 1e-6f ||
+                          std::abs(a->variance_m2 - b->variance_m2) > 1e-6f * b->variance_m2;
+            }
+        if (differ != 0 || s.accepted == 0) {
+            state.SkipWithError("fused insertion differs from apply() + insertPoints()");
+            return;
+        }
+        grid = frameGrid();
+    }
+    for (auto _ : state) {
+        grid.beginCycle();
+        benchmark::DoNotOptimize(grid.insertSensorPoints(f.propagator, f.sensorPoints, params));
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()) * state.range(0));
+}
+BENCHMARK(BM_InsertSensorPointsFused)->Arg(307200)->Unit(benchmark::kMillisecond);
+
 // The same map-frame points into MRPT's CHeightGridMap2D (a plain running mean per cell).
 static void BM_MrptHeightGridInsertIndividualPoint(benchmark::State& state) {
     const Frame f(size_t(state.range(0)));
@@ -149,16 +186,18 @@ static void BM_MrptHeightGridInsertIndividualPoint(benchmark::State& state) {
 }
 BENCHMARK(BM_MrptHeightGridInsertIndividualPoint)->Arg(307200)->Unit(benchmark::kMillisecond);
 
-// The ratio in one loop: every iteration runs propagation + bin update and then MRPT's insertion
-// of the same points, each timed, so machine noise hits both alike. Counters: throughput of each
-// [points/s] and ratio = multibin / MRPT (target >= 0.3).
+// The ratio in one loop: every iteration runs propagation + bin update (two steps, as the map
+// does today), MRPT's insertion of the same points, and the fused path, each timed in thread CPU
+// time, so machine noise hits all alike. Counters: throughput of each [points/s] and
+// ratio = multibin / MRPT (target >= 0.3), ratio_fused likewise for the fused path.
 static void BM_RatioToMrptSameLoop(benchmark::State& state) {
     const Frame f(size_t(state.range(0)));
     BinGrid grid = frameGrid();
     auto mrpt = mrptGridForFrame();
     const BinUpdateParams params;
     PointsWithCov mapPts;
-    double tOurs = 0, tMrpt = 0;
+    BinGrid fused = frameGrid();
+    double tOurs = 0, tMrpt = 0, tFused = 0;
     for (auto _ : state) {
         const auto t0 = Clock::now();
         f.propagator.apply(f.sensorPoints, mapPts);
@@ -167,13 +206,19 @@ static void BM_RatioToMrptSameLoop(benchmark::State& state) {
         const auto t1 = Clock::now();
         mrptInsert(mrpt, f.mapPoints);
         const auto t2 = Clock::now();
+        fused.beginCycle();
+        benchmark::DoNotOptimize(fused.insertSensorPoints(f.propagator, f.sensorPoints, params));
+        const auto t3 = Clock::now();
         tOurs += seconds(t0, t1);
         tMrpt += seconds(t1, t2);
+        tFused += seconds(t2, t3);
     }
     const double n = double(state.iterations()) * double(state.range(0));
     state.counters["multibin_pts_per_s"] = n / tOurs;
     state.counters["mrpt_pts_per_s"] = n / tMrpt;
     state.counters["ratio"] = tMrpt / tOurs;
+    state.counters["fused_pts_per_s"] = n / tFused;
+    state.counters["ratio_fused"] = tMrpt / tFused;
 }
 BENCHMARK(BM_RatioToMrptSameLoop)->Arg(307200)->Unit(benchmark::kMillisecond);
 

@@ -1,6 +1,10 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/BinGrid.h"
 
+#include <array>
+
+#include "multibin/PosePropagation.h"
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -242,6 +246,25 @@ struct ClassifiedBlock {
 
 InsertStats BinGrid::insertPoints(const PointsWithCov& mapPoints, const BinUpdateParams& params,
                                   double continuityBound_m) {
+    return insertPoints(mapPoints.data(), mapPoints.size(), params, continuityBound_m);
+}
+
+InsertStats BinGrid::insertSensorPoints(const PosePropagator& propagator,
+                                        const PointsWithCov& sensorPoints,
+                                        const BinUpdateParams& params, double continuityBound_m) {
+    constexpr size_t kChunk = 1024;  // 36 kB of map-frame points: stays in the L1/L2 cache
+    std::array<PointWithCov, kChunk> mapPoints;
+    InsertStats stats;
+    for (size_t begin = 0; begin < sensorPoints.size(); begin += kChunk) {
+        const size_t m = std::min(kChunk, sensorPoints.size() - begin);
+        propagator.apply(sensorPoints.data() + begin, mapPoints.data(), m);
+        stats += insertPoints(mapPoints.data(), m, params, continuityBound_m);
+    }
+    return stats;
+}
+
+InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
+                                  const BinUpdateParams& params, double continuityBound_m) {
     InsertStats stats;
     // Eq 14 compares each laser point with the bin height left by the previous point, so with a
     // finite bound points are fused one by one. Without it (stereo, depth: eq 13 only) a run of
@@ -279,10 +302,9 @@ InsertStats BinGrid::insertPoints(const PointsWithCov& mapPoints, const BinUpdat
     };
 
     ClassifiedBlock cb;
-    const size_t count = mapPoints.size();
     for (size_t begin = 0; begin < count; begin += kBlock) {
         const size_t m = std::min(kBlock, count - begin);
-        const PointWithCov* pts = mapPoints.data() + begin;
+        const PointWithCov* pts = mapPoints + begin;
         // Pass 1, no bin access: validity, gates that need only the point, cell and bin index.
         for (size_t i = 0; i < m; i++) {
             const PointWithCov& p = pts[i];
