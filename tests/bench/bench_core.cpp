@@ -8,7 +8,9 @@
 
 #include <time.h>
 
+#include <cstring>
 #include <random>
+#include <thread>
 
 #include "multibin/BinGrid.h"
 #include "multibin/PosePropagation.h"
@@ -110,6 +112,29 @@ static void BM_Propagate(benchmark::State& state) {
     state.SetItemsProcessed(int64_t(state.iterations()) * state.range(0));
 }
 BENCHMARK(BM_Propagate)->Arg(307200)->Unit(benchmark::kMillisecond);
+
+// Propagation on two threads, each taking half of the frame through the pointer-range apply():
+// the per-point work is independent, so the output is bit-identical to one thread. Shows what a
+// second core gives; the library itself stays single-threaded (callers choose).
+static void BM_PropagateTwoThreads(benchmark::State& state) {
+    const Frame f(size_t(state.range(0)));
+    PointsWithCov out(f.sensorPoints.size());
+    const size_t half = f.sensorPoints.size() / 2;
+    for (auto _ : state) {
+        std::thread second([&] {
+            f.propagator.apply(f.sensorPoints.data() + half, out.data() + half,
+                               f.sensorPoints.size() - half);
+        });
+        f.propagator.apply(f.sensorPoints.data(), out.data(), half);
+        second.join();
+        benchmark::DoNotOptimize(out.data());
+        benchmark::ClobberMemory();
+    }
+    if (std::memcmp(out.data(), f.mapPoints.data(), out.size() * sizeof(PointWithCov)) != 0)
+        state.SkipWithError("two-thread propagation differs from one thread");
+    state.SetItemsProcessed(int64_t(state.iterations()) * state.range(0));
+}
+BENCHMARK(BM_PropagateTwoThreads)->Arg(307200)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 // The bin update alone (gates, eq 15 Kalman, update-cycle bookkeeping) of map-frame points.
 static void BM_BinUpdate(benchmark::State& state) {
