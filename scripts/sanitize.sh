@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# CI stage 2: one clang build with AddressSanitizer + UndefinedBehaviorSanitizer (+ libFuzzer
+# instrumentation) into build-asan/, the fast test suite under it, then the fuzz corpora replayed
+# and each libFuzzer target fuzzed for a short while. See doc/reliability.md.
+#   FUZZ_SECONDS  seconds of fuzzing per target (default 30; 0 = replay the corpora only)
+#   MULTIBIN_ASAN_BUILD_DIR  build directory (default build-asan/)
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build_dir=${MULTIBIN_ASAN_BUILD_DIR:-$root/build-asan}
+fuzz_seconds=${FUZZ_SECONDS:-30}
+jobs=$(nproc)
+
+# The packages of scripts/setup.sh, plus clang with its sanitizer/libFuzzer runtimes and
+# llvm-symbolizer (readable stack traces). Only missing ones are installed.
+packages=(g++ cmake ninja-build pkg-config libmrpt-dev mrpt-apps mrpt-common libeigen3-dev
+          libopencv-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
+          clang libclang-rt-14-dev llvm)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "Installing missing Debian packages: ${missing[*]}"
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null
+fi
+
+# -O1 -g without NDEBUG: Eigen's and the library's assertions stay on. Every sanitizer finding is
+# fatal (-fno-sanitize-recover), so a test that triggers one fails.
+san="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer"
+CC=clang CXX=clang++ cmake -S "$root" -B "$build_dir" -G Ninja \
+  -DCMAKE_BUILD_TYPE=Sanitize \
+  -DCMAKE_C_FLAGS_SANITIZE="-O1 -g $san" -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g $san" \
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+  -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
+  -DMULTIBIN_BUILD_APPS=ON -DMULTIBIN_FUZZ=ON -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=ON >/dev/null
+cmake --build "$build_dir" -j "$jobs"
+
+export ASAN_SYMBOLIZER_PATH=${ASAN_SYMBOLIZER_PATH:-$(command -v llvm-symbolizer || true)}
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/tests/fuzz/lsan.supp:print_suppressions=0}
+
+# Left out of this run:
+# - label slow: minutes even without sanitizers (the gcc stage skips them too);
+# - label install: builds doc/example-consumer with the default flags against this ASan library;
+# - MrptTools.*: preloads the ASan-built library into MRPT's stock observations2map, which is not
+#   built with ASan (the runtime would have to come first in the process); the gcc stage runs it.
+ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -LE 'slow|install' \
+  -E '^MrptTools\.'
+
+# Fuzz targets: replay the committed corpora (every input once), then fuzz each for a while.
+# New inputs go to a scratch corpus in the build tree; the committed ones stay as they are.
+for target in map_deserialize ini_options observation_insert; do
+  exe="$build_dir/tests/fuzz/fuzz_$target"
+  corpus="$root/tests/fuzz/corpus/$target"
+  scratch="$build_dir/fuzz-corpus/$target"
+  mkdir -p "$scratch"
+  echo "== fuzz_$target: replay $(ls "$corpus" | wc -l) inputs"
+  "$exe" -runs=0 "$corpus" 2>&1 | tail -n 2
+  if [ "$fuzz_seconds" -gt 0 ]; then
+    echo "== fuzz_$target: fuzz ${fuzz_seconds} s"
+    "$exe" -max_total_time="$fuzz_seconds" -jobs=1 -workers=1 -print_final_stats=1 \
+      -artifact_prefix="$build_dir/fuzz-" "$scratch" "$corpus" 2>&1 |
+      grep -E '^(#[0-9]+.*DONE|stat::number_of_executed_units|stat::peak_rss_mb|==[0-9]+==ERROR|SUMMARY)' || true
+    test "${PIPESTATUS[0]}" -eq 0
+  fi
+done
+echo "sanitize.sh: all clean"

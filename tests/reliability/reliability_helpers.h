@@ -1,0 +1,89 @@
+/* Helpers of the bad-input tests: a map with data in it, its content for "nothing lost"
+ * comparisons, and synthetic observations. */
+#pragma once
+
+#include <mrpt/core/bits_math.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cmath>
+#include <tuple>
+#include <vector>
+
+namespace reliability {
+
+using Map = mrpt::maps::CMultiBinElevationMap;
+
+/** The map's bytes as CArchive writes them (options and both grids). */
+inline std::vector<uint8_t> serialize(const Map& map) {
+    mrpt::io::CMemoryStream mem;
+    auto arch = mrpt::serialization::archiveFrom(mem);
+    arch << map;
+    const auto* p = static_cast<const uint8_t*>(mem.getRawBufferData());
+    return std::vector<uint8_t>(p, p + mem.getTotalBytesCount());
+}
+
+/** One bin with the cell it belongs to: (grid, ix, iy, index, height, variance, certainty). */
+using BinRecord = std::tuple<int, int, int, int, float, float, float, uint32_t>;
+
+/** Everything the map knows, independent of its window (which may legitimately grow): every bin
+ * of every non-empty cell of both grids. */
+inline std::vector<BinRecord> content(const Map& map) {
+    std::vector<BinRecord> out;
+    int gi = 0;
+    for (const multibin::BinGrid* g : {&map.grid(), &map.localGrid()}) {
+        const multibin::CellWindow& w = g->window();
+        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
+                g->forEachBin(ix, iy, [&](const multibin::Bin& b) {
+                    out.emplace_back(gi, ix, iy, b.index, b.height_m, b.variance_m2, b.certainty,
+                                     b.pointCount);
+                });
+        gi++;
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+/** A pitched URG-04LX-like scan of the floor z = 0 from 0.26 m (683 beams over 240 deg). */
+inline mrpt::obs::CObservation2DRangeScan::Ptr floorScan(size_t beams = 683) {
+    auto scan = mrpt::obs::CObservation2DRangeScan::Create();
+    scan->sensorLabel = "LASER";
+    scan->aperture = float(mrpt::DEG2RAD(240.0));
+    scan->maxRange = 4.0f;
+    const double h = 0.26, pitch = mrpt::DEG2RAD(45.0);
+    scan->sensorPose = mrpt::poses::CPose3D(0, 0, h, 0, pitch, 0);
+    scan->resizeScan(beams);
+    for (size_t i = 0; i < beams; i++) {
+        const double a =
+            beams > 1 ? -0.5 * scan->aperture + scan->aperture * double(i) / double(beams - 1) : 0;
+        const mrpt::math::TVector3D d =
+            scan->sensorPose.rotateVector(mrpt::math::TVector3D(std::cos(a), std::sin(a), 0));
+        const double t = d.z < -1e-3 ? h / -d.z : 100.0;
+        const bool valid = t < scan->maxRange;
+        scan->setScanRange(i, valid ? float(t) : 0.f);
+        scan->setScanRangeValidity(i, valid);
+    }
+    return scan;
+}
+
+/** A robot pose PDF with a small diagonal covariance. */
+inline mrpt::poses::CPose3DPDFGaussian posePdf(double x_m = 0, double y_m = 0) {
+    mrpt::poses::CPose3DPDFGaussian pdf;
+    pdf.mean = mrpt::poses::CPose3D(x_m, y_m, 0, 0, 0, 0);
+    pdf.cov.setZero();
+    for (int i = 0; i < 3; i++) pdf.cov(i, i) = 1e-6;  // 1 mm
+    for (int i = 3; i < 6; i++) pdf.cov(i, i) = 1e-6;  // 1 mrad
+    return pdf;
+}
+
+/** A map that already holds a floor seen by one good scan. */
+inline Map mapWithData(const Map::TCreationOptions& c = Map::TCreationOptions()) {
+    Map map(c);
+    map.insertObservation(*floorScan(), posePdf());
+    return map;
+}
+
+}  // namespace reliability
