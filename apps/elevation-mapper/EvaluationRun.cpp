@@ -159,8 +159,9 @@ MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBin
     return m;
 }
 
-std::string EvaluationRun::finish(const std::string& outDir, double multibinInsert_s) {
-    for (CMultiBinElevationMap* map : {&m_evaluated, &m_laserOnly}) map->flushLocalToGlobal();
+std::string EvaluationRun::finish(const std::string& outDir, double multibinInsert_s,
+                                  double multibinFill_s) {
+    m_laserOnly.flushLocalToGlobal();
 
     std::vector<MethodEstimate> methods;
     MethodEstimate rawLaser{"raw_laser", m_rawLaser.heights_m(), {}, "raw_laser", m_raw_s, 0};
@@ -178,12 +179,10 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
     multibin.insert_s = multibinInsert_s;
     methods.push_back(multibin);
 
-    const auto fill0 = Clock::now();
-    m_evaluated.dem_update_map();  // gap filling runs here (lazily, once)
     MethodEstimate filled = sampleMap("multibin_filled", m_evaluated, true);
     filled.baseline = "raw_all";
     filled.insert_s = multibin.insert_s;
-    filled.fill_s = secondsSince(fill0);
+    filled.fill_s = multibinFill_s;
     methods.push_back(filled);
 
     MethodEstimate heightGrid;
@@ -222,18 +221,22 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
     const auto scores = multibin::eval::scoreMethods(m_truth, methods);
     std::vector<std::string> order;
     for (const auto& m : methods) order.push_back(m.name);
+    std::vector<multibin::eval::AreaScores> areas;
+    if (m_mrf)  // every method on the GMRF's crop only
+        areas.push_back(
+            multibin::eval::scoreArea("mrf_crop", m_truth, methods, m_lattice, m_mrfLattice));
 
     const fs::path out = outDir;
     {
         std::ofstream f(out / "report.json");
-        f << multibin::eval::reportJson(scores, order, m_lattice);
+        f << multibin::eval::reportJson(scores, order, m_lattice, areas);
         if (!f) throw std::runtime_error("cannot write '" + (out / "report.json").string() + "'");
     }
     rasterOf(m_lattice, m_truth).save((out / "eval_truth.asc").string());
     for (const auto& m : methods)
         rasterOf(m_lattice, m.height_m).save((out / ("eval_" + m.name + ".asc")).string());
     writeProfile((out / "profile.csv").string(), m_truth, methods);
-    return multibin::eval::reportTable(scores, order);
+    return multibin::eval::reportTable(scores, order, areas);
 }
 
 void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth,

@@ -40,9 +40,10 @@ public:
     void observe(const mrpt::obs::CObservation& obs,
                  const mrpt::poses::CPose3DPDFGaussian& robotPose, bool poseHasCovariance);
 
-    /** Fills, scores and writes report.json, profile.csv and the per-method rasters into outDir;
-     * returns the text table. `multibinInsert_s` is the evaluated map's insertion time [s]. */
-    std::string finish(const std::string& outDir, double multibinInsert_s);
+    /** Scores and writes report.json, profile.csv and the per-method rasters into outDir; returns
+     * the text table. The evaluated map must be filled already (dem_update_map()); its insertion
+     * and fill times [s] go into the report. */
+    std::string finish(const std::string& outDir, double multibinInsert_s, double multibinFill_s);
 
 private:
     void insertRawPoints(const mrpt::obs::CObservation& obs,

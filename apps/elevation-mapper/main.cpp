@@ -142,6 +142,7 @@ void drawFigures(const fs::path& out) {
         return;
     }
     const std::string cmd = python + " '" + script + "' '" + out.string() + "'";
+    std::cout.flush();
     if (std::system(cmd.c_str()) != 0)
         std::cerr << "elevation-mapper: warning: figures not drawn: '" << cmd << "' failed\n";
 }
@@ -234,11 +235,12 @@ int run(const Arguments& args) {
 
     fs::create_directories(args.out);
     const fs::path out = args.out;
-    std::string table;
-    if (evaluation) table = evaluation->finish(out.string(), insert_s);  // fills the map too
+    elevation->flushLocalToGlobal();  // dual grid: the global grid holds the whole run
     const auto fill0 = Clock::now();
-    elevation->dem_update_map();  // gap filling (a no-op if the evaluation already filled)
+    elevation->dem_update_map();  // gap filling, once
     const double fill_s = std::chrono::duration<double>(Clock::now() - fill0).count();
+    std::string table;
+    if (evaluation) table = evaluation->finish(out.string(), insert_s, fill_s);
     {
         mrpt::io::CFileGZOutputStream f;
         if (!f.open((out / "elevation_map.bin").string()))

@@ -127,3 +127,19 @@ TEST(Exports, PlyMeshHasOneVertexPerKnownCellAndTwoTrianglesPerKnownQuad) {
     EXPECT_NE(text.find("element face 7\n"), std::string::npos);
     std::filesystem::remove(path);
 }
+
+TEST(Evaluation, AreaScoresCountOnlyTheCellsOfTheSubArea) {
+    const CellArray truth = array2x2(0, 0, 0, 0);
+    EvalLattice L;
+    L.cellSize_m = 1;
+    L.nx = L.ny = 2;
+    EvalLattice crop = L;
+    crop.ix0 = 1;  // the right column: cells (r, 1)
+    crop.nx = 1;
+    const std::vector<MethodEstimate> methods{
+        {"m", array2x2(0.5f, 0.1f, 0.5f, 0.2f), {}, "m", 0, 0}};
+    const AreaScores a = scoreArea("crop", truth, methods, L, crop);
+    EXPECT_EQ(a.errors.at("m").cells, 2u);
+    EXPECT_NEAR(a.errors.at("m").mse_m2, (0.01 + 0.04) / 2, 1e-7);
+    EXPECT_EQ(a.area_m, (std::vector<double>{1, 2, 0, 2}));
+}

@@ -148,8 +148,26 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
     return scores;
 }
 
+AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
+                     const std::vector<MethodEstimate>& methods, const EvalLattice& lattice,
+                     const EvalLattice& area) {
+    Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> mask(lattice.ny, lattice.nx);
+    for (int r = 0; r < lattice.ny; r++)
+        for (int c = 0; c < lattice.nx; c++) {
+            const int ix = lattice.ix0 + c, iy = lattice.iy0 + r;
+            mask(r, c) = ix >= area.ix0 && ix < area.ix0 + area.nx && iy >= area.iy0 &&
+                         iy < area.iy0 + area.ny;
+        }
+    AreaScores a;
+    a.name = name;
+    a.area_m = area.area_m();
+    for (const auto& m : methods) a.errors[m.name] = meanSquaredError(m.height_m, truth_m, &mask);
+    return a;
+}
+
 std::string reportJson(const std::map<std::string, MethodScore>& scores,
-                       const std::vector<std::string>& order, const EvalLattice& lattice) {
+                       const std::vector<std::string>& order, const EvalLattice& lattice,
+                       const std::vector<AreaScores>& areas) {
     // NaN is not JSON: unknown values are written as null.
     auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
     nlohmann::ordered_json methods = nlohmann::ordered_json::object();
@@ -168,11 +186,23 @@ std::string reportJson(const std::map<std::string, MethodScore>& scores,
     }
     nlohmann::ordered_json report = {
         {"methods", methods}, {"cell_size_m", lattice.cellSize_m}, {"area_m", lattice.area_m()}};
+    for (const AreaScores& a : areas) {
+        nlohmann::ordered_json rmse = nlohmann::ordered_json::object(),
+                               cells = nlohmann::ordered_json::object();
+        for (const std::string& name : order) {
+            const auto it = a.errors.find(name);
+            if (it == a.errors.end()) continue;
+            rmse[name] = number(std::sqrt(it->second.mse_m2));
+            cells[name] = it->second.cells;
+        }
+        report[a.name] = {{"area_m", a.area_m}, {"rmse_m", rmse}, {"cells", cells}};
+    }
     return report.dump(2) + "\n";
 }
 
 std::string reportTable(const std::map<std::string, MethodScore>& scores,
-                        const std::vector<std::string>& order) {
+                        const std::vector<std::string>& order,
+                        const std::vector<AreaScores>& areas) {
     std::ostringstream os;
     char line[256];
     std::snprintf(line, sizeof line, "%-22s %10s %7s %9s %9s %9s %9s %8s\n", "method", "rmse [mm]",
@@ -188,6 +218,18 @@ std::string reportTable(const std::map<std::string, MethodScore>& scores,
                       name.c_str(), 1000 * s.rmse_m, s.pi, s.piShared, s.coverage, within,
                       s.insert_s, s.fill_s);
         os << line;
+    }
+    for (const AreaScores& a : areas) {
+        std::snprintf(line, sizeof line, "RMSE [mm] over %s x [%.3f, %.3f] y [%.3f, %.3f] m:\n",
+                      a.name.c_str(), a.area_m[0], a.area_m[1], a.area_m[2], a.area_m[3]);
+        os << line;
+        for (const std::string& name : order) {
+            const auto it = a.errors.find(name);
+            if (it == a.errors.end()) continue;
+            std::snprintf(line, sizeof line, "  %-22s %10.2f (%zu cells)\n", name.c_str(),
+                          1000 * std::sqrt(it->second.mse_m2), it->second.cells);
+            os << line;
+        }
     }
     return os.str();
 }

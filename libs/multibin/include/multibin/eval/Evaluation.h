@@ -92,12 +92,27 @@ struct MethodScore {
 std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
                                                 const std::vector<MethodEstimate>& methods);
 
+/** Errors of every method over a sub-area only (e.g. the crop MRPT's GMRF map is solved on). */
+struct AreaScores {
+    std::string name;            //!< what the area is, e.g. "mrf_crop"
+    std::vector<double> area_m;  //!< {xmin, xmax, ymin, ymax} [m]
+    std::map<std::string, SquaredError> errors;
+};
+/** Scores the methods over the cells of `area` (a sub-lattice of `lattice`). */
+AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
+                     const std::vector<MethodEstimate>& methods, const EvalLattice& lattice,
+                     const EvalLattice& area);
+
 /** report.json: {"methods": {name: {rmse_m, pi, pi_shared, coverage, within_3sigma, insert_s,
- * fill_s, valid_cells}}, "cell_size_m", "area_m": [xmin, xmax, ymin, ymax]}; methods in `order`. */
+ * fill_s, valid_cells}}, "cell_size_m", "area_m": [xmin, xmax, ymin, ymax]}; methods in `order`.
+ * Each sub-area adds {"<name>": {"area_m": [...], "rmse_m": {method: x}, "cells": {method: n}}}.
+ */
 std::string reportJson(const std::map<std::string, MethodScore>& scores,
-                       const std::vector<std::string>& order, const EvalLattice& lattice);
+                       const std::vector<std::string>& order, const EvalLattice& lattice,
+                       const std::vector<AreaScores>& areas = {});
 /** The same numbers as a fixed-width text table. */
 std::string reportTable(const std::map<std::string, MethodScore>& scores,
-                        const std::vector<std::string>& order);
+                        const std::vector<std::string>& order,
+                        const std::vector<AreaScores>& areas = {});
 
 }  // namespace multibin::eval
