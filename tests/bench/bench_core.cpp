@@ -300,11 +300,14 @@ static void BM_VisibilityShare(benchmark::State& state) {
 }
 BENCHMARK(BM_VisibilityShare)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
-// Moving the window by one cell in x on a full map of ny = 133 rows and nx columns: 133 cells
-// enter whatever nx is, so the time must stay flat as nx grows 30-fold (133 -> 4000). Every
-// entering slot holds a leaving cell with one bin (refilled between moves, outside the timing:
-// manual time covers moveWindowTo only).
-static void BM_MoveWindowOneCell(benchmark::State& state) {
+// Moving the window by one cell on a full map of ny = 133 rows and nx columns (one bin per cell,
+// refilled between moves outside the timing: manual time covers moveWindowTo only, with its
+// leaver callback, the dual grid's write-back hook).
+// - BM_MoveWindowOneCell/nx moves in x: 133 cells enter whatever nx is, so the time must stay
+//   flat as the map grows 30-fold (nx 133 -> 4000);
+// - BM_MoveWindowOneRow/nx moves in y: nx cells enter, so the time must grow with nx and the time
+//   per entering cell stay flat.
+static void moveWindowBenchmark(benchmark::State& state, bool alongX) {
     const int nx = int(state.range(0)), ny = 133;
     BinGrid grid(kCell_m);
     grid.reset(kCell_m, CellWindow{0, 0, nx, ny});
@@ -314,70 +317,86 @@ static void BM_MoveWindowOneCell(benchmark::State& state) {
     for (int iy = 0; iy < ny; iy++)
         for (int ix = 0; ix < nx; ix++)
             grid.insertHeight(ix, iy, 0.01 * ((ix + iy) % 7), 1e-4, params, inf, stats);
-    int x0 = 0;
+    int x0 = 0, y0 = 0;
     size_t leavers = 0;
     for (auto _ : state) {
-        x0 += 1;
+        (alongX ? x0 : y0) += 1;
         const auto t0 = Clock::now();
-        grid.moveWindowTo(x0, 0, [&](int, int) { leavers++; });  // the dual grid's write-back hook
+        grid.moveWindowTo(x0, y0, [&](int, int) { leavers++; });
         const auto t1 = Clock::now();
         state.SetIterationTime(seconds(t0, t1));
-        const int enteringX = x0 + nx - 1;  // refill, so the next move clears full cells again
-        for (int iy = 0; iy < ny; iy++)
-            grid.insertHeight(enteringX, iy, 0.01, 1e-4, params, inf, stats);
+        // Refill the entering cells, so the next moves clear full cells again.
+        if (alongX)
+            for (int iy = y0; iy < y0 + ny; iy++)
+                grid.insertHeight(x0 + nx - 1, iy, 0.01, 1e-4, params, inf, stats);
+        else
+            for (int ix = x0; ix < x0 + nx; ix++)
+                grid.insertHeight(ix, y0 + ny - 1, 0.01, 1e-4, params, inf, stats);
     }
+    const int entering = alongX ? ny : nx;
     state.counters["map_cells"] = double(nx) * ny;
-    state.counters["entering_cells"] = ny;
+    state.counters["entering_cells"] = entering;
     state.counters["leavers_per_move"] = double(leavers) / double(state.iterations());
     state.counters["ns_per_entering_cell"] =
-        benchmark::Counter(double(ny) * double(state.iterations()) * 1e-9,
+        benchmark::Counter(double(entering) * double(state.iterations()) * 1e-9,
                            benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
+static void BM_MoveWindowOneCell(benchmark::State& state) { moveWindowBenchmark(state, true); }
 BENCHMARK(BM_MoveWindowOneCell)
     ->Arg(133)
     ->Arg(1000)
     ->Arg(4000)
     ->UseManualTime()
     ->Unit(benchmark::kMicrosecond);
+static void BM_MoveWindowOneRow(benchmark::State& state) { moveWindowBenchmark(state, false); }
+BENCHMARK(BM_MoveWindowOneRow)
+    ->Arg(133)
+    ->Arg(1000)
+    ->Arg(4000)
+    ->UseManualTime()
+    ->Unit(benchmark::kMicrosecond);
 
-// Memory: a 2 x 2 m floor at 15 mm cells observed by one frame, then the same plus a few points
-// at +-400 m (a vertical extent of 800 m in 16000 bin heights): only the bins observed cost.
-// Counters [bytes]: total, per bin including the per-cell overhead, and the growth from the
-// tall extent.
+// Memory of a 2 x 2 m grid at 15 mm (133 x 133 cells) after 200000 points. Arg 0: a floor, all
+// points in one bin level; arg 1: the same points with each cell's height drawn from +-400 m
+// (16000 bin levels spanned, one bin per cell as on the floor); arg 2: the floor plus a second
+// bin in every cell (twice the observed bins). Memory must follow the observed bins (arg 2
+// against 0) and ignore the vertical extent (arg 1 equal to 0). Counters [bytes]: total, per
+// observed bin (including the 12 B per cell and the pool vector's spare capacity), per cell.
 static void BM_Memory(benchmark::State& state) {
-    size_t floorBytes = 0, tallBytes = 0, floorBins = 0, tallBins = 0, cells = 0;
+    const int mode = int(state.range(0));
+    size_t bytes = 0, bins = 0, cells = 0;
     for (auto _ : state) {
         BinGrid grid(kCell_m);
         grid.reset(kCell_m, CellWindow{-66, -66, 133, 133});
         const BinUpdateParams params;
-        PointsWithCov pts;
         std::mt19937 rng(5);
         std::uniform_real_distribution<float> u(-0.99f, 0.99f), z(0.0f, 0.04f);
-        for (int i = 0; i < 200000; i++)
-            pts.push_back(
-                {Eigen::Vector3f(u(rng), u(rng), z(rng)), {1e-6f, 0, 0, 1e-6f, 0, 1e-6f}});
-        grid.insertPoints(pts, params);
-        floorBytes = grid.memoryBytes();
-        floorBins = grid.binCount();
-        pts.clear();
-        for (int i = 0; i < 10; i++) {
-            const float h = i % 2 ? 400.f : -400.f;
-            pts.push_back(
-                {Eigen::Vector3f(0.1f * i - 0.5f, 0.2f, h), {1e-6f, 0, 0, 1e-6f, 0, 1e-6f}});
+        std::uniform_int_distribution<int> level(-8000, 7999);
+        std::vector<int> cellLevel(grid.window().cellCount());
+        for (int& l : cellLevel) l = level(rng);
+        PointsWithCov pts;
+        for (int i = 0; i < 200000; i++) {
+            const float x = u(rng), y = u(rng);
+            float h = z(rng);
+            if (mode == 1) {  // this cell's own level, 5 cm bins
+                const int ix = grid.cellIndex(x) + 66, iy = grid.cellIndex(y) + 66;
+                h += 0.05f * float(cellLevel[size_t(ix) + 133 * size_t(iy)]);
+            } else if (mode == 2 && i % 2) {
+                h += 0.5f;  // a second bin, 0.5 m up
+            }
+            pts.push_back({Eigen::Vector3f(x, y, h), {1e-6f, 0, 0, 1e-6f, 0, 1e-6f}});
         }
         grid.insertPoints(pts, params);
-        tallBytes = grid.memoryBytes();
-        tallBins = grid.binCount();
+        bytes = grid.memoryBytes();
+        bins = grid.binCount();
         cells = grid.window().cellCount();
     }
     state.counters["sizeof_Bin"] = double(sizeof(Bin));
     state.counters["cells"] = double(cells);
-    state.counters["bins_floor"] = double(floorBins);
-    state.counters["bytes_floor"] = double(floorBytes);
-    state.counters["bytes_per_bin_floor"] = double(floorBytes) / double(floorBins);
-    state.counters["bins_tall"] = double(tallBins);
-    state.counters["bytes_growth_tall"] = double(tallBytes) - double(floorBytes);
+    state.counters["bins"] = double(bins);
+    state.counters["bytes"] = double(bytes);
+    state.counters["bytes_per_bin"] = double(bytes) / double(bins);
 }
-BENCHMARK(BM_Memory)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Memory)->Arg(0)->Arg(1)->Arg(2)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();
