@@ -255,6 +255,21 @@ TEST(StereoModel, WallInFrontOfTheRobotLandsAtItsDistance) {
     // Second frame with the same calibration: no new table.
     ASSERT_TRUE(observationToSensorPoints(obs, pose, opts, 0.02, 20, state, core, sp));
     EXPECT_EQ(state.stats.stereo.tableBuilds, 1u);
+    // A second camera with another calibration gets its own table; alternating frames of the
+    // two cameras build nothing more.
+    StereoGeometry g2 = g;
+    g2.fx = g2.fy = 400;
+    auto obs2 = makeObservation(g2, disp);
+    obs2.sensorLabel = "STEREO_REAR";
+    for (int k = 0; k < 2; k++) {
+        ASSERT_TRUE(observationToSensorPoints(obs2, pose, opts, 0.02, 20, state, core, sp));
+        ASSERT_TRUE(observationToSensorPoints(obs, pose, opts, 0.02, 20, state, core, sp));
+    }
+    EXPECT_EQ(state.stats.stereo.tableBuilds, 2u);
+    // A changed sigma rebuilds.
+    opts.stereo.matchingSigma_px = 0.5;
+    ASSERT_TRUE(observationToSensorPoints(obs, pose, opts, 0.02, 20, state, core, sp));
+    EXPECT_EQ(state.stats.stereo.tableBuilds, 3u);
 }
 
 TEST(StereoModel, GroundSeenByPitchedCameraIsMappedFlat) {

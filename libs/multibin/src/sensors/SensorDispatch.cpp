@@ -48,11 +48,12 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
     if (opts.haloFilter) st.halo += removeHalos(disp, opts);
     if (opts.nearClusterFilter) st.nearCluster += removeNearClusters(disp, opts);
 
-    if (!state.stereoTable || !state.stereoTable->matches(g, opts)) {
-        state.stereoTable = std::make_shared<const StereoCovarianceTable>(g, opts);
+    auto& cached = state.stereoTables[obs.sensorLabel];
+    if (!cached || !cached->matches(g, opts)) {
+        cached = std::make_shared<const StereoCovarianceTable>(g, opts);
         st.tableBuilds++;
     }
-    const StereoCovarianceTable& table = *state.stereoTable;
+    const StereoCovarianceTable& table = *cached;
     st.pairs++;
     out.clear();
     const int step = opts.subsample;

@@ -51,12 +51,13 @@ struct SensorModelState {
         mrpt::Clock::time_point time;
     };
     std::map<std::string, PreviousScan> previousScan;  //!< by sensor label
-    /** Shared, read-only once built: copies of a map share it safely. */
-    std::shared_ptr<const StereoCovarianceTable> stereoTable;
+    /** Per-pixel covariance table of each stereo camera (by sensor label), rebuilt only when its
+     * calibration changes. Read-only once built: copies of a map share them safely. */
+    std::map<std::string, std::shared_ptr<const StereoCovarianceTable>> stereoTables;
     SensorModelStats stats;
 
-    /** Forgets the previous scans and the statistics (keeps the stereo table: it depends only on
-     * the calibration). */
+    /** Forgets the previous scans and the statistics (keeps the stereo tables: they depend only
+     * on the calibration). */
     void reset() {
         previousScan.clear();
         stats = {};
