@@ -75,6 +75,27 @@ TEST(DepthModel, MonteCarloCovarianceMatchesPropagation) {
     mc::expectConsistent(samples, pred.point_m.cast<double>(), pred.cov_m2.toMatrix());
 }
 
+TEST(DepthModel, PointArraysOfDifferentSizesAreRefused) {
+    mrpt::obs::CObservation3DRangeScan scan;
+    scan.sensorLabel = "DEPTH";
+    scan.hasPoints3D = true;
+    scan.points3D_x.assign(10, 1.0f);
+    scan.points3D_y.assign(3, 0.0f);
+    scan.points3D_z.assign(10, 0.0f);
+    PointsWithCov out;
+    DepthStats st;
+    try {
+        depthScanToPoints(scan, DepthModelOptions(), 0.02, 20, out, st);
+        ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("DEPTH"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("points3D"), std::string::npos);
+    }
+    scan.points3D_y.assign(10, 0.0f);
+    depthScanToPoints(scan, DepthModelOptions(), 0.02, 20, out, st);
+    EXPECT_EQ(out.size(), 10u);
+}
+
 TEST(DepthModel, PointCloudObservationUsesTheModel) {
     mrpt::obs::CObservationPointCloud cloud;
     auto pts = mrpt::maps::CSimplePointsMap::Create();

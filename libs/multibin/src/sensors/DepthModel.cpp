@@ -5,6 +5,8 @@
 #include <mrpt/maps/CSimplePointsMap.h>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace multibin::sensors {
 
@@ -59,7 +61,14 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
                        PointsWithCov& out, DepthStats& stats) {
     out.clear();
     if (scan.hasPoints3D) {
-        out.reserve(scan.points3D_x.size());
+        const size_t nx = scan.points3D_x.size(), ny = scan.points3D_y.size(),
+                     nz = scan.points3D_z.size();
+        if (nx != ny || nx != nz)
+            throw std::invalid_argument(
+                "CObservation3DRangeScan '" + scan.sensorLabel +
+                "': points3D_x, points3D_y and points3D_z have different sizes (" +
+                std::to_string(nx) + ", " + std::to_string(ny) + ", " + std::to_string(nz) + ")");
+        out.reserve(nx);
         for (size_t i = 0; i < scan.points3D_x.size(); i++)
             appendDepthPoint(
                 Eigen::Vector3f(scan.points3D_x[i], scan.points3D_y[i], scan.points3D_z[i]), opts,

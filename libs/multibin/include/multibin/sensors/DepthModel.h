@@ -29,7 +29,8 @@ void appendDepthPoint(const Eigen::Vector3f& p_m, const DepthModelOptions& opts,
                       double maxRange_m, PointsWithCov& out, DepthStats& stats);
 
 /** Points of a depth camera observation in its sensor frame (MRPT's: +x forward), from its 3D
- * points if present, else from its range image unprojected with its own camera parameters. */
+ * points if present, else from its range image unprojected with its own camera parameters.
+ * Throws std::invalid_argument if the three 3D point arrays differ in size. */
 void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
                        const DepthModelOptions& opts, double minRange_m, double maxRange_m,
                        PointsWithCov& out, DepthStats& stats);
