@@ -109,20 +109,25 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
                                  {"global_size_m", global_size_m},
                                  {"global_resolution", global_resolution_m}})
         if (!(v > 0) || !std::isfinite(v)) bad(key, "must be positive [m]");
-    if (dual_grid &&
-        (local_size_m / local_resolution_m > 2e4 || global_size_m / global_resolution_m > 2e4))
-        bad("local_size_m/global_size_m", "a dual grid side may hold at most 20000 cells");
     if (!grow && (max_x <= min_x || max_y <= min_y))
         bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
-    // Refuse before allocating: the cell heads alone take 4 bytes per cell.
-    const double side_cells = std::max({max_size_m, max_x - min_x, max_y - min_y}) / resolution_m;
-    constexpr double kMaxCells = 2.0e8;  // 800 MB of cell heads
-    if (side_cells * side_cells > kMaxCells) {
+    // Refuse before allocating: every cell of a grid's window takes a slot of BinGrid (12 bytes:
+    // first bin, cycle stamp, update index) before any bin is stored.
+    constexpr double kCellBytes = 12, kMaxCells = 2.0e8;  // 2.4 GB of cell slots
+    auto checkArea = [&](const std::string& key, double side_m, double cell_m) {
+        const double side_cells = side_m / cell_m;
+        if (side_cells * side_cells <= kMaxCells) return;
         std::ostringstream os;
-        os << "a map of " << side_cells << " x " << side_cells << " cells (" << resolution_m
-           << " m cells) would need " << side_cells * side_cells * 4 / 1e9
-           << " GB for cell heads alone; use a coarser resolution or a smaller max_size_m";
-        bad("max_size_m", os.str());
+        os << "a grid of " << side_cells << " x " << side_cells << " cells (" << cell_m
+           << " m cells) would need " << side_cells * side_cells * kCellBytes / 1e9
+           << " GB for its cells alone; use a coarser resolution or a smaller size";
+        bad(key, os.str());
+    };
+    if (dual_grid) {
+        checkArea("local_size_m", local_size_m, local_resolution_m);
+        checkArea("global_size_m", global_size_m, global_resolution_m);
+    } else {
+        checkArea("max_size_m", std::max({max_size_m, max_x - min_x, max_y - min_y}), resolution_m);
     }
 }
 

@@ -17,6 +17,10 @@ constexpr const char* kCreationSection = "creation";
 constexpr const char* kInsertionSection = "insertion";
 // A serialized window larger than this is corrupt (the options refuse such maps anyway).
 constexpr double kMaxSerializedCells = 2.0e8;
+// Version 1 ends with the bin count and then this tag. MRPT's CArchive reads a value cut in the
+// middle without a word, so a stream that loses its last bytes would otherwise load a garbage last
+// bin; a cut tag never matches (its high bytes are non-zero).
+constexpr uint32_t kTrailerTag = 0x4D42454D;  // "MBEM"
 
 /** A grid: its window, then each non-empty cell with its bins. */
 void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid) {
@@ -72,7 +76,7 @@ void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double
 }
 }  // namespace
 
-uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 0; }
+uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 1; }
 
 void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) const {
     // Options travel as ini text: readable, and keys can be added without a new version.
@@ -85,11 +89,13 @@ void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) cons
 
     writeGrid(out, m_grid);
     if (creationOptions.dual_grid) writeGrid(out, m_local);
+    out << uint64_t(m_grid.binCount() + m_local.binCount()) << kTrailerTag;
 }
 
 void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version) {
     switch (version) {
-        case 0: {
+        case 0:
+        case 1: {
             std::string iniText;
             in >> iniText;
             mrpt::config::CConfigFileMemory ini(iniText);
@@ -103,6 +109,15 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
             readGrid(in, grid,
                      creation.dual_grid ? creation.global_resolution_m : creation.resolution_m);
             if (creation.dual_grid) readGrid(in, local, creation.local_resolution_m);
+            if (version >= 1) {
+                uint32_t tag = 0;
+                uint64_t bins = 0;
+                in >> bins >> tag;
+                if (tag != kTrailerTag || bins != grid.binCount() + local.binCount())
+                    throw std::runtime_error(
+                        "CMultiBinElevationMap: corrupt serialized map (truncated: its trailer "
+                        "is missing or does not match the bins read)");
+            }
             creationOptions = creation;
             insertionOptions = insertion;
             internal_clear();
