@@ -101,7 +101,7 @@ public:
         /** Pose sigmas (x, y, z [m], yaw, pitch, roll [rad]) used when no pose PDF is known. */
         std::vector<double> default_pose_sigmas{0.01, 0.01, 0.01, 0.005, 0.005, 0.005};
         double robot_pose_max_dt_s = 0.5;  //!< a CObservationRobotPose stays valid this long [s]
-        double range_sigma_m = 0.01;       //!< range noise of depth cameras and point clouds [m]
+        double range_sigma_m = 0.01;       //!< default height sigma of insertIndividualPoint [m]
         double min_range_m = 0.02, max_range_m = 20.0;  //!< accepted ranges [m]
         /** Only observations with these sensor labels are inserted; empty = all. */
         std::vector<std::string> sensor_labels;
