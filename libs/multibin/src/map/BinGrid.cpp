@@ -231,7 +231,8 @@ enum PointStatus : uint8_t {
     kBadCovariance,
     kOutsideMap,
     kTooUncertain,
-    kOutsideBinRange
+    kOutsideBinRange,
+    kStatusCount
 };
 
 /** Per-point results of the classification pass over one block. */
@@ -302,6 +303,7 @@ InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
     };
 
     ClassifiedBlock cb;
+    size_t rejected[kStatusCount] = {};
     for (size_t begin = 0; begin < count; begin += kBlock) {
         const size_t m = std::min(kBlock, count - begin);
         const PointWithCov* pts = mapPoints + begin;
@@ -342,24 +344,9 @@ InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
         }
         // Pass 2, in point order: the bin updates.
         for (size_t i = 0; i < m; i++) {
-            switch (cb.status[i]) {
-                case kAccept:
-                    break;
-                case kNotFinite:
-                    stats.notFinite++;
-                    continue;
-                case kBadCovariance:
-                    stats.badCovariance++;
-                    continue;
-                case kOutsideMap:
-                    stats.outsideMap++;
-                    continue;
-                case kTooUncertain:
-                    stats.tooUncertain++;
-                    continue;
-                default:
-                    stats.outsideBinRange++;
-                    continue;
+            if (cb.status[i] != kAccept) {  // rare: counted per reason after the loop
+                rejected[cb.status[i]]++;
+                continue;
             }
             const double h = pts[i].point_m.z(), var = pts[i].cov_m2.zz;
             const size_t s = cb.slot[i];
@@ -396,6 +383,11 @@ InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
         }
     }
     closeRun();
+    stats.notFinite += rejected[kNotFinite];
+    stats.badCovariance += rejected[kBadCovariance];
+    stats.outsideMap += rejected[kOutsideMap];
+    stats.tooUncertain += rejected[kTooUncertain];
+    stats.outsideBinRange += rejected[kOutsideBinRange];
     return stats;
 }
 
