@@ -219,17 +219,14 @@ int run(const Arguments& args) {
         const mrpt::maps::CSimpleMap sm = RawlogSource::loadSimplemap(args.simplemap);
         for (const auto& m : maps.maps)
             if (m.get() != elevation.get()) m->loadFromSimpleMap(sm);
-        for (size_t i = 0; i < sm.size(); i++) {
-            const auto& [posePdf, sf] = sm.get(i);
-            if (!posePdf || !sf) continue;
-            mrpt::poses::CPose3DPDFGaussian pdf;
-            const auto [cov, mean] = posePdf->getCovarianceAndMean();
-            pdf.mean = mean;
-            pdf.cov = cov;
-            for (const auto& obs : *sf)
-                if (obs) insertTimed(*obs, pdf, true);
-            bar.update(double(i + 1) / double(sm.size()), std::to_string(i + 1) + " keyframes");
-        }
+        CMultiBinElevationMap::forEachObservationWithPosePdf(
+            sm,
+            [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
+                insertTimed(obs, pdf, true);
+            },
+            [&](size_t done, size_t total) {
+                bar.update(double(done) / double(total), std::to_string(done) + " keyframes");
+            });
     }
     bar.finish("done");
 

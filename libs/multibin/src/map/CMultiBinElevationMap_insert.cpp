@@ -60,20 +60,34 @@ bool CMultiBinElevationMap::insertObservation(const mrpt::obs::CObservation& obs
     return done;
 }
 
+void CMultiBinElevationMap::forEachObservationWithPosePdf(
+    const mrpt::maps::CSimpleMap& simplemap,
+    const std::function<void(const mrpt::obs::CObservation&,
+                             const mrpt::poses::CPose3DPDFGaussian&)>& visit,
+    const std::function<void(size_t, size_t)>& progress) {
+    for (size_t i = 0; i < simplemap.size(); i++) {
+        const auto& [posePdf, sf] = simplemap.get(i);
+        if (posePdf && sf) {
+            mrpt::poses::CPose3DPDFGaussian pdf;
+            const auto [cov, mean] = posePdf->getCovarianceAndMean();
+            pdf.mean = mean;
+            pdf.cov = cov;
+            for (const auto& obs : *sf)
+                if (obs) visit(*obs, pdf);
+        }
+        if (progress) progress(i + 1, simplemap.size());
+    }
+}
+
 size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
     const mrpt::maps::CSimpleMap& simplemap, const std::function<void(size_t, size_t)>& progress) {
     size_t inserted = 0;
-    for (size_t i = 0; i < simplemap.size(); i++) {
-        const auto& [posePdf, sf] = simplemap.get(i);
-        if (!posePdf || !sf) continue;
-        mrpt::poses::CPose3DPDFGaussian pdf;
-        const auto [cov, mean] = posePdf->getCovarianceAndMean();
-        pdf.mean = mean;
-        pdf.cov = cov;
-        for (const auto& obs : *sf)
-            if (obs && insertObservation(*obs, pdf)) inserted++;
-        if (progress) progress(i + 1, simplemap.size());
-    }
+    forEachObservationWithPosePdf(
+        simplemap,
+        [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
+            if (insertObservation(obs, pdf)) inserted++;
+        },
+        progress);
     return inserted;
 }
 

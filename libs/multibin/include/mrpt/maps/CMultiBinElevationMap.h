@@ -154,6 +154,14 @@ public:
      * `progress(keyframesDone, keyframesTotal)` is called after each keyframe, if given. */
     size_t insertSimpleMapWithPosePdfs(const mrpt::maps::CSimpleMap& simplemap,
                                        const std::function<void(size_t, size_t)>& progress = {});
+    /** Calls visit(obs, pdf) for every observation of a simplemap with its keyframe's pose PDF
+     * (mean and 6x6 covariance from getCovarianceAndMean()), and progress(done, total) after each
+     * keyframe, if given. */
+    static void forEachObservationWithPosePdf(
+        const mrpt::maps::CSimpleMap& simplemap,
+        const std::function<void(const mrpt::obs::CObservation&,
+                                 const mrpt::poses::CPose3DPDFGaussian&)>& visit,
+        const std::function<void(size_t, size_t)>& progress = {});
 
     /** Inserts points already in the map frame with their covariance (the shared insertion core,
      * for sensors the map does not model): one update cycle. `continuityBound_m` is eq 14's
