@@ -6,6 +6,8 @@
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include "multibin/ErrorMessage.h"
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -42,6 +44,12 @@ private:
     size_t m_size;
     size_t m_pos = 0;
 };
+
+/** With FUZZ_DEBUG set, prints why an input was rejected (for corpus maintenance). */
+inline void debugRejected(const std::exception& e) {
+    static const bool on = std::getenv("FUZZ_DEBUG") != nullptr;
+    if (on) std::fprintf(stderr, "rejected: %s\n", multibin::oneLineMessage(e).c_str());
+}
 
 [[noreturn]] inline void fail(const char* what) {
     std::fprintf(stderr, "fuzz invariant violated: %s\n", what);

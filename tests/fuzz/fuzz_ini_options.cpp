@@ -37,7 +37,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     mrpt::config::CConfigFileMemory ini;
     try {
         ini.setContent(text);
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+        fuzz::debugRejected(e);
         return 0;  // MRPT's own parser refused the text
     }
     Map::TCreationOptions creation;
@@ -45,7 +46,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     try {
         creation.loadFromConfigFile(ini, "creation");
         creationOk = true;
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+        fuzz::debugRejected(e);
     }
     if (creationOk) {
         roundTrip(creation);
@@ -55,7 +57,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     Map::TInsertionOptions insertion;
     try {
         insertion.loadFromConfigFile(ini, "insertion");
-    } catch (const std::exception&) {
+    } catch (const std::exception& e) {
+        fuzz::debugRejected(e);
         return 0;
     }
     roundTrip(insertion);

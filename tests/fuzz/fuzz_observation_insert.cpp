@@ -150,7 +150,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                 map.insertObservation(*obs, pdf);
             else
                 map.insertObservation(*obs, pdf.mean);
-        } catch (const std::exception&) {
+        } catch (const std::exception& e) {
+            fuzz::debugRejected(e);
             if (fuzz::serialize(map) != before)
                 fuzz::fail("a rejected observation changed the map");
         }
