@@ -147,7 +147,7 @@ TEST(BadInputFiles, MissingInputAndEmptyFileAreOneLineErrors) {
 //         (mrpt::rtti::registerClass(CLASS_ID(CMultiBinElevationMap)), true);
 // (checked on a two-class repro with gcc 12 and clang 14, with and without sanitizers).
 // The tests below register explicitly (public API) so they test their own concern under clang.
-TEST(BadInputFiles, DISABLED_MapClassIsRegisteredWhenTheLibraryLoads) {
+TEST(BadInputFiles, MapClassIsRegisteredWhenTheLibraryLoads) {
     EXPECT_NE(mrpt::rtti::findRegisteredClass("mrpt::maps::CMultiBinElevationMap"), nullptr);
 }
 

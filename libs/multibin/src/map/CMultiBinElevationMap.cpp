@@ -1,5 +1,4 @@
 /* Part of the multibin elevation-mapping library. */
-#include <mrpt/core/initializer.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 #include <mrpt/rtti/CObject.h>
@@ -21,10 +20,14 @@ MAP_DEFINITION_REGISTER("mrpt::maps::CMultiBinElevationMap,multiBinElevationMap"
 IMPLEMENTS_SERIALIZABLE(CMultiBinElevationMap, CMetricMap, mrpt::maps)
 
 // Register with MRPT's class registry when the library loads, so polymorphic deserialization
-// (CArchive::ReadObject) finds the class in any program that loads the library.
-MRPT_INITIALIZER(registerMultiBinElevationMapClass) {
-    mrpt::rtti::registerClass(CLASS_ID(CMultiBinElevationMap));
-}
+// (CArchive::ReadObject) finds the class in any program that loads the library. A C++ dynamic
+// initialiser placed after IMPLEMENTS_SERIALIZABLE runs after the class id it reads (same
+// translation unit, in order); MRPT_INITIALIZER (a constructor attribute) may run before it with
+// clang, which then registers a null class name.
+namespace {
+const bool kClassRegistered =
+    (mrpt::rtti::registerClass(CLASS_ID(mrpt::maps::CMultiBinElevationMap)), true);
+}  // namespace
 
 namespace multibin {
 void registerMultiBinElevationMap() {

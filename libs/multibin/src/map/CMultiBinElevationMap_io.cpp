@@ -5,6 +5,7 @@
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -15,8 +16,9 @@ using namespace mrpt::maps;
 namespace {
 constexpr const char* kCreationSection = "creation";
 constexpr const char* kInsertionSection = "insertion";
-// A serialized window larger than this is corrupt (the options refuse such maps anyway).
-constexpr double kMaxSerializedCells = 2.0e8;
+// The options travel as ini text of a few kB; a longer one is corrupt (and must be refused before
+// MRPT's string reader allocates whatever length the stream claims).
+constexpr uint32_t kMaxOptionsTextBytes = 1u << 20;
 // Version 1 ends with the bin count and then this tag. MRPT's CArchive reads a value cut in the
 // middle without a word, so a stream that loses its last bytes would otherwise load a garbage last
 // bin; a cut tag never matches (its high bytes are non-zero).
@@ -46,14 +48,20 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
         }
 }
 
-void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double cellSize_m) {
-    auto corrupt = [](const std::string& what) {
-        throw std::runtime_error("CMultiBinElevationMap: corrupt serialized map (" + what + ")");
-    };
+[[noreturn]] void corrupt(const std::string& what) {
+    throw std::runtime_error("CMultiBinElevationMap: corrupt serialized map (" + what + ")");
+}
+
+/** Reads a grid whose window may have at most maxSideCells cells per side (the stored options'
+ * own limit), checked before anything is allocated. */
+void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double cellSize_m,
+              double maxSideCells) {
     int32_t ix0, iy0, nx, ny;
     in >> ix0 >> iy0 >> nx >> ny;
-    if (nx < 0 || ny < 0 || double(nx) * double(ny) > kMaxSerializedCells)
-        corrupt("window of " + std::to_string(nx) + " x " + std::to_string(ny) + " cells");
+    if (nx < 0 || ny < 0 || double(nx) > maxSideCells || double(ny) > maxSideCells)
+        corrupt("window of " + std::to_string(nx) + " x " + std::to_string(ny) +
+                " cells, beyond the stored options' limit of " +
+                std::to_string(int64_t(maxSideCells)) + " per side");
     grid.reset(cellSize_m, multibin::CellWindow{ix0, iy0, nx, ny});
     uint64_t nonEmpty;
     in >> nonEmpty;
@@ -96,8 +104,14 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
     switch (version) {
         case 0:
         case 1: {
-            std::string iniText;
-            in >> iniText;
+            // Same layout as MRPT's string (uint32 length, bytes), read with a bound first.
+            uint32_t textBytes = 0;
+            in >> textBytes;
+            if (textBytes > kMaxOptionsTextBytes)
+                corrupt("options text of " + std::to_string(textBytes) + " bytes");
+            std::string iniText(textBytes, '\0');
+            if (textBytes > 0 && in.ReadBuffer(iniText.data(), textBytes) != textBytes)
+                corrupt("options text cut short");
             mrpt::config::CConfigFileMemory ini(iniText);
             TCreationOptions creation;
             TInsertionOptions insertion;
@@ -106,9 +120,19 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 
             // Read everything before touching the map: a corrupt stream leaves it unchanged.
             multibin::BinGrid grid, local;
-            readGrid(in, grid,
-                     creation.dual_grid ? creation.global_resolution_m : creation.resolution_m);
-            if (creation.dual_grid) readGrid(in, local, creation.local_resolution_m);
+            // A window never exceeds what the options allow (growth stops at max_size_m; the
+            // margin covers rounding at the window's edges).
+            const auto& c = creation;
+            const double singleSide_m =
+                std::max({c.max_size_m, c.max_x - c.min_x, c.max_y - c.min_y});
+            if (c.dual_grid) {
+                readGrid(in, grid, c.global_resolution_m,
+                         c.global_size_m / c.global_resolution_m + 2);
+                readGrid(in, local, c.local_resolution_m,
+                         c.local_size_m / c.local_resolution_m + 2);
+            } else {
+                readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2);
+            }
             if (version >= 1) {
                 uint32_t tag = 0;
                 uint64_t bins = 0;
