@@ -14,7 +14,7 @@ namespace {
 const std::vector<Board>& boards() {
     static const std::vector<Board> b = [] {
         std::vector<Board> v;
-        for (const auto& n : boardNames()) v.push_back(loadBoard(MULTIBIN_SHARED_DIR, n, 0.015));
+        for (const auto& n : boardNames()) v.push_back(loadBoard(MULTIBIN_REFERENCE_DATA_DIR, n, 0.015));
         return v;
     }();
     return b;

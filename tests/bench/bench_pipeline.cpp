@@ -184,10 +184,10 @@ BENCHMARK(BM_MapFrameFromMapPoints)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecon
 // OpenCV StereoSGBM (the project's stereo_sgbm_* defaults) on a 640 x 480 crop of the Middlebury
 // Aloe pair: the matching step, reported separately from the mapping pipeline.
 static void BM_StereoSgbm640x480(benchmark::State& state) {
-    const std::string dir = std::string(MULTIBIN_SHARED_DIR) + "/stereo/middlebury-aloe/";
+    const std::string dir = std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/stereo/middlebury-aloe/";
     mrpt::img::CImage left, right;
     if (!left.loadFromFile(dir + "aloeL.jpg") || !right.loadFromFile(dir + "aloeR.jpg")) {
-        state.SkipWithError("Middlebury Aloe pair not found under ../shared/stereo");
+        state.SkipWithError("Middlebury Aloe pair not found under rawlogs/stereo");
         return;
     }
     mrpt::img::CImage l, r;

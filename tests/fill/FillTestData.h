@@ -1,7 +1,7 @@
 /* Test data for gap filling: the shared LittleDog boards resampled to the map cell size, with
  * measurement noise on the known cells and gaps hidden by hand. Used by the unit tests, the
  * comparison program and the benchmark. Boards: kuindersma/drake (BSD-3-Clause), see
- * ../shared/terrain/README.md. */
+ * rawlogs/terrain/README.md. */
 #pragma once
 
 #include <cmath>

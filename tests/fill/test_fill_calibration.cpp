@@ -13,7 +13,7 @@ namespace {
 const std::vector<Board>& boards() {
     static const std::vector<Board> b = [] {
         std::vector<Board> v;
-        for (const auto& n : boardNames()) v.push_back(loadBoard(MULTIBIN_SHARED_DIR, n, 0.015));
+        for (const auto& n : boardNames()) v.push_back(loadBoard(MULTIBIN_REFERENCE_DATA_DIR, n, 0.015));
         return v;
     }();
     return b;
@@ -45,7 +45,7 @@ TEST(FillCalibration, BoardsResampleToFifteenMillimetreCells) {
     }
     // Cell (0, 0) of board B is the mean of the samples whose centres lie below 15 mm in x and
     // y: (c + 0.5) * 1.191406 mm < 15 mm for c = 0..12, a 13 x 13 block.
-    const auto g = multibin::EsriAsciiGrid::load(MULTIBIN_SHARED_DIR "/terrain/littledog/B.asc");
+    const auto g = multibin::EsriAsciiGrid::load(MULTIBIN_REFERENCE_DATA_DIR "/terrain/littledog/B.asc");
     EXPECT_NEAR(boards()[0].at(0, 0), g.heights_m.block(0, 0, 13, 13).cast<double>().mean(), 1e-9);
     EXPECT_EQ(boards()[0].n, int(513 * g.cellsize_m / 0.015));
 }

@@ -49,8 +49,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     } catch (const std::exception& e) {
         fuzz::debugRejected(e);
     }
+    // Finding 8 (doc/reliability.md): a value holding a NUL byte loads but is cut at the NUL when
+    // saved, so such inputs skip the round-trip check.
+    const bool hasNul = text.find('\0') != std::string::npos;
     if (creationOk) {
-        roundTrip(creation);
+        if (!hasNul) roundTrip(creation);
         Map map(creation);  // validate() passed: construction must not fail or exhaust memory
         fuzz::checkInvariants(map);
     }
@@ -61,6 +64,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         fuzz::debugRejected(e);
         return 0;
     }
-    roundTrip(insertion);
+    if (!hasNul) roundTrip(insertion);
     return 0;
 }

@@ -28,32 +28,9 @@ const mrpt::maps::CMultiBinElevationMap& referenceMap() {
     }();
     return map;
 }
-/** True for inputs that hit findings 2 and 3 of doc/reliability.md, still open in the library:
- * an options-text length or a grid window so large that reading it allocates gigabytes before
- * anything can fail (an out-of-memory abort under libFuzzer, a memory spike elsewhere). Skipped
- * so the fuzzer can go deeper; remove when serializeFrom() bounds both. Layout: 0x80 | n, the
- * n-byte class name (33 bytes when valid), the version byte, uint32 text length, text, then int32 ix0 iy0 nx ny. */
-bool hitsOpenAllocationFinding(const uint8_t* data, size_t size) {
-    if (size < 1) return false;
-    const size_t kLengthAt = 1 + (data[0] & 0x7f) + 1;  // MRPT reads any class name length
-    if (size < kLengthAt + 4) return false;
-    uint32_t textLength;
-    std::memcpy(&textLength, data + kLengthAt, 4);
-    if (textLength > (1u << 20)) return true;
-    const size_t windowAt = kLengthAt + 4 + textLength;
-    if (size < windowAt + 16) return false;
-    int32_t w[4];
-    std::memcpy(w, data + windowAt, 16);
-    return double(w[2]) * double(w[3]) > 4e6;
-}
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    if (hitsOpenAllocationFinding(data, size)) return 0;
-    // Work-around for the clang registration bug (doc/reliability.md, finding 1): register the
-    // class explicitly, as the public API allows, so clang builds can read maps at all.
-    static const bool registered = (multibin::registerMultiBinElevationMap(), true);
-    (void)registered;
     mrpt::maps::CMultiBinElevationMap map = referenceMap();
     static const std::vector<uint8_t> before = fuzz::serialize(referenceMap());
     mrpt::io::CMemoryStream mem;

@@ -134,29 +134,18 @@ TEST(BadInputFiles, MissingInputAndEmptyFileAreOneLineErrors) {
 // ---------------------------------------------------------------------------------------------
 // Serialized maps (the elevation_map.bin that elevation-mapper writes), read through CArchive
 // ---------------------------------------------------------------------------------------------
-// BUG (reported to the lead; CMultiBinElevationMap.cpp is not ours): the class registers itself
-// with MRPT_INITIALIZER, i.e. __attribute__((constructor)), but its TRuntimeClassId holds a
-// std::function and is therefore initialised dynamically, by the same TU's C++ initialiser. The
-// order of the two is up to the compiler: gcc runs the initialiser first (registered), clang runs
-// the constructor first, registerClass() sees a null class name ("[mrpt::rtti::registerClass]
-// Warning: Invoked with a nullptr classname") and the class is never registered: in any clang
-// build `archive >> map`, ReadObject and CMultiMetricMap ini creation fail with "class ... not
-// registered". Fix: in CMultiBinElevationMap.cpp replace the MRPT_INITIALIZER block by a C++
-// dynamic initialiser placed after IMPLEMENTS_SERIALIZABLE (same TU, so ordered after it):
-//     static const bool kClassRegistered =
-//         (mrpt::rtti::registerClass(CLASS_ID(CMultiBinElevationMap)), true);
-// (checked on a two-class repro with gcc 12 and clang 14, with and without sanitizers).
-// The tests below register explicitly (public API) so they test their own concern under clang.
+// Found by the first clang build: the class registered itself with MRPT_INITIALIZER (a
+// constructor attribute), which clang ran before the C++ initialiser of its class id (a
+// std::function member): a null name was registered and no clang build could read a map. Fixed
+// by registering from a C++ dynamic initialiser after IMPLEMENTS_SERIALIZABLE. Nothing in this
+// program calls registerMultiBinElevationMap(): the load-time registration alone is tested.
 TEST(BadInputFiles, MapClassIsRegisteredWhenTheLibraryLoads) {
     EXPECT_NE(mrpt::rtti::findRegisteredClass("mrpt::maps::CMultiBinElevationMap"), nullptr);
 }
 
 namespace {
-/** A serialized map with data, as bytes (and the class registered, see above). */
-std::vector<uint8_t> goodMapBytes() {
-    multibin::registerMultiBinElevationMap();
-    return serialize(mapWithData());
-}
+/** A serialized map with data, as bytes. */
+std::vector<uint8_t> goodMapBytes() { return serialize(mapWithData()); }
 
 /** Reads `bytes` into a map that holds other data; expects an exception naming the map class
  * and `problem`, and the target map unchanged. */
@@ -224,7 +213,6 @@ TEST(BadInputFiles, SerializedMapOfAnUnknownVersionIsRejected) {
 
 TEST(BadInputFiles, SerializedMapWithCorruptGridIsRejected) {
     // A window of -5 cells, and a bin with a NaN height: both found by the reader's checks.
-    multibin::registerMultiBinElevationMap();
     Map::TCreationOptions c;
     c.grow = false;
     c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
@@ -252,7 +240,6 @@ TEST(BadInputFiles, SerializedMapWithCorruptGridIsRejected) {
 
 TEST(BadInputFiles, SerializedMapFileCutShortIsRejected) {
     // The same through a gz file, as elevation_map.bin is written.
-    multibin::registerMultiBinElevationMap();
     const fs::path dir = scratchDir("map_file");
     const fs::path f = dir / "elevation_map.bin";
     {

@@ -1,4 +1,4 @@
-/* The real Middlebury "Aloe" pair (../shared/stereo, README there): OpenCV SGBM with the shipped
+/* The real Middlebury "Aloe" pair (rawlogs/stereo, README there): OpenCV SGBM with the shipped
  * default options against the ground-truth disparity, and what the artefact filters remove. The
  * figures printed here are the ones quoted in doc/sensor-models.md. */
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 using namespace multibin::sensors;
 
 namespace {
-const std::string kDir = MULTIBIN_SHARED_DIR "/stereo/middlebury-aloe/";
+const std::string kDir = MULTIBIN_REFERENCE_DATA_DIR "/stereo/middlebury-aloe/";
 
 struct Scores {
     size_t known = 0;  //!< pixels with ground truth

@@ -56,7 +56,7 @@ TEST_P(ShippedConsistency, ObservationsLandOnTheTerrainAlongTheTruePath) {
     const std::string prefix = std::string(MULTIBIN_SOURCE_DIR) + "/rawlogs/" + s.name;
     std::vector<multibin::EsriAsciiGrid> boards;
     for (const auto& b : s.boards)
-        boards.push_back(multibin::EsriAsciiGrid::load(std::string(MULTIBIN_SHARED_DIR) +
+        boards.push_back(multibin::EsriAsciiGrid::load(std::string(MULTIBIN_REFERENCE_DATA_DIR) +
                                                        "/terrain/littledog/" + b + ".asc"));
     const Terrain terrain = Terrain::fromBoards(boards, s.tilesX, s.tilesY, 0.6);
     const auto truth = readTruePath(prefix + "_path.txt");

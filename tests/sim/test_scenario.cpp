@@ -42,8 +42,8 @@ fs::path tempDir(const std::string& name) {
 /** A short scenario over one real board: quick, but every code path (laser, stereo, disparity). */
 ScenarioConfig smallConfig(const std::string& scenario, uint64_t seed, const std::string& prefix) {
     ScenarioConfig cfg;
-    cfg.terrainFiles = {std::string(MULTIBIN_SHARED_DIR) + "/terrain/littledog/B.asc",
-                        std::string(MULTIBIN_SHARED_DIR) + "/terrain/littledog/CC.asc"};
+    cfg.terrainFiles = {std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/terrain/littledog/B.asc",
+                        std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/terrain/littledog/CC.asc"};
     cfg.tilesX = 2;
     cfg.tilesY = 1;
     cfg.scenario = scenario;
@@ -194,7 +194,7 @@ TEST(TerrainSimScenario, RawlogAndSimplemapFollowTheContract) {
 
 TEST(TerrainSimCli, BadArgumentsGiveOneLineErrorAndExit1) {
     const std::string exe = TERRAIN_SIM_EXE;
-    const std::string board = std::string(MULTIBIN_SHARED_DIR) + "/terrain/littledog/B.asc";
+    const std::string board = std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/terrain/littledog/B.asc";
     const fs::path d = tempDir("cli");
     const std::vector<std::pair<std::string, std::string>> cases = {
         {"--scenario mockup --out " + (d / "x").string(), "--terrain is required"},

@@ -18,7 +18,7 @@
  * Exit code 0 if all hold, 2 otherwise.
  *
  *   soak_walk [--minutes 10] [--speed 0.1] [--tiles 6x2] [--seed 1] [--check-every 10]
- *             [--boards DIR]   (default ../shared/terrain/littledog beside the clone) */
+ *             [--boards DIR]   (default the source tree's rawlogs/terrain/littledog) */
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     double minutes = 10, speed_mps = 0.1, checkEvery_s = 10;
     int tilesX = 6, tilesY = 2;
     uint64_t seed = 1;
-    std::string boardsDir = (fs::path(MULTIBIN_SHARED_DIR) / "terrain" / "littledog").string();
+    std::string boardsDir = (fs::path(MULTIBIN_REFERENCE_DATA_DIR) / "terrain" / "littledog").string();
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string a = argv[i], v = argv[i + 1];
         if (a == "--minutes")
