@@ -93,7 +93,18 @@ mrpt::obs::CObservation::Ptr takeStereo(fuzz::ByteReader& in) {
     if (flags & 8) obs->rightCamera.setIntrinsicParamsFromValues(f, f + 1, 0.5 * w, 0.5 * h);
     obs->rightCameraPose =
         mrpt::math::TPose3DQuat(in.takeFloat(-0.1f, 0.2f, flags & 16), 0, 0, 1, 0, 0, 0);
-    obs->cameraPose = mrpt::poses::CPose3DQuat(takeSensorPose(in)).asTPose();
+    // Left camera on the robot as a raw quaternion pose: with raw values it may be NaN or not of
+    // unit norm (MRPT's CPose3DQuat would refuse to build it; the map must cope).
+    const bool rawQ = in.take<uint8_t>() & 1;
+    obs->cameraPose =
+        rawQ ? mrpt::math::TPose3DQuat(in.take<float>(), in.take<float>(), in.take<float>(),
+                                       in.take<float>(), in.take<float>(), in.take<float>(),
+                                       in.take<float>())
+             : mrpt::poses::CPose3DQuat(mrpt::poses::CPose3D(in.takeFloat(-0.5, 0.5, false), 0,
+                                                             in.takeFloat(0, 0.6f, false),
+                                                             in.takeFloat(-3, 3, false),
+                                                             in.takeFloat(-1.5, 1.5, false), 0))
+                   .asTPose();
     multibin::sensors::DisparityImage d(w, h);
     for (float& v : d.disparity_px) v = in.takeFloat(0, 40, flags & 32);
     obs->imageDisparity = multibin::sensors::encodeDisparityImage(d);
@@ -127,19 +138,26 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (int k = 0; k < 4 && in.remaining() > 0; k++) {
         const uint8_t kind = in.take<uint8_t>() % 4;
         mrpt::obs::CObservation::Ptr obs;
-        switch (kind) {
-            case 0:
-                obs = takeScan(in);
-                break;
-            case 1:
-                obs = takeCloud(in);
-                break;
-            case 2:
-                obs = takeStereo(in);
-                break;
-            default:
-                obs = takeRobotPose(in);
-                break;
+        try {
+            switch (kind) {
+                case 0:
+                    obs = takeScan(in);
+                    break;
+                case 1:
+                    obs = takeCloud(in);
+                    break;
+                case 2:
+                    obs = takeStereo(in);
+                    break;
+                default:
+                    obs = takeRobotPose(in);
+                    break;
+            }
+        } catch (const std::exception& e) {
+            // MRPT itself refuses to build some observations (e.g. a pose whose quaternion is not
+            // of unit norm); they never reach the map.
+            fuzz::debugRejected(e);
+            return 0;
         }
         obs->timestamp = mrpt::Clock::fromDouble(1.0 + 0.1 * k);
         const bool withPdf = in.take<uint8_t>() & 1;
