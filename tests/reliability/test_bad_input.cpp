@@ -9,6 +9,7 @@
 #include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 
+#include <chrono>
 #include <limits>
 #include <string>
 
@@ -365,6 +366,30 @@ TEST(BadInputExtent, ARobotPoseFarAwayKeepsTheDataAlreadyMapped) {
     EXPECT_EQ(map.insertStats().outsideMap - outside0, kFloorReturns);
     double h;
     EXPECT_TRUE(floorHeightAt(map, 0, 0, h));
+}
+
+// BUG (found by fuzz_observation_insert, reported to the lead; VisibilityConstraint.cpp is not
+// ours): applyVisibilityConstraint() walks each line of sight from the updated cell to the sensor
+// in half-cell steps over its whole length, skipping cells outside the window but not stopping
+// there. A sensor 10^9 m from the map (a corrupt sensorPose, a pose jump) means ~10^11 steps per
+// updated cell: 3 points take 20 s at 10^9 m (gcc Release), hours at 10^12 m. Fix: before the loop,
+// clip `length` to where the ray leaves the grid window (slab test of the ray from (tx, ty) along
+// (ux, uy) against the window's rectangle [ix0, ix0 + nx) x [iy0, iy0 + ny) * cell): the ray starts
+// inside the window, which is convex, so no sample beyond that point can touch a cell of the grid.
+TEST(BadInputExtent, DISABLED_ASensorFarFromTheMapDoesNotHangTheVisibilityConstraint) {
+    Map::TCreationOptions c;
+    c.grow = false;
+    c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
+    Map map(c);
+    multibin::PointsWithCov pts(3);
+    for (int i = 0; i < 3; i++) {
+        pts[size_t(i)].point_m = Eigen::Vector3f(0.1f * float(i), 0.f, 0.f);
+        pts[size_t(i)].cov_m2 = {1e-6f, 0, 0, 1e-6f, 0, 1e-6f};
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    map.insertPoints(pts, std::numeric_limits<double>::infinity(), Eigen::Vector3d(1e9, 0.0, 1.0));
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_LT(s, 1.0) << "3 points took " << s << " s";
 }
 
 TEST(BadInputExtent, HeightsBeyondTheBinRangeAreCounted) {
