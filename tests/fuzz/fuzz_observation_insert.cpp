@@ -94,17 +94,19 @@ mrpt::obs::CObservation::Ptr takeStereo(fuzz::ByteReader& in) {
     obs->rightCameraPose =
         mrpt::math::TPose3DQuat(in.takeFloat(-0.1f, 0.2f, flags & 16), 0, 0, 1, 0, 0, 0);
     // Left camera on the robot as a raw quaternion pose: with raw values it may be NaN or not of
-    // unit norm (MRPT's CPose3DQuat would refuse to build it; the map must cope).
+    // unit norm. MRPT's quaternion constructor refuses such values by throwing through a noexcept
+    // path (std::terminate), so the raw values are written into the pose's storage directly: the
+    // map must cope with what a corrupt observation can hold.
     const bool rawQ = in.take<uint8_t>() & 1;
-    obs->cameraPose =
-        rawQ ? mrpt::math::TPose3DQuat(in.take<float>(), in.take<float>(), in.take<float>(),
-                                       in.take<float>(), in.take<float>(), in.take<float>(),
-                                       in.take<float>())
-             : mrpt::poses::CPose3DQuat(mrpt::poses::CPose3D(in.takeFloat(-0.5, 0.5, false), 0,
-                                                             in.takeFloat(0, 0.6f, false),
-                                                             in.takeFloat(-3, 3, false),
-                                                             in.takeFloat(-1.5, 1.5, false), 0))
-                   .asTPose();
+    if (rawQ) {
+        obs->cameraPose = mrpt::poses::CPose3DQuat();
+        for (int i = 0; i < 3; i++) obs->cameraPose[i] = double(in.take<float>());
+        for (int i = 0; i < 4; i++) obs->cameraPose.quat()[i] = double(in.take<float>());
+    } else {
+        obs->cameraPose = mrpt::poses::CPose3DQuat(
+            mrpt::poses::CPose3D(in.takeFloat(-0.5, 0.5, false), 0, in.takeFloat(0, 0.6f, false),
+                                 in.takeFloat(-3, 3, false), in.takeFloat(-1.5, 1.5, false), 0));
+    }
     multibin::sensors::DisparityImage d(w, h);
     for (float& v : d.disparity_px) v = in.takeFloat(0, 40, flags & 32);
     obs->imageDisparity = multibin::sensors::encodeDisparityImage(d);
