@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/VisibilityConstraint.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace multibin {
@@ -63,8 +64,19 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         auto cellOf = [&](double coord_m) {
             return unclamped ? BinGrid::floorToInt(coord_m * invCell) : grid.cellIndex(coord_m);
         };
+        // The ray starts inside the window, which is convex: past the point where it leaves the
+        // window no sample can touch a cell of the grid. Without this, a sensor far from the map
+        // (a corrupt pose) costs 10^11 samples per updated cell.
+        const CellWindow& w = grid.window();
+        double walk = length;
+        auto clipAxis = [&](double origin, double dir, int i0, int n) {
+            if (dir > 0) walk = std::min(walk, ((i0 + n) * cell - origin) / dir + cell);
+            if (dir < 0) walk = std::min(walk, (i0 * cell - origin) / dir + cell);
+        };
+        clipAxis(tx, ux, w.ix0, w.nx);
+        clipAxis(ty, uy, w.iy0, w.ny);
         int lastIx = u.ix, lastIy = u.iy;
-        for (double d = step; d < length; d += step) {
+        for (double d = step; d < walk; d += step) {
             const double rayZ = tz + slope * d;
             if (slope > 0 && rayZ - inCellRise > stopHeight) break;
             const int ix = cellOf(tx + ux * d);
