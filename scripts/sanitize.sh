@@ -10,23 +10,10 @@ build_dir=${MULTIBIN_ASAN_BUILD_DIR:-$root/build-asan}
 fuzz_seconds=${FUZZ_SECONDS:-30}
 jobs=$(nproc)
 
-# The packages of scripts/setup.sh, plus clang with its sanitizer/libFuzzer runtimes and
-# llvm-symbolizer (readable stack traces). Only missing ones are installed.
-packages=(g++ cmake ninja-build pkg-config libmrpt-dev mrpt-apps mrpt-common libeigen3-dev
-          libopencv-dev libgtest-dev libbenchmark-dev nlohmann-json3-dev
-          clang libclang-rt-14-dev llvm)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "Installing missing Debian packages: ${missing[*]}"
-  sudo_cmd=""
-  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
-  $sudo_cmd apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends \
-    "${missing[@]}" >/dev/null
-fi
+# The build's packages, plus clang with its sanitizer/libFuzzer runtimes and llvm-symbolizer
+# (readable stack traces). Only missing ones are installed.
+source "$root/scripts/install-packages.sh"
+install_missing_packages "${multibin_build_packages[@]}" clang libclang-rt-14-dev llvm
 
 # Google Benchmark programs are left out (CMAKE_DISABLE_FIND_PACKAGE_benchmark): they are not run
 # here and are among the heaviest files to compile.

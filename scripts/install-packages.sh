@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# install_missing_packages PKG...: installs, with apt, those of the given Debian packages that are
+# not installed yet (sudo when not root). Sourced by setup.sh and sanitize.sh.
+
+# What any build of the project needs (compilers and tools, MRPT, Eigen, OpenCV, GoogleTest,
+# Google Benchmark, nlohmann-json).
+multibin_build_packages=(g++ cmake ninja-build pkg-config libmrpt-dev mrpt-apps mrpt-common
+                         libeigen3-dev libopencv-dev libgtest-dev libbenchmark-dev
+                         nlohmann-json3-dev)
+install_missing_packages() {
+  local missing=() p sudo_cmd=""
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "Installing missing Debian packages: ${missing[*]}"
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null
+}
