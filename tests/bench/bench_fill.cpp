@@ -11,14 +11,7 @@ using namespace multibin::fill;
 using namespace multibin::filltest;
 
 namespace {
-const std::vector<Board>& boards() {
-    static const std::vector<Board> b = [] {
-        std::vector<Board> v;
-        for (const auto& n : boardNames()) v.push_back(loadBoard(MULTIBIN_REFERENCE_DATA_DIR, n, 0.015));
-        return v;
-    }();
-    return b;
-}
+const std::vector<Board>& boards() { return boardsAt15mm(MULTIBIN_REFERENCE_DATA_DIR); }
 
 /** The 2 x 2 m local grid (133 x 133 cells) with four large gaps (sides 6, 10, 14, 18 cells)
  * and `holeFraction` of the other cells hidden as scattered 1- and 2-cell holes. */

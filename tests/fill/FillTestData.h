@@ -51,6 +51,16 @@ inline Board loadBoard(const std::string& sharedDir, const std::string& name, do
     return b;
 }
 
+/** Every board at 15 mm cells (cell means), loaded once from the reference data in dataDir. */
+inline const std::vector<Board>& boardsAt15mm(const std::string& dataDir) {
+    static const std::vector<Board> b = [&] {
+        std::vector<Board> v;
+        for (const auto& n : boardNames()) v.push_back(loadBoard(dataDir, n, 0.015));
+        return v;
+    }();
+    return b;
+}
+
 /** A side x side crop of a board at (x0, y0), every cell measured: height = truth + N(0, s^2),
  * s drawn per cell uniformly in [sigmaLo_m, sigmaHi_m] and stored as the cell's sigma. */
 inline fill::HeightRaster noisyCrop(const Board& b, int x0, int y0, int side, unsigned seed,

@@ -33,7 +33,8 @@ const std::vector<int> kSmallSizes{1, 2, 3};
 
 std::vector<Board> loadBoards() {
     std::vector<Board> boards;
-    for (const auto& n : boardNames()) boards.push_back(loadBoard(MULTIBIN_REFERENCE_DATA_DIR, n, kCell_m));
+    for (const auto& n : boardNames())
+        boards.push_back(loadBoard(MULTIBIN_REFERENCE_DATA_DIR, n, kCell_m));
     return boards;
 }
 

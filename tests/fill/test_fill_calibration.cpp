@@ -10,14 +10,7 @@ using namespace multibin::fill;
 using namespace multibin::filltest;
 
 namespace {
-const std::vector<Board>& boards() {
-    static const std::vector<Board> b = [] {
-        std::vector<Board> v;
-        for (const auto& n : boardNames()) v.push_back(loadBoard(MULTIBIN_REFERENCE_DATA_DIR, n, 0.015));
-        return v;
-    }();
-    return b;
-}
+const std::vector<Board>& boards() { return boardsAt15mm(MULTIBIN_REFERENCE_DATA_DIR); }
 
 struct Coverage {
     int n = 0, in3 = 0, in1 = 0;
@@ -45,7 +38,8 @@ TEST(FillCalibration, BoardsResampleToFifteenMillimetreCells) {
     }
     // Cell (0, 0) of board B is the mean of the samples whose centres lie below 15 mm in x and
     // y: (c + 0.5) * 1.191406 mm < 15 mm for c = 0..12, a 13 x 13 block.
-    const auto g = multibin::EsriAsciiGrid::load(MULTIBIN_REFERENCE_DATA_DIR "/terrain/littledog/B.asc");
+    const auto g =
+        multibin::EsriAsciiGrid::load(MULTIBIN_REFERENCE_DATA_DIR "/terrain/littledog/B.asc");
     EXPECT_NEAR(boards()[0].at(0, 0), g.heights_m.block(0, 0, 13, 13).cast<double>().mean(), 1e-9);
     EXPECT_EQ(boards()[0].n, int(513 * g.cellsize_m / 0.015));
 }

@@ -22,12 +22,12 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
+#include <unistd.h>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -100,7 +100,8 @@ int main(int argc, char** argv) {
     double minutes = 10, speed_mps = 0.1, checkEvery_s = 10;
     int tilesX = 6, tilesY = 2;
     uint64_t seed = 1;
-    std::string boardsDir = (fs::path(MULTIBIN_REFERENCE_DATA_DIR) / "terrain" / "littledog").string();
+    std::string boardsDir =
+        (fs::path(MULTIBIN_REFERENCE_DATA_DIR) / "terrain" / "littledog").string();
     for (int i = 1; i + 1 < argc; i += 2) {
         const std::string a = argv[i], v = argv[i + 1];
         if (a == "--minutes")
