@@ -1,6 +1,12 @@
 #!/usr/bin/env bash
-# Quick start 2: set up, build, and run the test suite (ctest over the GoogleTest programs).
+# Quick start 2: set up, build, and run the test suite: ctest over the GoogleTest programs in the
+# Release build, then the sanitizer stage (scripts/sanitize.sh: the same tests in a clang
+# ASan + UBSan build, fuzz corpora replayed, a short fuzzing run per target).
+# Arguments go to the first ctest; MULTIBIN_SANITIZE=0 skips the sanitizer stage.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 source "$root/scripts/setup.sh"
 ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" -LE slow "$@"
+if [ "${MULTIBIN_SANITIZE:-1}" != 0 ]; then
+  bash "$root/scripts/sanitize.sh"
+fi
