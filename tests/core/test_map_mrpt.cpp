@@ -2,6 +2,8 @@
  * CMultiMetricMap creation, pose PDFs from CObservationRobotPose. */
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
+
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CMultiMetricMap.h>
@@ -12,6 +14,7 @@
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 #include <mrpt/random/RandomGenerators.h>
 #include <mrpt/serialization/CArchive.h>
+#include "multibin/StrictConfigSection.h"
 
 #include <Eigen/Dense>
 #include <random>
@@ -316,4 +319,26 @@ TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
     EXPECT_LE(map.getXMax() - map.getXMin(), 4.0 + 1e-9);
     EXPECT_EQ(map.insertStats().outsideMap, 1u);  // 15 m away: beyond the growth limit
     EXPECT_EQ(map.insertStats().outOfRange, 1u);  // 50 m away: beyond max_range
+}
+
+TEST(StrictConfigSection, ReadChoiceTakesOnlyTheListedWords) {
+    mrpt::config::CConfigFileMemory ini;
+    ini.write("s", "mode", "hot");
+    ini.write("s", "bad", "warm");
+    multibin::StrictConfigSection s(ini, "s");
+    enum class Mode { Jet, Hot, Grey } mode = Mode::Jet, absent = Mode::Grey;
+    const std::vector<std::pair<std::string, Mode>> choices{
+        {"jet", Mode::Jet}, {"hot", Mode::Hot}, {"grayscale", Mode::Grey}};
+    s.readChoice("mode", mode, choices);
+    EXPECT_EQ(mode, Mode::Hot);
+    s.readChoice("missing", absent, choices);
+    EXPECT_EQ(absent, Mode::Grey);  // absent keys keep their value
+    try {
+        s.readChoice("bad", mode, choices);
+        ADD_FAILURE() << "no exception";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(),
+                     "ini section [s], key 'bad': expected jet, hot or grayscale, got 'warm'");
+    }
+    EXPECT_EQ(mode, Mode::Hot);
 }

@@ -5,6 +5,7 @@
 
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace multibin {
@@ -39,6 +40,25 @@ public:
     /** Reads a double and checks lo <= value <= hi (inclusive). */
     void readInRange(const std::string& key, double& value, double lo, double hi);
 
+    /** Reads one word of a fixed set into `value` (an enum, typically): `choices` pairs each
+     * accepted word with its value; any other word fails naming the accepted ones. */
+    template <typename T>
+    void readChoice(const std::string& key, T& value,
+                    const std::vector<std::pair<std::string, T>>& choices) {
+        if (!has(key)) return;
+        std::string word;
+        read(key, word);
+        std::vector<std::string> words;
+        for (const auto& [name, v] : choices) {
+            if (name == word) {
+                value = v;
+                return;
+            }
+            words.push_back(name);
+        }
+        fail(key, "expected " + listOfWords(words) + ", got '" + word + "'");
+    }
+
     /** Declares keys that may appear without being read (MRPT's generic map keys). */
     void allow(const std::vector<std::string>& keys);
 
@@ -50,6 +70,8 @@ public:
 
 private:
     const std::string* raw(const std::string& key);
+    /** "a, b or c". */
+    static std::string listOfWords(const std::vector<std::string>& words);
 
     const mrpt::config::CConfigFileBase& m_source;
     std::string m_section;

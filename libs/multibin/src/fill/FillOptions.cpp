@@ -41,29 +41,18 @@ void FillOptions::read(StrictConfigSection& s) {
     s.read("fill_max_training_points", maxTrainingPoints);
     s.read("fill_residual_correction", residualCorrection);
     s.read("fill_extrapolation_margin", extrapolationMargin);
-    std::string crit = criterionName(criterion);
-    s.read("fill_model_criterion", crit);
-    if (crit == "aic")
-        criterion = ModelCriterion::AICc;
-    else if (crit == "bic")
-        criterion = ModelCriterion::BIC;
-    else if (crit == "holdout")
-        criterion = ModelCriterion::Holdout;
-    else
-        s.fail("fill_model_criterion", "expected aic, bic or holdout, got '" + crit + "'");
+    s.readChoice<ModelCriterion>("fill_model_criterion", criterion,
+                                 {{"aic", ModelCriterion::AICc},
+                                  {"bic", ModelCriterion::BIC},
+                                  {"holdout", ModelCriterion::Holdout}});
     s.read("fill_max_terms", maxTerms);
     s.read("fill_min_width", minWidth_cells);
     s.read("fill_pso_particles", swarmParticles);
     s.read("fill_pso_iterations", swarmIterations);
     s.read("fill_pso_seed", swarmSeed);
-    std::string model = sigmaModelName(sigmaModel);
-    s.read("fill_sigma_model", model);
-    if (model == "calibrated")
-        sigmaModel = FillSigmaModel::Calibrated;
-    else if (model == "paper")
-        sigmaModel = FillSigmaModel::Paper;
-    else
-        s.fail("fill_sigma_model", "expected calibrated or paper, got '" + model + "'");
+    s.readChoice<FillSigmaModel>(
+        "fill_sigma_model", sigmaModel,
+        {{"calibrated", FillSigmaModel::Calibrated}, {"paper", FillSigmaModel::Paper}});
     s.read("fill_median_sigma_gain", medianSigmaGain);
     s.read("fill_gaussian_sigma_gain", gaussianSigmaGain);
     s.read("fill_sigma_floor", sigmaFloor_m);

@@ -75,6 +75,13 @@ const std::string* StrictConfigSection::raw(const std::string& key) {
     return &m_values[static_cast<size_t>(it - m_keys.begin())];
 }
 
+std::string StrictConfigSection::listOfWords(const std::vector<std::string>& words) {
+    std::string out;
+    for (size_t i = 0; i < words.size(); i++)
+        out += (i == 0 ? "" : i + 1 == words.size() ? " or " : ", ") + words[i];
+    return out;
+}
+
 void StrictConfigSection::fail(const std::string& key, const std::string& problem) const {
     throw std::invalid_argument("ini section [" + m_section + "], key '" + key + "': " + problem);
 }

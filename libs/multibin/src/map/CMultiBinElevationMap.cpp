@@ -147,16 +147,10 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     s.read("max_range", max_range_m);
     s.read("sensor_labels", sensor_labels);
     s.read("global_sensor_labels", global_sensor_labels);
-    std::string cmap = colormapName(colormap);
-    s.read("colormap", cmap);
-    if (cmap == "jet")
-        colormap = mrpt::img::cmJET;
-    else if (cmap == "hot")
-        colormap = mrpt::img::cmHOT;
-    else if (cmap == "grayscale")
-        colormap = mrpt::img::cmGRAYSCALE;
-    else
-        s.fail("colormap", "expected jet, hot or grayscale, got '" + cmap + "'");
+    s.readChoice<mrpt::img::TColormap>("colormap", colormap,
+                                       {{"jet", mrpt::img::cmJET},
+                                        {"hot", mrpt::img::cmHOT},
+                                        {"grayscale", mrpt::img::cmGRAYSCALE}});
     s.read("color_by_sigma", color_by_sigma);
     s.read("visibility_constraint", visibility.enabled);
     s.read("visibility_margin", visibility.margin_m);
