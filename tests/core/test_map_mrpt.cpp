@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 
-#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CMultiMetricMap.h>
