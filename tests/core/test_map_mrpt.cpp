@@ -2,7 +2,6 @@
  * CMultiMetricMap creation, pose PDFs from CObservationRobotPose. */
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
-
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CMultiMetricMap.h>
