@@ -9,18 +9,20 @@
 
 namespace test_scenes {
 
-/** A pitched 2D laser seeing the plane z = 0 from 0.26 m, like the paper's URG-04LX. */
+/** A pitched 2D laser (240 deg, `beams` beams) seeing the plane z = 0 from `height_m`, like the
+ * paper's URG-04LX (683 beams, 0.26 m, 45 deg). */
 inline mrpt::obs::CObservation2DRangeScan::Ptr pitchedScanOverFloor(double height_m,
-                                                                    double pitch_rad) {
+                                                                    double pitch_rad,
+                                                                    size_t beams = 683) {
     auto scan = mrpt::obs::CObservation2DRangeScan::Create();
     scan->sensorLabel = "LASER";
     scan->aperture = float(mrpt::DEG2RAD(240.0));
     scan->maxRange = 4.0f;
     scan->sensorPose = mrpt::poses::CPose3D(0, 0, height_m, 0, pitch_rad, 0);
-    const size_t N = 683;
-    scan->resizeScan(N);
-    for (size_t i = 0; i < N; i++) {
-        const double a = -0.5 * scan->aperture + scan->aperture * double(i) / (N - 1);
+    scan->resizeScan(beams);
+    for (size_t i = 0; i < beams; i++) {
+        const double a =
+            beams > 1 ? -0.5 * scan->aperture + scan->aperture * double(i) / double(beams - 1) : 0;
         // Ray direction in the robot frame; hits z = 0 at t = h / -dz.
         const mrpt::math::TVector3D d =
             scan->sensorPose.rotateVector(mrpt::math::TVector3D(std::cos(a), std::sin(a), 0));

@@ -12,6 +12,8 @@
 #include <tuple>
 #include <vector>
 
+#include "../core/test_scenes.h"
+
 namespace reliability {
 
 using Map = mrpt::maps::CMultiBinElevationMap;
@@ -49,24 +51,7 @@ inline std::vector<BinRecord> content(const Map& map) {
 
 /** A pitched URG-04LX-like scan of the floor z = 0 from 0.26 m (683 beams over 240 deg). */
 inline mrpt::obs::CObservation2DRangeScan::Ptr floorScan(size_t beams = 683) {
-    auto scan = mrpt::obs::CObservation2DRangeScan::Create();
-    scan->sensorLabel = "LASER";
-    scan->aperture = float(mrpt::DEG2RAD(240.0));
-    scan->maxRange = 4.0f;
-    const double h = 0.26, pitch = mrpt::DEG2RAD(45.0);
-    scan->sensorPose = mrpt::poses::CPose3D(0, 0, h, 0, pitch, 0);
-    scan->resizeScan(beams);
-    for (size_t i = 0; i < beams; i++) {
-        const double a =
-            beams > 1 ? -0.5 * scan->aperture + scan->aperture * double(i) / double(beams - 1) : 0;
-        const mrpt::math::TVector3D d =
-            scan->sensorPose.rotateVector(mrpt::math::TVector3D(std::cos(a), std::sin(a), 0));
-        const double t = d.z < -1e-3 ? h / -d.z : 100.0;
-        const bool valid = t < scan->maxRange;
-        scan->setScanRange(i, valid ? float(t) : 0.f);
-        scan->setScanRangeValidity(i, valid);
-    }
-    return scan;
+    return test_scenes::pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0), beams);
 }
 
 /** A robot pose PDF with a small diagonal covariance. */
