@@ -32,6 +32,12 @@ struct BinUpdateParams {
     float certaintyIncrement = 1.0f;         //!< `a` of eqs 13-14
     double maxElevationUncertainty_m = 0.1;  //!< Delta_max: a point counts if 3 sigma_z <= this [m]
     double varianceFloor_m2 = 0.002 * 0.002;  //!< reported variance never falls below this [m^2]
+
+    /** Eq 13 gate: a height with this variance [m^2] counts only if its 99.7 % interval
+     * (3 sigma) lies within Delta_max. */
+    bool passesEq13(double variance_m2) const {
+        return !(9.0 * variance_m2 > maxElevationUncertainty_m * maxElevationUncertainty_m);
+    }
 };
 
 /** What happened to the points of one insertion. */

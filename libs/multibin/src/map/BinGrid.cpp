@@ -180,7 +180,7 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
                            const BinUpdateParams& params, double continuityBound_m,
                            InsertStats& stats) {
     // Eq 13 gate: the 99.7 % interval of the measured height must be within Delta_max.
-    if (9.0 * variance_m2 > params.maxElevationUncertainty_m * params.maxElevationUncertainty_m) {
+    if (!params.passesEq13(variance_m2)) {
         stats.tooUncertain++;
         return false;
     }
@@ -273,7 +273,6 @@ InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
     // 1/var = 1/var0 + sum 1/var_i, h/var = h0/var0 + sum h_i/var_i: the same estimate as the
     // sequential filter up to rounding, without a division chained through every point.
     const bool perPoint = continuityBound_m < std::numeric_limits<double>::infinity();
-    const double maxVar9 = params.maxElevationUncertainty_m * params.maxElevationUncertainty_m;
     const CellWindow w = m_window;
 
     // The open run: consecutive accepted points in one bin.
@@ -332,7 +331,7 @@ InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
                 status = kBadCovariance;
             else if (!w.contains(ix, iy))
                 status = kOutsideMap;
-            else if (9.0 * double(c.zz) > maxVar9)  // eq 13 (as in insertHeight)
+            else if (!params.passesEq13(double(c.zz)))
                 status = kTooUncertain;
             else if (!binIndexOf(p.point_m.z(), params.binHeight_m, n))
                 status = kOutsideBinRange;

@@ -162,11 +162,11 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
     const double half = 0.5 * c.max_size_m;
     double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
     // Nor may a point the eq 13 gate will refuse (a stereo point 20 m away, sigma_z metres).
-    const double maxVariance_m2 = std::pow(insertionOptions.max_elevation_uncertainty_m / 3.0, 2);
+    const multibin::BinUpdateParams params = binUpdateParams();
     for (const PointWithCov& p : mapPoints) {
         const double x = p.point_m.x(), y = p.point_m.y();
         if (!(std::abs(x - sensor_m.x()) <= half && std::abs(y - sensor_m.y()) <= half)) continue;
-        if (!(p.cov_m2.zz <= maxVariance_m2)) continue;
+        if (std::isnan(p.cov_m2.zz) || !params.passesEq13(p.cov_m2.zz)) continue;
         xmin = std::min(xmin, x);
         xmax = std::max(xmax, x);
         ymin = std::min(ymin, y);
