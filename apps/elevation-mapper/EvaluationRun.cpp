@@ -126,10 +126,7 @@ void EvaluationRun::insertRawPoints(const mrpt::obs::CObservation& obs,
 void EvaluationRun::observe(const mrpt::obs::CObservation& obs,
                             const mrpt::poses::CPose3DPDFGaussian& robotPose,
                             bool poseHasCovariance) {
-    if (m_evaluated.insertionOptions.sensor_labels.empty() ||
-        std::count(m_evaluated.insertionOptions.sensor_labels.begin(),
-                   m_evaluated.insertionOptions.sensor_labels.end(), obs.sensorLabel) > 0)
-        insertRawPoints(obs, robotPose);
+    if (m_evaluated.acceptsLabel(obs.sensorLabel)) insertRawPoints(obs, robotPose);
     if (!dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs) &&
         !dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs))
         return;

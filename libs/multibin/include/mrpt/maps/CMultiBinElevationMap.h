@@ -228,6 +228,9 @@ public:
     /** Observations inserted with the default pose covariance because no valid pose PDF was known.
      */
     size_t poseFallbackCount() const { return m_poseFallbacks; }
+    /** True if observations with this sensor label are inserted (insertionOptions.sensor_labels
+     * is empty or lists it). */
+    bool acceptsLabel(const std::string& label) const;
     /** Observations skipped because their sensor label is not in insertionOptions.sensor_labels. */
     size_t skippedByLabelCount() const { return m_skippedByLabel; }
     /** What the sensor models did (per sensor kind), since the last clear(). */
@@ -289,7 +292,6 @@ private:
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);
     /** Grows the window (if allowed) to cover map-frame points near the sensor. */
     void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m);
-    bool acceptsLabel(const std::string& label) const;
 
     /** One update cycle of `grid`: insertion core, then the visibility constraint. */
     multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid,
