@@ -11,8 +11,6 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "multibin/RasterExport.h"
-
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
 using multibin::eval::CellArray;
@@ -45,6 +43,23 @@ multibin::EsriAsciiGrid rasterOf(const EvalLattice& L, const CellArray& values) 
     g.yllcenter_m = L.cellCenterY_m(0);
     g.heights_m = values.matrix();
     return g;
+}
+
+/** Heights of one of MRPT's DEMs at the lattice's cell centres; NaN where it has none, or outside
+ * `within` when given. */
+CellArray sampleDem(const mrpt::maps::CHeightGridMap2D_Base& dem, const EvalLattice& lattice,
+                    const EvalLattice* within = nullptr) {
+    CellArray h;
+    h.setConstant(lattice.ny, lattice.nx, NAN);
+    for (int r = 0; r < lattice.ny; r++)
+        for (int c = 0; c < lattice.nx; c++) {
+            const double x = lattice.cellCenterX_m(c), y = lattice.cellCenterY_m(r);
+            int cc, rr;
+            double z;
+            if ((!within || within->cellOf(x, y, cc, rr)) && dem.dem_get_z(x, y, z))
+                h(r, c) = float(z);
+        }
+    return h;
 }
 
 }  // namespace
@@ -186,13 +201,7 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
     heightGrid.name = "mrpt_height_grid";
     heightGrid.baseline = "raw_all";
     heightGrid.insert_s = m_heightGrid_s;
-    heightGrid.height_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
-    for (int r = 0; r < m_lattice.ny; r++)
-        for (int c = 0; c < m_lattice.nx; c++) {
-            double z;
-            if (m_heightGrid.dem_get_z(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), z))
-                heightGrid.height_m(r, c) = float(z);
-        }
+    heightGrid.height_m = sampleDem(m_heightGrid, m_lattice);
     methods.push_back(heightGrid);
 
     if (m_mrf) {
@@ -203,15 +212,7 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
         mrf.baseline = "raw_all";
         mrf.insert_s = m_mrf_s;
         mrf.fill_s = secondsSince(t0);
-        mrf.height_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
-        for (int r = 0; r < m_lattice.ny; r++)
-            for (int c = 0; c < m_lattice.nx; c++) {
-                int cc, rr;
-                const double x = m_lattice.cellCenterX_m(c), y = m_lattice.cellCenterY_m(r);
-                double z;
-                if (m_mrfLattice.cellOf(x, y, cc, rr) && m_mrf->dem_get_z(x, y, z))
-                    mrf.height_m(r, c) = float(z);
-            }
+        mrf.height_m = sampleDem(*m_mrf, m_lattice, &m_mrfLattice);
         methods.push_back(mrf);
     }
 
