@@ -33,6 +33,7 @@
 #include "ProgressBar.h"
 #include "RawlogSource.h"
 #include "multibin/ErrorMessage.h"
+#include "multibin/NumberText.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
@@ -153,14 +154,8 @@ std::vector<double> parseProfile(const std::string& text) {
     std::string item;
     std::istringstream is(text);
     while (std::getline(is, item, ',')) {
-        size_t used = 0;
         double x = 0;
-        try {
-            x = std::stod(item, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != item.size() || !std::isfinite(x))
+        if (!multibin::parseFiniteNumber(item, x))
             throw std::invalid_argument("--profile: '" + item + "' is not a number");
         v.push_back(x);
     }

@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/EsriAsciiGrid.h"
 
+#include "multibin/NumberText.h"
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -16,10 +18,8 @@ namespace {
 }
 
 double parseNumber(const std::string& path, const std::string& token, const std::string& what) {
-    char* end = nullptr;
-    const double v = std::strtod(token.c_str(), &end);
-    if (token.empty() || end != token.c_str() + token.size() || !std::isfinite(v))
-        fail(path, "malformed " + what + " '" + token + "'");
+    double v = 0;
+    if (!parseFiniteNumber(token, v)) fail(path, "malformed " + what + " '" + token + "'");
     return v;
 }
 }  // namespace

@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/StrictConfigSection.h"
 
+#include "multibin/NumberText.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -46,12 +48,6 @@ std::vector<std::string> splitList(const std::string& s) {
     return out;
 }
 
-bool parseDouble(const std::string& s, double& v) {
-    if (s.empty()) return false;
-    char* end = nullptr;
-    v = std::strtod(s.c_str(), &end);
-    return end == s.c_str() + s.size() && std::isfinite(v);
-}
 }  // namespace
 
 StrictConfigSection::StrictConfigSection(const mrpt::config::CConfigFileBase& source,
@@ -90,7 +86,7 @@ void StrictConfigSection::read(const std::string& key, double& value) {
     const std::string* s = raw(key);
     if (!s) return;
     double v;
-    if (!parseDouble(*s, v)) fail(key, "expected a finite number, got '" + *s + "'");
+    if (!parseFiniteNumber(*s, v)) fail(key, "expected a finite number, got '" + *s + "'");
     value = v;
 }
 
@@ -143,7 +139,7 @@ void StrictConfigSection::read(const std::string& key, std::vector<double>& valu
     std::vector<double> out;
     for (const auto& tok : splitList(*s)) {
         double v;
-        if (!parseDouble(tok, v)) fail(key, "expected a list of numbers, got '" + tok + "'");
+        if (!parseFiniteNumber(tok, v)) fail(key, "expected a list of numbers, got '" + tok + "'");
         out.push_back(v);
     }
     if (expected_size && out.size() != expected_size)
