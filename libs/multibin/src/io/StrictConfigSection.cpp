@@ -68,7 +68,16 @@ const std::string* StrictConfigSection::raw(const std::string& key) {
     const auto it = std::find(m_keys.begin(), m_keys.end(), key);
     if (it == m_keys.end()) return nullptr;
     m_used.insert(key);
-    return &m_values[static_cast<size_t>(it - m_keys.begin())];
+    const std::string& value = m_values[static_cast<size_t>(it - m_keys.begin())];
+    // MRPT's ini writer takes a trailing backslash for a line continuation, so such a value would
+    // not load back the same from saved options (or from the options inside a serialized map).
+    if (!value.empty() && value.back() == '\\')
+        fail(key, "a value must not end in a backslash, got '" + value + "'");
+    for (const char c : value)
+        if (std::iscntrl(static_cast<unsigned char>(c)) && c != '\t')
+            fail(key, "the value holds a control character (byte " +
+                          std::to_string(static_cast<unsigned char>(c)) + ")");
+    return &value;
 }
 
 std::string StrictConfigSection::listOfWords(const std::vector<std::string>& words) {
