@@ -24,10 +24,17 @@ double secondsSince(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-CellArray loadTruth(const std::string& path, double cellSize_m, EvalLattice& lattice) {
+/** The truth on the map's lattice, cut to `area_m` when given. */
+CellArray loadTruth(const std::string& path, double cellSize_m, const std::vector<double>& area_m,
+                    EvalLattice& lattice) {
     if (!fs::exists(path)) throw std::runtime_error("ground truth '" + path + "' not found");
-    return multibin::eval::groundTruthOnLattice(multibin::EsriAsciiGrid::load(path), cellSize_m,
-                                                lattice);
+    const CellArray whole = multibin::eval::groundTruthOnLattice(
+        multibin::EsriAsciiGrid::load(path), cellSize_m, lattice);
+    if (area_m.empty()) return whole;
+    const EvalLattice sub = multibin::eval::subLattice(lattice, area_m);
+    const CellArray cut = whole.block(sub.iy0 - lattice.iy0, sub.ix0 - lattice.ix0, sub.ny, sub.nx);
+    lattice = sub;
+    return cut;
 }
 
 /** Cell size of the evaluated map's (global) grid [m]. */
@@ -68,7 +75,8 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
     : m_options(options),
       m_evaluated(evaluated),
       m_laserOnly(evaluated.creationOptions),
-      m_truth(loadTruth(options.groundTruthPath, evaluatedCellSize_m(evaluated), m_lattice)),
+      m_truth(loadTruth(options.groundTruthPath, evaluatedCellSize_m(evaluated), options.area_m,
+                        m_lattice)),
       m_rawLaser(m_lattice),
       m_rawAll(m_lattice),
       m_heightGrid(mrpt::maps::CHeightGridMap2D::mrSimpleAverage, m_lattice.area_m()[0],

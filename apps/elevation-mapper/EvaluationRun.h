@@ -31,6 +31,9 @@ public:
         /** Profile line for the height-profile figure [m]: x0, y0, x1, y1; empty = along x through
          * the middle of the evaluated area. */
         std::vector<double> profile_m;
+        /** Evaluate only the truth cells whose centres lie in {xmin, xmax, ymin, ymax} [m];
+         * empty = the whole truth. */
+        std::vector<double> area_m;
     };
 
     EvaluationRun(const Options& options, mrpt::maps::CMultiBinElevationMap& evaluated);

@@ -5,7 +5,8 @@
  * the map side by side with its baselines and MRPT's height maps (report.json and figures).
  *
  *   elevation-mapper --config INI (--rawlog FILE | --simplemap FILE) --out DIR
- *                    [--ground-truth GT.asc [--with-mrf] [--profile x0,y0,x1,y1]] [--no-plots]
+ *                    [--ground-truth GT.asc [--with-mrf] [--profile x0,y0,x1,y1]
+ *                     [--eval-area xmin,xmax,ymin,ymax]] [--no-plots]
  *
  * The ini file has the maps in section [MappingApplication], as MRPT's observations2map reads
  * them, so one file serves both programs. With no arguments it runs on the shipped default data. */
@@ -43,7 +44,7 @@ namespace {
 constexpr const char* kMapsSection = "MappingApplication";
 
 struct Arguments {
-    std::string config, rawlog, simplemap, out, groundTruth, profile;
+    std::string config, rawlog, simplemap, out, groundTruth, profile, evalArea;
     bool withMrf = false, plots = true;
     bool usedDefaults = false;
 };
@@ -51,8 +52,8 @@ struct Arguments {
 void printUsage() {
     std::cout
         << "Usage: elevation-mapper --config INI (--rawlog FILE | --simplemap FILE) --out DIR\n"
-           "                        [--ground-truth GT.asc [--with-mrf] [--profile x0,y0,x1,y1]]\n"
-           "                        [--no-plots]\n"
+           "                        [--ground-truth GT.asc [--with-mrf] [--profile x0,y0,x1,y1]\n"
+           "                         [--eval-area xmin,xmax,ymin,ymax]] [--no-plots]\n"
            "       elevation-mapper            (runs on the shipped default data)\n\n"
            "Builds a multi-bin elevation map (gaps filled) and writes to DIR: elevation_map.bin\n"
            "(serialized map, gz), elevation_height.png, elevation_sigma.png, ESRI ASCII rasters\n"
@@ -60,7 +61,8 @@ void printUsage() {
            "elevation.ply (mesh) and elevation.3Dscene.\n"
            "With --ground-truth it evaluates raw, laser_only, multibin, multibin_filled and\n"
            "mrpt_height_grid (and mrpt_height_grid_mrf with --with-mrf, on a crop of 35 x 35\n"
-           "cells) over the truth's area and writes report.json, profile.csv and, unless\n"
+           "cells) over the truth's area (or the part of it inside --eval-area [m]) and writes\n"
+           "report.json, profile.csv and, unless\n"
            "--no-plots, figures drawn by matplotlib (fig_pi.png, fig_profile.png, layers.png).\n"
            "The ini file lists the maps in section ["
         << kMapsSection
@@ -84,7 +86,8 @@ Arguments parseArguments(int argc, char** argv) {
                                               {"--simplemap", &a.simplemap},
                                               {"--out", &a.out},
                                               {"--ground-truth", &a.groundTruth},
-                                              {"--profile", &a.profile}};
+                                              {"--profile", &a.profile},
+                                              {"--eval-area", &a.evalArea}};
     for (int i = 1; i < argc; i++) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
@@ -108,8 +111,8 @@ Arguments parseArguments(int argc, char** argv) {
     if (a.rawlog.empty() == a.simplemap.empty())
         throw std::invalid_argument("give exactly one of --rawlog FILE and --simplemap FILE");
     if (a.out.empty()) throw std::invalid_argument("--out DIR is required");
-    if (a.groundTruth.empty() && (a.withMrf || !a.profile.empty()))
-        throw std::invalid_argument("--with-mrf and --profile need --ground-truth");
+    if (a.groundTruth.empty() && (a.withMrf || !a.profile.empty() || !a.evalArea.empty()))
+        throw std::invalid_argument("--with-mrf, --profile and --eval-area need --ground-truth");
     return a;
 }
 
@@ -148,7 +151,9 @@ void drawFigures(const fs::path& out) {
         std::cerr << "elevation-mapper: warning: figures not drawn: '" << cmd << "' failed\n";
 }
 
-std::vector<double> parseProfile(const std::string& text) {
+/** Four comma-separated numbers given to `flag` (e.g. "--profile"), or none for empty text. */
+std::vector<double> parseFourNumbers(const std::string& flag, const std::string& text,
+                                     const std::string& meaning) {
     std::vector<double> v;
     if (text.empty()) return v;
     std::string item;
@@ -156,10 +161,10 @@ std::vector<double> parseProfile(const std::string& text) {
     while (std::getline(is, item, ',')) {
         double x = 0;
         if (!multibin::parseFiniteNumber(item, x))
-            throw std::invalid_argument("--profile: '" + item + "' is not a number");
+            throw std::invalid_argument(flag + ": '" + item + "' is not a number");
         v.push_back(x);
     }
-    if (v.size() != 4) throw std::invalid_argument("--profile needs x0,y0,x1,y1 [m]");
+    if (v.size() != 4) throw std::invalid_argument(flag + " needs " + meaning);
     return v;
 }
 
@@ -180,7 +185,8 @@ int run(const Arguments& args) {
         EvaluationRun::Options eo;
         eo.groundTruthPath = args.groundTruth;
         eo.withMrf = args.withMrf;
-        eo.profile_m = parseProfile(args.profile);
+        eo.profile_m = parseFourNumbers("--profile", args.profile, "x0,y0,x1,y1 [m]");
+        eo.area_m = parseFourNumbers("--eval-area", args.evalArea, "xmin,xmax,ymin,ymax [m]");
         evaluation = std::make_unique<EvaluationRun>(eo, *elevation);
     }
 

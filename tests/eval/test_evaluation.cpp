@@ -143,3 +143,23 @@ TEST(Evaluation, AreaScoresCountOnlyTheCellsOfTheSubArea) {
     EXPECT_NEAR(a.errors.at("m").mse_m2, (0.01 + 0.04) / 2, 1e-7);
     EXPECT_EQ(a.area_m, (std::vector<double>{1, 2, 0, 2}));
 }
+
+// Cells of 0.1 m, lattice cells ix -5..14 (x in [-0.5, 1.5)), iy 0..9. An area whose edges fall
+// just past cell centres keeps exactly the cells whose centres lie inside it.
+TEST(Evaluation, SubLatticeKeepsTheCellsWhoseCentresLieInTheArea) {
+    EvalLattice L;
+    L.cellSize_m = 0.1;
+    L.ix0 = -5;
+    L.nx = 20;
+    L.iy0 = 0;
+    L.ny = 10;
+    const EvalLattice s = subLattice(L, {0.0, 0.34, 0.24, 2.0});
+    EXPECT_EQ(s.ix0, 0);  // centre 0.05 is the first >= 0.0
+    EXPECT_EQ(s.nx, 3);   // centres 0.05, 0.15, 0.25 (0.35 > 0.34)
+    EXPECT_EQ(s.iy0, 2);  // centre 0.25 is the first >= 0.24
+    EXPECT_EQ(s.ny, 8);   // up to the lattice's last row (iy 9), the area goes beyond it
+    EXPECT_DOUBLE_EQ(s.cellSize_m, 0.1);
+    EXPECT_THROW(subLattice(L, {2.0, 3.0, 0.0, 1.0}), std::invalid_argument);  // outside
+    EXPECT_THROW(subLattice(L, {1.0, 0.0, 0.0, 1.0}), std::invalid_argument);  // xmin > xmax
+    EXPECT_THROW(subLattice(L, {0.0, 1.0}), std::invalid_argument);            // two numbers
+}

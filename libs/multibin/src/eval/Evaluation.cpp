@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library: evaluation against ground truth (eq 17). */
 #include "multibin/eval/Evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -23,6 +24,23 @@ bool EvalLattice::cellOf(double x_m, double y_m, int& col, int& row) const {
     col = floorIndex(x_m, cellSize_m) - ix0;
     row = floorIndex(y_m, cellSize_m) - iy0;
     return col >= 0 && row >= 0 && col < nx && row < ny;
+}
+
+EvalLattice subLattice(const EvalLattice& lattice, const std::vector<double>& area_m) {
+    if (area_m.size() != 4 || !(area_m[0] < area_m[1]) || !(area_m[2] < area_m[3]))
+        throw std::invalid_argument("evaluation area: expected xmin < xmax, ymin < ymax [m]");
+    // Cell k's centre (k + 0.5) s lies in [lo, hi] for ceil(lo/s - 0.5) <= k <= floor(hi/s - 0.5).
+    const double s = lattice.cellSize_m;
+    const auto first = [s](double lo) { return int(std::ceil(lo / s - 0.5)); };
+    const auto last = [s](double hi) { return int(std::floor(hi / s - 0.5)); };
+    EvalLattice sub = lattice;
+    sub.ix0 = std::max(lattice.ix0, first(area_m[0]));
+    sub.iy0 = std::max(lattice.iy0, first(area_m[2]));
+    sub.nx = std::min(lattice.ix0 + lattice.nx - 1, last(area_m[1])) - sub.ix0 + 1;
+    sub.ny = std::min(lattice.iy0 + lattice.ny - 1, last(area_m[3])) - sub.iy0 + 1;
+    if (sub.nx <= 0 || sub.ny <= 0)
+        throw std::invalid_argument("evaluation area: no cell of the ground truth lies inside it");
+    return sub;
 }
 
 CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m,

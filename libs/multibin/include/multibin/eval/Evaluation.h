@@ -38,6 +38,11 @@ struct EvalLattice {
 CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m,
                                EvalLattice& latticeOut);
 
+/** The cells of `lattice` whose centres lie inside area_m = {xmin, xmax, ymin, ymax} [m] (to
+ * evaluate over part of the truth, e.g. a mock-up without the floor around it). Throws
+ * std::invalid_argument naming the problem if the area is malformed or holds no cell centre. */
+EvalLattice subLattice(const EvalLattice& lattice, const std::vector<double>& area_m);
+
 /** The raw map of eq 17: range points simply registered in the grid, a cell's value being the
  * mean of the points that fall in it. */
 class RawPointGrid {
