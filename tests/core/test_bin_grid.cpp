@@ -1,9 +1,14 @@
 /* Tests of the insertion core: Kalman fusion, winning bin, gates, window moves. */
 #include <gtest/gtest.h>
 
+#include <mrpt/core/bits_math.h>
+
+#include <cstring>
+#include <limits>
 #include <random>
 
 #include "multibin/BinGrid.h"
+#include "multibin/PosePropagation.h"
 
 using namespace multibin;
 
@@ -169,4 +174,120 @@ TEST(BinGrid, MovingTheWindowKeepsCellsInsideAndReportsLeavers) {
     for (int i = 10; i < 13; i++) EXPECT_EQ(g.winningBin(i, 0), nullptr);
     EXPECT_EQ(g.winningBin(5, -1), nullptr);
     EXPECT_EQ(g.binCount(), 56u);
+}
+
+TEST(BinGrid, BlockHeightBoundCoversEveryBin) {
+    // Random insertions (with and without the eq 14 bound), fused and appended bins, moves and
+    // growth: every bin's height stays at or below the bound of its block, and a block whose
+    // cells never held a bin reports none.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    BinGrid g(0.05);
+    g.reset(0.05, CellWindow{-13, 5, 37, 29});
+    BinUpdateParams p;
+    size_t checkedBins = 0;
+    for (int round = 0; round < 40; round++) {
+        const CellWindow w = g.window();
+        PointsWithCov pts;
+        for (int k = 0; k < 200; k++) {
+            const double x = (w.ix0 + unit(rng) * w.nx) * 0.05,
+                         y = (w.iy0 + unit(rng) * w.ny) * 0.05;
+            pts.push_back(
+                pointAt(x, y, -1.0 + 3.0 * unit(rng) * unit(rng), 0.001 + 0.02 * unit(rng)));
+        }
+        g.beginCycle();
+        g.insertPoints(pts, p, round % 2 ? 0.05 : std::numeric_limits<double>::infinity());
+        Bin b;
+        b.height_m = float(unit(rng) * 2.0);
+        b.variance_m2 = 1e-4f;
+        b.certainty = 1;
+        b.pointCount = 1;
+        BinUpdateParams wide = p;
+        wide.binHeight_m = 10.0;  // every height in one bin index: fuseBin moves its height
+        g.fuseBin(w.ix0 + int(unit(rng) * w.nx), w.iy0 + int(unit(rng) * w.ny), b, wide);
+        g.appendBin(w.ix0 + int(unit(rng) * w.nx), w.iy0 + int(unit(rng) * w.ny), b);
+        if (round % 5 == 1)
+            g.moveWindowTo(w.ix0 + int(unit(rng) * 30) - 15, w.iy0 + int(unit(rng) * 30) - 15);
+        if (round % 13 == 7) g.growToInclude(CellWindow{w.ix0 - 9, w.iy0 + 4, 3, 40});
+        const CellWindow now = g.window();
+        for (int iy = now.iy0; iy < now.iy0 + now.ny; iy++)
+            for (int ix = now.ix0; ix < now.ix0 + now.nx; ix++) {
+                const float bound = g.blockMaxHeight_m(BinGrid::blockOf(ix), BinGrid::blockOf(iy));
+                g.forEachBin(ix, iy, [&](const Bin& bin) {
+                    ASSERT_LE(bin.height_m, bound) << "cell " << ix << "," << iy;
+                    checkedBins++;
+                });
+            }
+    }
+    EXPECT_GT(checkedBins, 10000u);
+    // Blocks are 8 cells: -13 >> 3 = -2 (cells -16..-9), and a block beyond the window has none.
+    EXPECT_EQ(BinGrid::blockOf(-13), -2);
+    EXPECT_EQ(BinGrid::blockOf(-8), -1);
+    EXPECT_EQ(BinGrid::blockOf(7), 0);
+    BinGrid fresh(0.05);
+    fresh.reset(0.05, CellWindow{0, 0, 16, 16});
+    fresh.insertPoints({pointAt(0.05 * 3.5, 0.05 * 9.5, 0.3, 0.003)}, p);
+    EXPECT_EQ(fresh.blockMaxHeight_m(0, 1), 0.3f);
+    EXPECT_EQ(fresh.blockMaxHeight_m(1, 1), -std::numeric_limits<float>::infinity());
+    EXPECT_EQ(fresh.blockMaxHeight_m(5, 1), -std::numeric_limits<float>::infinity());
+}
+
+TEST(BinGrid, FusedSensorInsertionIsBitIdenticalToTwoSteps) {
+    // PosePropagator::apply then insertPoints, against insertSensorPoints, with and without the
+    // eq 14 bound, on batches whose runs of points in one bin cross the 256-point blocks.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    mrpt::poses::CPose3DPDFGaussian robot;
+    robot.mean = mrpt::poses::CPose3D(0.3, -0.2, 0.05, 0.4, 0.02, -0.03);
+    robot.cov.setIdentity();
+    robot.cov *= 1e-5;
+    const mrpt::poses::CPose3D sensorOnRobot(0.1, 0, 0.45, 0, mrpt::DEG2RAD(35.0), 0);
+    const PosePropagator propagator(robot, sensorOnRobot);
+    for (const double bound : {std::numeric_limits<double>::infinity(), 0.05}) {
+        PointsWithCov sensorPoints;
+        for (int k = 0; k < 3000; k++) {
+            // Runs of 1 to 400 points on one spot (one bin), then a jump.
+            const Eigen::Vector3f spot(float(1.0 + unit(rng)), float(unit(rng) - 0.5),
+                                       float(0.1 * unit(rng)));
+            const int run = 1 + int(unit(rng) * unit(rng) * 400);
+            for (int r = 0; r < run && sensorPoints.size() < 20000; r++) {
+                PointWithCov p;
+                p.point_m = spot + Eigen::Vector3f(0, 0, float(0.001 * unit(rng)));
+                p.cov_m2 = {1e-5f, 0, 0, 1e-5f, 0, float(1e-6 + 1e-5 * unit(rng))};
+                sensorPoints.push_back(p);
+            }
+        }
+        BinGrid twoSteps(0.02), fused(0.02);
+        twoSteps.reset(0.02, CellWindow{-100, -100, 250, 200});
+        fused.reset(0.02, CellWindow{-100, -100, 250, 200});
+        BinUpdateParams p;
+        PointsWithCov mapPoints;
+        propagator.apply(sensorPoints, mapPoints);
+        const InsertStats a = twoSteps.insertPoints(mapPoints, p, bound);
+        const InsertStats b = fused.insertSensorPoints(propagator, sensorPoints, p, bound);
+        EXPECT_GT(a.accepted, 15000u);
+        EXPECT_EQ(a.accepted, b.accepted);
+        EXPECT_EQ(a.continuityRejected, b.continuityRejected);
+        EXPECT_EQ(a.outsideMap, b.outsideMap);
+        ASSERT_EQ(twoSteps.binCount(), fused.binCount());
+        size_t same = 0;
+        const CellWindow& w = twoSteps.window();
+        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+                std::vector<Bin> x, y;
+                twoSteps.forEachBin(ix, iy, [&](const Bin& bin) { x.push_back(bin); });
+                fused.forEachBin(ix, iy, [&](const Bin& bin) { y.push_back(bin); });
+                ASSERT_EQ(x.size(), y.size());
+                for (size_t i = 0; i < x.size(); i++) {
+                    ASSERT_EQ(std::memcmp(&x[i], &y[i], sizeof(Bin)), 0) << ix << "," << iy;
+                    same++;
+                }
+            }
+        EXPECT_EQ(same, twoSteps.binCount());
+        ASSERT_EQ(twoSteps.updatedCells().size(), fused.updatedCells().size());
+        for (size_t i = 0; i < twoSteps.updatedCells().size(); i++) {
+            EXPECT_EQ(twoSteps.updatedCells()[i].points, fused.updatedCells()[i].points);
+            EXPECT_EQ(twoSteps.updatedCells()[i].maxHeight_m, fused.updatedCells()[i].maxHeight_m);
+        }
+    }
 }

@@ -2,6 +2,10 @@
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
+#include <array>
+#include <cstring>
+#include <random>
+
 #include "multibin/VisibilityConstraint.h"
 #include "test_scenes.h"
 
@@ -13,6 +17,110 @@ PointWithCov pointAt(double x, double y, double z, double sigmaZ_m) {
     p.point_m = Eigen::Vector3f(float(x), float(y), float(z));
     p.cov_m2 = {1e-6f, 0, 0, 1e-6f, 0, float(sigmaZ_m * sigmaZ_m)};
     return p;
+}
+
+/** Reference: the constraint as it was before the local height bound (commit 483eb88). Every
+ * ray is sampled every half cell from the updated cell towards the sensor until it clears the
+ * highest bin ever stored in the grid, and every cell it enters is tested. The library's version
+ * must edit exactly the same bins. */
+VisibilityStats referenceVisibility(BinGrid& grid, const Eigen::Vector3d& sensor_m,
+                                    const VisibilityParams& vis, const BinUpdateParams& binParams) {
+    VisibilityStats stats;
+    if (!vis.enabled) return stats;
+    const double cell = grid.cellSize_m();
+    const double step = 0.5 * cell;
+    const double stopHeight = grid.maxHeight_m() + vis.margin_m;
+    const double invCell = 1.0 / cell;
+    constexpr double kNoClamp = 1e8;
+    auto conflictMargin = [&](const Bin& b) {
+        return vis.margin_m + 3.0 * BinGrid::sigma_m(b, binParams);
+    };
+    const double minConflictMargin = conflictMargin(Bin{});
+    auto conflicts = [&](const Bin& b, double lineHeight_m) {
+        const double above = b.height_m - lineHeight_m;
+        return above > minConflictMargin && above > conflictMargin(b);
+    };
+    for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
+        const Bin* winner = grid.winningBin(u.ix, u.iy);
+        const float targetCertainty = winner ? winner->certainty : 0.f;
+        const double tz = u.maxHeight_m;
+        const float decrement = vis.certaintyDecrement * float(u.points);
+        grid.editBins(u.ix, u.iy, [&](Bin& b) {
+            if (!conflicts(b, tz)) return true;
+            b.certainty -= decrement;
+            stats.binsWeakened++;
+            if (b.certainty > 0) return true;
+            stats.binsRemoved++;
+            return false;
+        });
+        const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
+        const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
+        const double length = std::sqrt(dx * dx + dy * dy);
+        if (length < cell) continue;
+        stats.raysCast++;
+        const double slope = (sensor_m.z() - tz) / length;
+        const double inCellRise = std::abs(slope) * 0.7072 * cell;
+        const double ux = dx / length, uy = dy / length;
+        const bool unclamped = std::abs(sensor_m.x() * invCell) < kNoClamp &&
+                               std::abs(sensor_m.y() * invCell) < kNoClamp &&
+                               std::abs(tx * invCell) < kNoClamp &&
+                               std::abs(ty * invCell) < kNoClamp;
+        auto cellOf = [&](double coord_m) {
+            return unclamped ? BinGrid::floorToInt(coord_m * invCell) : grid.cellIndex(coord_m);
+        };
+        const CellWindow& w = grid.window();
+        double walk = length;
+        auto clipAxis = [&](double origin, double dir, int i0, int n) {
+            if (dir > 0) walk = std::min(walk, ((i0 + n) * cell - origin) / dir + cell);
+            if (dir < 0) walk = std::min(walk, (i0 * cell - origin) / dir + cell);
+        };
+        clipAxis(tx, ux, w.ix0, w.nx);
+        clipAxis(ty, uy, w.iy0, w.ny);
+        int lastIx = u.ix, lastIy = u.iy;
+        for (double d = step; d < walk; d += step) {
+            const double rayZ = tz + slope * d;
+            if (slope > 0 && rayZ - inCellRise > stopHeight) break;
+            const int ix = cellOf(tx + ux * d);
+            const int iy = cellOf(ty + uy * d);
+            if (ix == lastIx && iy == lastIy) continue;
+            lastIx = ix;
+            lastIy = iy;
+            if (!grid.window().contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
+            stats.cellsVisited++;
+            const double rayHigh = rayZ + inCellRise;
+            grid.editBins(ix, iy, [&](Bin& b) {
+                if (!conflicts(b, rayHigh)) return true;
+                if (b.certainty < targetCertainty) {
+                    stats.binsRemoved++;
+                    return false;
+                }
+                b.certainty -= decrement;
+                stats.binsWeakened++;
+                if (b.certainty > 0) return true;
+                stats.binsRemoved++;
+                return false;
+            });
+        }
+    }
+    return stats;
+}
+
+/** Every bin of the window, cell by cell in chain order, as raw bytes. */
+std::vector<std::array<uint32_t, 5>> binsOf(const BinGrid& g) {
+    std::vector<std::array<uint32_t, 5>> out;
+    const CellWindow& w = g.window();
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
+            g.forEachBin(ix, iy, [&](const Bin& b) {
+                std::array<uint32_t, 5> r;
+                std::memcpy(&r[0], &b.height_m, 4);
+                std::memcpy(&r[1], &b.variance_m2, 4);
+                std::memcpy(&r[2], &b.certainty, 4);
+                r[3] = b.pointCount;
+                r[4] = uint32_t(uint16_t(b.index)) | (uint32_t(ix - w.ix0) << 16);
+                out.push_back(r);
+            });
+    return out;
 }
 }  // namespace
 
@@ -52,20 +160,123 @@ TEST(Visibility, MoreCertainOccluderOnlyLosesCertainty) {
 }
 
 TEST(Visibility, ConsistentTerrainIsUntouched) {
-    BinGrid g(0.1);
-    g.reset(0.1, CellWindow{-5, -5, 30, 10});
-    BinUpdateParams p;
-    VisibilityParams v;
-    // A slope rising away from the sensor: every cell is visible, nothing is stale.
-    g.beginCycle();
-    for (int i = 3; i < 20; i++)
-        g.insertPoints({pointAt(0.1 * i + 0.05, 0.05, 0.01 * i, 0.005)}, p);
-    g.beginCycle();
-    g.insertPoints({pointAt(2.05, 0.05, 0.2, 0.005)}, p);
-    // Sensor 0.25 m up: the line of sight runs low over the slope for a while.
-    const VisibilityStats s = applyVisibilityConstraint(g, {0.05, 0.05, 0.25}, v, p);
-    EXPECT_EQ(s.binsRemoved + s.binsWeakened, 0u);
-    EXPECT_GT(s.cellsVisited, 5u);
+    // A slope rising away from the sensor: every cell is visible, nothing is stale. The same
+    // slope with one cell raised 5 cm into the line of sight: exactly that bin is edited.
+    for (const bool raised : {false, true}) {
+        BinGrid g(0.1);
+        g.reset(0.1, CellWindow{-5, -5, 30, 10});
+        BinUpdateParams p;
+        VisibilityParams v;
+        g.beginCycle();
+        for (int i = 3; i < 20; i++) {
+            // The line of sight from (0.05, 0.25) to (2.05, 0.2) passes x = 1.25 at 0.22 m.
+            const double z = raised && i == 12 ? 0.27 : 0.01 * i;
+            g.insertPoints({pointAt(0.1 * i + 0.05, 0.05, z, 0.005)}, p);
+        }
+        g.beginCycle();
+        g.insertPoints({pointAt(2.05, 0.05, 0.2, 0.005)}, p);
+        BinGrid reference = g;
+        // Sensor 0.25 m up: the line of sight runs low over the slope for a while.
+        const VisibilityStats s = applyVisibilityConstraint(g, {0.05, 0.05, 0.25}, v, p);
+        const VisibilityStats r = referenceVisibility(reference, {0.05, 0.05, 0.25}, v, p);
+        // Raised: weakened by the contradicting point to certainty 0, hence also removed.
+        EXPECT_EQ(s.binsWeakened, raised ? 1u : 0u);
+        EXPECT_EQ(s.binsRemoved, raised ? 1u : 0u);
+        EXPECT_EQ(s.binsRemoved, r.binsRemoved);
+        EXPECT_EQ(s.binsWeakened, r.binsWeakened);
+        EXPECT_EQ(binsOf(g), binsOf(reference));
+        if (raised) EXPECT_EQ(g.winningBin(12, 0), nullptr) << "less certain than the target";
+        // The reference walks every cell under the line; the local bound only those near it.
+        EXPECT_LE(s.cellsVisited, r.cellsVisited);
+        EXPECT_GT(r.cellsVisited, 5u);
+    }
+}
+
+TEST(Visibility, LocalHeightBoundEditsTheSameBinsAsTheGlobalWalk) {
+    // Random terrains with spikes and stale layers, random updates and sensor positions (above,
+    // below, on a cell-centre line so samples fall on cell edges, far outside the window), on
+    // windows that were moved and grown (block slots reused): the library's constraint must
+    // leave every bin bit-identical to the reference walk, with the same counts.
+    std::mt19937 rng(20261122);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    size_t edits = 0, visited = 0, visitedReference = 0, scenes = 0;
+    for (int scene = 0; scene < 300; scene++) {
+        const double cell = unit(rng) < 0.5 ? 0.015 : 0.1;
+        const int nx = 8 + int(unit(rng) * 60), ny = 8 + int(unit(rng) * 60);
+        const int ix0 = int(unit(rng) * 40) - 20, iy0 = int(unit(rng) * 40) - 20;
+        BinGrid g(cell);
+        g.reset(cell, CellWindow{ix0, iy0, nx, ny});
+        BinUpdateParams p;
+        VisibilityParams v;
+        const double slopeX = (unit(rng) - 0.5) * 0.4, slopeY = (unit(rng) - 0.5) * 0.4;
+        auto ground = [&](int ix, int iy) {
+            return slopeX * ix * cell + slopeY * iy * cell + 0.01 * std::sin(ix * 0.7 + iy * 1.3);
+        };
+        auto fill = [&](const CellWindow& w) {
+            for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+                for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+                    if (unit(rng) < 0.15) continue;  // unobserved
+                    double z = ground(ix, iy);
+                    if (unit(rng) < 0.03) z += 0.05 + unit(rng) * 0.8;  // spikes, stale objects
+                    const int reps = 1 + int(unit(rng) * 4);
+                    PointsWithCov pts;
+                    for (int k = 0; k < reps; k++)
+                        pts.push_back(pointAt(g.cellCenter_m(ix), g.cellCenter_m(iy),
+                                              z + 0.002 * unit(rng), 0.002 + 0.01 * unit(rng)));
+                    if (unit(rng) < 0.2)  // a second layer
+                        pts.push_back(pointAt(g.cellCenter_m(ix), g.cellCenter_m(iy),
+                                              z + 0.1 + 0.3 * unit(rng), 0.005));
+                    g.beginCycle();
+                    g.insertPoints(pts, p);
+                }
+        };
+        fill(g.window());
+        if (unit(rng) < 0.4) {  // move: entering cells reuse the slots of leaving blocks
+            const int mx = int(unit(rng) * 2 * nx) - nx, my = int(unit(rng) * 2 * ny) - ny;
+            g.moveWindowTo(ix0 + mx, iy0 + my);
+            fill(g.window());
+        }
+        if (unit(rng) < 0.2) {  // grow: the block table is rebuilt
+            const CellWindow w = g.window();
+            g.growToInclude(CellWindow{w.ix0 - 5, w.iy0 - 3, w.nx + 9, w.ny + 4});
+            fill(CellWindow{w.ix0 - 5, w.iy0 - 3, 5, 3});
+        }
+        // The update: a random subset of cells seen lower than stored (objects gone) or at
+        // the ground.
+        const CellWindow w = g.window();
+        g.beginCycle();
+        PointsWithCov update;
+        const int n = 1 + int(unit(rng) * 40);
+        for (int k = 0; k < n; k++) {
+            const int ix = w.ix0 + int(unit(rng) * w.nx), iy = w.iy0 + int(unit(rng) * w.ny);
+            const double z = ground(ix, iy) - (unit(rng) < 0.3 ? 0.1 * unit(rng) : 0.0);
+            for (int r = int(unit(rng) * 3); r >= 0; r--)
+                update.push_back(pointAt(g.cellCenter_m(ix), g.cellCenter_m(iy), z, 0.003));
+        }
+        g.insertPoints(update, p);
+        Eigen::Vector3d sensor((w.ix0 + unit(rng) * w.nx) * cell, (w.iy0 + unit(rng) * w.ny) * cell,
+                               unit(rng) < 0.8 ? 0.2 + unit(rng) * 1.0 : -0.3 - unit(rng) * 0.5);
+        const double kind = unit(rng);
+        if (kind < 0.2) sensor.y() = g.cellCenter_m(w.iy0 + int(unit(rng) * w.ny));
+        if (kind > 0.2 && kind < 0.3) sensor.x() = g.cellCenter_m(w.ix0 + int(unit(rng) * w.nx));
+        if (kind > 0.95) sensor.x() += 50.0;  // far outside the window
+        BinGrid reference = g;
+        const VisibilityStats s = applyVisibilityConstraint(g, sensor, v, p);
+        const VisibilityStats r = referenceVisibility(reference, sensor, v, p);
+        ASSERT_EQ(s.raysCast, r.raysCast) << "scene " << scene;
+        ASSERT_EQ(s.binsRemoved, r.binsRemoved) << "scene " << scene;
+        ASSERT_EQ(s.binsWeakened, r.binsWeakened) << "scene " << scene;
+        ASSERT_EQ(g.binCount(), reference.binCount()) << "scene " << scene;
+        ASSERT_TRUE(binsOf(g) == binsOf(reference)) << "scene " << scene;
+        edits += r.binsRemoved + r.binsWeakened;
+        visited += s.cellsVisited;
+        visitedReference += r.cellsVisited;
+        scenes++;
+    }
+    std::cout << scenes << " scenes, " << edits << " bins edited; cells tested " << visited
+              << " against the reference's " << visitedReference << "\n";
+    EXPECT_GT(edits, 300u) << "the scenes must exercise the constraint";
+    EXPECT_LT(visited, visitedReference);
 }
 
 TEST(Visibility, UpdatedCellBinAboveTheNewMeasurementsLosesCertainty) {

@@ -77,7 +77,8 @@ struct CellWindow {
  * Storage is a circular buffer over the cell window (grid_map style): cell (ix, iy) lives in slot
  * (ix mod nx) + (iy mod ny) nx, so moving the window only clears the slots of the cells that enter,
  * and growing it re-slots the cell heads without touching any bin. Memory: 12 B per cell of the
- * window (chain head, update-cycle stamp and index) and 24 B per bin. */
+ * window (chain head, update-cycle stamp and index), 12 B per block of 64 cells (local height
+ * bound) and 24 B per bin. */
 class BinGrid {
 public:
     static constexpr uint32_t kNoBin = std::numeric_limits<uint32_t>::max();
@@ -136,10 +137,10 @@ public:
                              double continuityBound_m = std::numeric_limits<double>::infinity());
 
     /** Moves sensor-frame points to the map frame with `propagator` (PosePropagator::apply) and
-     * fuses them (insertPoints), a thousand points at a time, so the map-frame batch never exists
-     * in memory: a 640 x 480 frame then streams 11 MB once instead of three times. Same per-point
-     * arithmetic; a run of points in one bin is closed at each block boundary, so bins can differ
-     * from apply() + insertPoints() by rounding only. */
+     * fuses them (insertPoints), 256 points at a time, so the map-frame batch never exists in
+     * memory: a 640 x 480 frame then streams 11 MB once instead of three times. The result is
+     * bit-identical to apply() followed by insertPoints(): the same per-point arithmetic in the
+     * same order (a run of points in one bin stays open across blocks). */
     InsertStats insertSensorPoints(
         const PosePropagator& propagator, const PointsWithCov& sensorPoints,
         const BinUpdateParams& params,
@@ -190,6 +191,32 @@ public:
     double maxHeight_m() const { return m_maxHeight_m; }
     /** @} */
 
+    /** @name Local height bound: blocks of kBlockCells x kBlockCells cells. Block (bx, by) holds
+     * cells bx kBlockCells .. bx kBlockCells + kBlockCells - 1 (and likewise in y), so a cell's
+     * block is (ix >> kBlockShift, iy >> kBlockShift). Kept up to date on every insertion (one
+     * compare per run of points); conservative on removal: the bound never goes down while the
+     * block stays in the window, which costs the visibility constraint time, never correctness.
+     * @{ */
+    static constexpr int kBlockShift = 3;
+    static constexpr int kBlockCells = 1 << kBlockShift;
+    /** Block index of a cell index (floor division by kBlockCells). */
+    static int blockOf(int cellIndex) { return cellIndex >> kBlockShift; }  // arithmetic shift
+    /** An upper bound on the height of every bin stored in a cell of block (bx, by) [m]: the
+     * highest height fused into it since it entered the window, rounded up to float; -infinity
+     * if none (or the block lies outside the window). */
+    float blockMaxHeight_m(int bx, int by) const {
+        int sx = bx - m_blockX0, sy = by - m_blockY0;
+        if (sx < 0 || sy < 0 || sx >= m_blockNx || sy >= m_blockNy)
+            return -std::numeric_limits<float>::infinity();
+        sx += m_blockOriginX;
+        sy += m_blockOriginY;
+        if (sx >= m_blockNx) sx -= m_blockNx;
+        if (sy >= m_blockNy) sy -= m_blockNy;
+        const BlockSlot& b = m_blocks[size_t(sx) + size_t(sy) * size_t(m_blockNx)];
+        return b.bx == bx && b.by == by ? b.maxHeight_m : -std::numeric_limits<float>::infinity();
+    }
+    /** @} */
+
     /** Removes every bin of one cell. */
     void clearCell(int ix, int iy);
     /** Appends a bin as stored elsewhere (deserialization, grid-to-grid copies). */
@@ -198,11 +225,12 @@ public:
     /** Number of bins in use, over all cells. */
     size_t binCount() const { return m_pool.size() - m_freeCount; }
     /** Memory held by the grid [bytes]: per cell of the window a bin-chain head and an
-     * update-cycle index (8 B), the bin pool (24 B per bin, with the vector's spare capacity)
-     * and the list of cells updated in the current cycle. Independent of the vertical extent. */
+     * update-cycle stamp and index (12 B), the bin pool (24 B per bin, with the vector's spare
+     * capacity), the list of cells updated in the current cycle and the block height bounds
+     * (12 B per block of 64 cells). Independent of the vertical extent. */
     size_t memoryBytes() const {
         return m_cells.capacity() * sizeof(CellSlot) + m_pool.capacity() * sizeof(Bin) +
-               m_updated.capacity() * sizeof(UpdatedCell);
+               m_updated.capacity() * sizeof(UpdatedCell) + m_blocks.capacity() * sizeof(BlockSlot);
     }
     bool empty() const { return binCount() == 0; }
 
@@ -231,7 +259,17 @@ private:
     }
     /** i mod n in [0, n) (0 for an empty axis). */
     static int residue(int i, int n) { return n > 0 ? ((i % n) + n) % n : 0; }
+    /** Sets the window and the block table's geometry (not its contents). */
     void setWindow(const CellWindow& w);
+    /** The insertion core over `count` map-frame points, fetched a classification block at a time
+     * by `blockAt(begin, n)` (a pointer to points begin .. begin + n - 1). */
+    template <typename BlockSource>
+    InsertStats insertBlocks(size_t count, BlockSource&& blockAt, const BinUpdateParams& params,
+                             double continuityBound_m);
+    /** Rebuilds the block table from every bin (after the window changed size). */
+    void rebuildBlocks();
+    /** Raises the bound of the block of cell (ix, iy), inside the window, to `height_m` [m]. */
+    void raiseBlock(int ix, int iy, double height_m);
     uint32_t allocateBin();
     void releaseChain(uint32_t head);
     /** The bin of index n in the cell at `slot`, appended to its chain if missing. */
@@ -258,13 +296,41 @@ private:
     std::vector<UpdatedCell> m_updated;  //!< cells updated in this cycle, in first-update order
     uint32_t m_cycle = 1;
     double m_maxHeight_m = -std::numeric_limits<double>::infinity();
+    /** Height bound of one block, tagged with the block it belongs to: blocks whose indices are
+     * congruent modulo the table size share a slot, but never while both meet the window (the
+     * table is one block larger than the window on each axis). A slot tagged with another
+     * block therefore means "no bin in this block". */
+    struct BlockSlot {
+        int32_t bx = std::numeric_limits<int32_t>::min(), by = 0;
+        float maxHeight_m = -std::numeric_limits<float>::infinity();
+    };
+    std::vector<BlockSlot> m_blocks;   //!< slot (bx mod m_blockNx) + (by mod m_blockNy) m_blockNx
+    int m_blockX0 = 0, m_blockY0 = 0;  //!< block of the window's first cell
+    int m_blockNx = 0, m_blockNy = 0;  //!< table size: ceil(nx / kBlockCells) + 1, likewise y
+    int m_blockOriginX = 0, m_blockOriginY = 0;  //!< m_blockX0 mod m_blockNx, likewise y
     uint32_t m_freeHead = kNoBin;
     size_t m_freeCount = 0;
 };
 
 // Inline: called per run of points; out of line they would go through the PLT.
+inline void BinGrid::raiseBlock(int ix, int iy, double height_m) {
+    const int bx = blockOf(ix), by = blockOf(iy);
+    int sx = bx - m_blockX0 + m_blockOriginX, sy = by - m_blockY0 + m_blockOriginY;
+    if (sx >= m_blockNx) sx -= m_blockNx;
+    if (sy >= m_blockNy) sy -= m_blockNy;
+    BlockSlot& b = m_blocks[size_t(sx) + size_t(sy) * size_t(m_blockNx)];
+    float h = static_cast<float>(height_m);
+    if (double(h) < height_m) h = std::nextafter(h, std::numeric_limits<float>::infinity());
+    if (b.bx != bx || b.by != by) {
+        b = {bx, by, h};  // the slot's previous block has left the window
+    } else if (h > b.maxHeight_m) {
+        b.maxHeight_m = h;
+    }
+}
+
 inline void BinGrid::noteUpdate(size_t s, int ix, int iy, double height_m, uint32_t points) {
     m_maxHeight_m = std::max(m_maxHeight_m, height_m);
+    raiseBlock(ix, iy, height_m);
     CellSlot& cs = m_cells[s];
     if (cs.cycle == m_cycle) {
         UpdatedCell& u = m_updated[cs.updatedIndex];

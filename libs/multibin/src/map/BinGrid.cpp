@@ -35,6 +35,7 @@ void BinGrid::reset(double cellSize_m, const CellWindow& window) {
     m_invCellSize = 1.0 / cellSize_m;
     setWindow(window);
     m_cells.assign(window.cellCount(), CellSlot{});
+    m_blocks.assign(size_t(m_blockNx) * size_t(m_blockNy), BlockSlot{});
     m_updated.clear();
     m_maxHeight_m = -std::numeric_limits<double>::infinity();
     m_pool.clear();
@@ -67,6 +68,7 @@ void BinGrid::growToInclude(const CellWindow& w) {
         }
     m_cells.swap(cells);
     setWindow(nw);
+    rebuildBlocks();
     // Growth happens between update cycles: the cycle bookkeeping starts afresh (the new slots
     // carry no stamp).
     m_updated.clear();
@@ -76,6 +78,22 @@ void BinGrid::setWindow(const CellWindow& w) {
     m_window = w;
     m_originSlotX = residue(w.ix0, w.nx);
     m_originSlotY = residue(w.iy0, w.ny);
+    // One block more than the window spans at most, so the blocks meeting it never share a slot.
+    m_blockX0 = blockOf(w.ix0);
+    m_blockY0 = blockOf(w.iy0);
+    m_blockNx = w.nx > 0 ? (w.nx + kBlockCells - 1) / kBlockCells + 1 : 0;
+    m_blockNy = w.ny > 0 ? (w.ny + kBlockCells - 1) / kBlockCells + 1 : 0;
+    m_blockOriginX = residue(m_blockX0, m_blockNx);
+    m_blockOriginY = residue(m_blockY0, m_blockNy);
+}
+
+void BinGrid::rebuildBlocks() {
+    m_blocks.assign(size_t(m_blockNx) * size_t(m_blockNy), BlockSlot{});
+    const CellWindow& w = m_window;
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
+            for (uint32_t b = m_cells[slot(ix, iy)].head; b != kNoBin; b = m_pool[b].next)
+                raiseBlock(ix, iy, m_pool[b].height_m);
 }
 
 void BinGrid::beginCycle() {
@@ -123,6 +141,7 @@ void BinGrid::appendBin(int ix, int iy, const Bin& bin) {
     m_pool[b] = bin;
     m_pool[b].next = kNoBin;
     m_maxHeight_m = std::max(m_maxHeight_m, double(bin.height_m));
+    raiseBlock(ix, iy, bin.height_m);
     const size_t s = slot(ix, iy);
     uint32_t last = m_cells[s].head;
     if (last == kNoBin) {
@@ -151,6 +170,7 @@ void BinGrid::fuseBin(int ix, int iy, const Bin& other, const BinUpdateParams& p
         m_pool[b].next = kNoBin;
         (prev == kNoBin ? m_cells[s].head : m_pool[prev].next) = b;
         m_maxHeight_m = std::max(m_maxHeight_m, double(other.height_m));
+        raiseBlock(ix, iy, other.height_m);
         return;
     }
     Bin& bin = m_pool[b];
@@ -161,6 +181,7 @@ void BinGrid::fuseBin(int ix, int iy, const Bin& other, const BinUpdateParams& p
     bin.certainty += other.certainty;
     bin.pointCount += other.pointCount;
     m_maxHeight_m = std::max(m_maxHeight_m, double(bin.height_m));
+    raiseBlock(ix, iy, bin.height_m);
 }
 
 const Bin* BinGrid::winningBin(int ix, int iy) const {
@@ -223,7 +244,7 @@ bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height
 namespace {
 
 /** Points classified per block before the sequential bin update. */
-constexpr size_t kBlock = 256;
+constexpr size_t kPointBlock = 256;
 
 enum PointStatus : uint8_t {
     kAccept,
@@ -237,10 +258,10 @@ enum PointStatus : uint8_t {
 
 /** Per-point results of the classification pass over one block. */
 struct ClassifiedBlock {
-    uint8_t status[kBlock];
-    int16_t bin[kBlock];
-    int32_t ix[kBlock], iy[kBlock];
-    uint32_t slot[kBlock];
+    uint8_t status[kPointBlock];
+    int16_t bin[kPointBlock];
+    int32_t ix[kPointBlock], iy[kPointBlock];
+    uint32_t slot[kPointBlock];
 };
 
 }  // namespace
@@ -250,21 +271,29 @@ InsertStats BinGrid::insertPoints(const PointsWithCov& mapPoints, const BinUpdat
     return insertPoints(mapPoints.data(), mapPoints.size(), params, continuityBound_m);
 }
 
+InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
+                                  const BinUpdateParams& params, double continuityBound_m) {
+    return insertBlocks(
+        count, [mapPoints](size_t begin, size_t) { return mapPoints + begin; }, params,
+        continuityBound_m);
+}
+
 InsertStats BinGrid::insertSensorPoints(const PosePropagator& propagator,
                                         const PointsWithCov& sensorPoints,
                                         const BinUpdateParams& params, double continuityBound_m) {
-    constexpr size_t kChunk = 1024;  // 36 kB of map-frame points: stays in the L1/L2 cache
-    std::array<PointWithCov, kChunk> mapPoints;
-    InsertStats stats;
-    for (size_t begin = 0; begin < sensorPoints.size(); begin += kChunk) {
-        const size_t m = std::min(kChunk, sensorPoints.size() - begin);
-        propagator.apply(sensorPoints.data() + begin, mapPoints.data(), m);
-        stats += insertPoints(mapPoints.data(), m, params, continuityBound_m);
-    }
-    return stats;
+    // One classification block of map-frame points at a time (9 kB, stays in the L1 cache).
+    std::array<PointWithCov, kPointBlock> mapPoints;
+    return insertBlocks(
+        sensorPoints.size(),
+        [&](size_t begin, size_t m) {
+            propagator.apply(sensorPoints.data() + begin, mapPoints.data(), m);
+            return static_cast<const PointWithCov*>(mapPoints.data());
+        },
+        params, continuityBound_m);
 }
 
-InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
+template <typename BlockSource>
+InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
                                   const BinUpdateParams& params, double continuityBound_m) {
     InsertStats stats;
     // Eq 14 compares each laser point with the bin height left by the previous point, so with a
@@ -303,9 +332,9 @@ InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
 
     ClassifiedBlock cb;
     size_t rejected[kStatusCount] = {};
-    for (size_t begin = 0; begin < count; begin += kBlock) {
-        const size_t m = std::min(kBlock, count - begin);
-        const PointWithCov* pts = mapPoints + begin;
+    for (size_t begin = 0; begin < count; begin += kPointBlock) {
+        const size_t m = std::min(kPointBlock, count - begin);
+        const PointWithCov* pts = blockAt(begin, m);
         // Pass 1, no bin access: validity, gates that need only the point, cell and bin index.
         for (size_t i = 0; i < m; i++) {
             const PointWithCov& p = pts[i];

@@ -13,6 +13,18 @@ using namespace mrpt::maps;
 using multibin::PointsWithCov;
 using multibin::PointWithCov;
 
+namespace {
+/** The points growToCover() sizes the window by: within `half_m` of the sensor on each axis (a
+ * stray far return must not stretch the map) and passing the eq 13 gate (nor may a stereo point
+ * 20 m away with sigma_z of metres). */
+bool canGrowTheMap(const PointWithCov& p, const Eigen::Vector3d& sensor_m, double half_m,
+                   const multibin::BinUpdateParams& params) {
+    return std::abs(p.point_m.x() - sensor_m.x()) <= half_m &&
+           std::abs(p.point_m.y() - sensor_m.y()) <= half_m && !std::isnan(p.cov_m2.zz) &&
+           params.passesEq13(p.cov_m2.zz);
+}
+}  // namespace
+
 bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
     const auto& labels = insertionOptions.sensor_labels;
     return labels.empty() || std::find(labels.begin(), labels.end(), label) != labels.end();
@@ -116,31 +128,100 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     if (sensorPoints.empty()) return false;
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
-    PointsWithCov mapPoints;
-    propagator.apply(sensorPoints, mapPoints);
-    if (isDualGrid())
+    const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
+    if (isDualGrid()) {
         recenter(robotPose.mean.x(), robotPose.mean.y());
-    else
-        growToCover(mapPoints, propagator.sensorOriginInMap_m());
-    return insertIntoGrid(gridFor(obs), mapPoints, continuityBound_m,
-                          propagator.sensorOriginInMap_m())
+    } else if (growthNeeded(sensorPoints, robotPose.mean + sensorPose, propagator)) {
+        // Growth is sized by all map-frame points: propagate them first (the rare case).
+        PointsWithCov mapPoints;
+        propagator.apply(sensorPoints, mapPoints);
+        growToCover(mapPoints, sensor_m);
+        return insertIntoGrid(
+                   gridFor(obs),
+                   [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
+                       return g.insertPoints(mapPoints, params, continuityBound_m);
+                   },
+                   sensor_m)
+                   .accepted > 0;
+    }
+    // The window stays as it is: propagate and fuse block by block (bit-identical result).
+    return insertIntoGrid(
+               gridFor(obs),
+               [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
+                   return g.insertSensorPoints(propagator, sensorPoints, params, continuityBound_m);
+               },
+               sensor_m)
                .accepted > 0;
+}
+
+bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
+                                         const mrpt::poses::CPose3D& sensorInMap,
+                                         const multibin::PosePropagator& propagator) const {
+    const auto& c = creationOptions;
+    if (!c.grow || c.dual_grid || sensorPoints.empty()) return false;
+    const multibin::CellWindow& w = m_grid.window();
+    if (w.nx <= 0 || w.ny <= 0) return true;
+    // growToCover() changes the window iff a point that canGrowTheMap() lies in a cell outside
+    // it. The map-frame positions in double, from the same pose, differ from the propagator's
+    // (single precision) by far less than `slack`: a point clearly inside the window, or clearly
+    // farther than max_size_m / 2 from the sensor, cannot grow the map. The few others are
+    // propagated exactly and tested as growToCover() would.
+    const double cell = m_grid.cellSize_m(), half = 0.5 * c.max_size_m;
+    const double x0 = w.ix0 * cell, x1 = (w.ix0 + w.nx) * cell;
+    const double y0 = w.iy0 * cell, y1 = (w.iy0 + w.ny) * cell;
+    const Eigen::Matrix3d R = sensorInMap.getRotationMatrix().asEigen();
+    const Eigen::Vector3d t(sensorInMap.x(), sensorInMap.y(), sensorInMap.z());
+    const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
+    const double tNorm = t.cwiseAbs().sum();
+    const multibin::BinUpdateParams params = binUpdateParams();
+    constexpr size_t kBatch = 256;
+    PointWithCov exact[kBatch];
+    size_t pending = 0;
+    auto anyGrows = [&]() {
+        propagator.apply(exact, exact, pending);
+        bool grows = false;
+        for (size_t i = 0; i < pending; i++) {
+            const PointWithCov& p = exact[i];
+            grows = grows ||
+                    (canGrowTheMap(p, s, half, params) &&
+                     !w.contains(m_grid.cellIndex(p.point_m.x()), m_grid.cellIndex(p.point_m.y())));
+        }
+        pending = 0;
+        return grows;
+    };
+    for (const PointWithCov& p : sensorPoints) {
+        const Eigen::Vector3d ps = p.point_m.cast<double>();
+        const Eigen::Vector3d q = R * ps + t;
+        const double slack = 1e-4 + 1e-5 * (ps.cwiseAbs().sum() + tNorm);  // [m]
+        const bool inside = q.x() >= x0 + slack && q.x() <= x1 - slack && q.y() >= y0 + slack &&
+                            q.y() <= y1 - slack;
+        const bool far =
+            std::abs(q.x() - s.x()) > half + slack || std::abs(q.y() - s.y()) > half + slack;
+        if (inside || far) continue;  // NaN coordinates are neither: tested exactly
+        exact[pending++] = p;
+        if (pending == kBatch && anyGrows()) return true;
+    }
+    return pending > 0 && anyGrows();
 }
 
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
-    return insertIntoGrid(isDualGrid() ? m_local : m_grid, mapPoints, continuityBound_m,
-                          sensorOrigin_m);
+    return insertIntoGrid(
+        isDualGrid() ? m_local : m_grid,
+        [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
+            return g.insertPoints(mapPoints, params, continuityBound_m);
+        },
+        sensorOrigin_m);
 }
 
 multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
-    multibin::BinGrid& grid, const PointsWithCov& mapPoints, double continuityBound_m,
+    multibin::BinGrid& grid, const FuseIntoGrid& fuse,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
     const multibin::BinUpdateParams params = binUpdateParams();
     grid.beginCycle();
     m_fillStale = true;
-    const multibin::InsertStats s = grid.insertPoints(mapPoints, params, continuityBound_m);
+    const multibin::InsertStats s = fuse(grid, params);
     m_stats += s;
     if (sensorOrigin_m) {
         const multibin::VisibilityStats v = multibin::applyVisibilityConstraint(
@@ -157,16 +238,12 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
                                         const Eigen::Vector3d& sensor_m) {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || mapPoints.empty()) return;
-    // Only points within max_size_m/2 of the sensor can make the grid grow: a stray far return
-    // must not stretch the map.
     const double half = 0.5 * c.max_size_m;
     double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
-    // Nor may a point the eq 13 gate will refuse (a stereo point 20 m away, sigma_z metres).
     const multibin::BinUpdateParams params = binUpdateParams();
     for (const PointWithCov& p : mapPoints) {
         const double x = p.point_m.x(), y = p.point_m.y();
-        if (!(std::abs(x - sensor_m.x()) <= half && std::abs(y - sensor_m.y()) <= half)) continue;
-        if (std::isnan(p.cov_m2.zz) || !params.passesEq13(p.cov_m2.zz)) continue;
+        if (!canGrowTheMap(p, sensor_m, half, params)) continue;
         xmin = std::min(xmin, x);
         xmax = std::max(xmax, x);
         ymin = std::min(ymin, y);

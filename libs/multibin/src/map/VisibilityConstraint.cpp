@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace multibin {
 
@@ -27,6 +28,18 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const double above = b.height_m - lineHeight_m;
         return above > minConflictMargin && above > conflictMargin(b);
     };
+    // Local height bound: a block whose bound lies no more than minConflictMargin above the line
+    // holds no conflicting bin. The tolerance covers the rounding of bins' float heights.
+    auto blockMayConflict = [&](float blockMax_m, double lineHeight_m) {
+        return blockMax_m > -std::numeric_limits<float>::infinity() &&
+               double(blockMax_m) + 1e-6 * (1.0 + std::abs(double(blockMax_m))) >
+                   lineHeight_m + minConflictMargin;
+    };
+    const double block_m = BinGrid::kBlockCells * cell;
+    const double invBlock = 1.0 / block_m;
+    // Slack [m] along and across the ray between a sample's computed position and the exact
+    // line: far above the rounding of the sample positions (~1e-15 of the coordinates).
+    constexpr double kSlack_m = 1e-6;
 
     for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
         const Bin* winner = grid.winningBin(u.ix, u.iy);
@@ -75,8 +88,39 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         };
         clipAxis(tx, ux, w.ix0, w.nx);
         clipAxis(ty, uy, w.iy0, w.ny);
+        // The samples never go past the global bound (below) or the window.
+        const double globalReach =
+            slope > 0 ? (stopHeight + inCellRise - tz) / slope + kSlack_m : walk;
+        // Walk the ray's block columns (rows if it runs more along y): over each, the blocks the
+        // line can touch, and the lowest ray height there. `reach` ends the last stretch of the
+        // ray below some block's bound: no sample beyond it can meet a conflicting bin.
+        double reach = 0;
+        {
+            const bool xMajor = std::abs(ux) >= std::abs(uy);
+            const double a0 = xMajor ? tx : ty, b0 = xMajor ? ty : tx;
+            const double ua = xMajor ? ux : uy, ub = xMajor ? uy : ux;  // |ua| >= 0.707
+            const double invUa = 1.0 / ua;
+            const double limit = std::min(walk, globalReach);
+            int ka = BinGrid::blockOf(xMajor ? u.ix : u.iy);
+            for (double da = 0; da<limit; ka += ua> 0 ? 1 : -1) {
+                const double exit = ((ua > 0 ? ka + 1 : ka) * block_m - a0) * invUa;
+                const double db = std::min(exit, limit);
+                const double bLo = b0 + ub * (ub > 0 ? da - kSlack_m : db + kSlack_m) - kSlack_m;
+                const double bHi = b0 + ub * (ub > 0 ? db + kSlack_m : da - kSlack_m) + kSlack_m;
+                float bound_m = -std::numeric_limits<float>::infinity();
+                for (int kb = BinGrid::floorToInt(bLo * invBlock),
+                         kbEnd = BinGrid::floorToInt(bHi * invBlock);
+                     kb <= kbEnd; kb++)
+                    bound_m = std::max(bound_m, xMajor ? grid.blockMaxHeight_m(ka, kb)
+                                                       : grid.blockMaxHeight_m(kb, ka));
+                const double lowest_m = tz + slope * (slope > 0 ? da - kSlack_m : db + kSlack_m);
+                if (blockMayConflict(bound_m, lowest_m + inCellRise)) reach = db + kSlack_m;
+                da = exit;
+            }
+        }
         int lastIx = u.ix, lastIy = u.iy;
         for (double d = step; d < walk; d += step) {
+            if (d > reach) break;
             const double rayZ = tz + slope * d;
             if (slope > 0 && rayZ - inCellRise > stopHeight) break;
             const int ix = cellOf(tx + ux * d);
@@ -85,8 +129,11 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             lastIx = ix;
             lastIy = iy;
             if (!grid.window().contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
-            stats.cellsVisited++;
             const double rayHigh = rayZ + inCellRise;
+            if (!blockMayConflict(grid.blockMaxHeight_m(BinGrid::blockOf(ix), BinGrid::blockOf(iy)),
+                                  rayHigh))
+                continue;
+            stats.cellsVisited++;
             grid.editBins(ix, iy, [&](Bin& b) {
                 if (!conflicts(b, rayHigh)) return true;
                 if (b.certainty < targetCertainty) {

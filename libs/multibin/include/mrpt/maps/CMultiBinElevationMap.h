@@ -293,10 +293,18 @@ private:
     /** Grows the window (if allowed) to cover map-frame points near the sensor. */
     void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m);
 
+    /** True if growToCover() would change the window for these sensor-frame points seen from
+     * `sensorInMap` (the robot pose's mean composed with the sensor pose), without propagating
+     * more than the few points near the window's edge. */
+    bool growthNeeded(const multibin::PointsWithCov& sensorPoints,
+                      const mrpt::poses::CPose3D& sensorInMap,
+                      const multibin::PosePropagator& propagator) const;
+
+    /** The insertion core of one update cycle: BinGrid::insertPoints or insertSensorPoints. */
+    using FuseIntoGrid =
+        std::function<multibin::InsertStats(multibin::BinGrid&, const multibin::BinUpdateParams&)>;
     /** One update cycle of `grid`: insertion core, then the visibility constraint. */
-    multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid,
-                                         const multibin::PointsWithCov& mapPoints,
-                                         double continuityBound_m,
+    multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid, const FuseIntoGrid& fuse,
                                          const std::optional<Eigen::Vector3d>& sensorOrigin_m);
     /** Fuses one local cell into the global grid (write-back of data the global grid lacks). */
     void writeBackLocalCell(int ix, int iy);
