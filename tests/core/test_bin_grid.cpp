@@ -1,10 +1,16 @@
-/* Tests of the insertion core: Kalman fusion, winning bin, gates, window moves. */
+/* Tests of the insertion core: Kalman fusion, winning bin, gates, window moves, the block height
+ * bound, and the fused insertion path (grid and map). */
 #include <gtest/gtest.h>
 
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/core/bits_math.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimpleMap.h>
 
+#include <array>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <random>
 
 #include "multibin/BinGrid.h"
@@ -290,4 +296,108 @@ TEST(BinGrid, FusedSensorInsertionIsBitIdenticalToTwoSteps) {
             EXPECT_EQ(twoSteps.updatedCells()[i].maxHeight_m, fused.updatedCells()[i].maxHeight_m);
         }
     }
+}
+
+namespace {
+/** Every bin of a grid's window, cell by cell in chain order, as raw bytes. */
+std::vector<std::array<unsigned char, sizeof(Bin)>> binBytes(const BinGrid& g) {
+    std::vector<std::array<unsigned char, sizeof(Bin)>> out;
+    const CellWindow& w = g.window();
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
+            g.forEachBin(ix, iy, [&](const Bin& b) {
+                Bin c = b;
+                c.next = 0;  // pool order may differ; the chain order is compared
+                out.emplace_back();
+                std::memcpy(out.back().data(), &c, sizeof(Bin));
+            });
+    return out;
+}
+}  // namespace
+
+TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
+    // The shipped mock-up (laser scans and stereo frames), its first keyframes, through
+    // insertObservation() (fused propagation and bin update unless the window must grow) and
+    // through the two steps of before (sensor model, PosePropagator::apply, insertPoints).
+    mrpt::maps::CSimpleMap simplemap;
+    ASSERT_TRUE(
+        simplemap.loadFromFile(std::string(MULTIBIN_SOURCE_DIR) + "/rawlogs/mockup.simplemap"));
+    const mrpt::config::CConfigFile ini(std::string(MULTIBIN_SOURCE_DIR) + "/ini/mockup.ini");
+    auto makeMap = [&](bool grow) {
+        mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
+        c.resolution_m = 0.015;
+        c.grow = grow;
+        if (!grow) {  // the mock-up's extent (rawlogs/mockup_gt.asc)
+            c.min_x = -0.6;
+            c.max_x = 2.445;
+            c.min_y = -1.515;
+            c.max_y = 1.53;
+        }
+        auto m = std::make_unique<mrpt::maps::CMultiBinElevationMap>(c);
+        m->insertionOptions.loadFromConfigFile(
+            ini, "MappingApplication_multiBinElevationMap_00_insertOpts");
+        m->insertionOptions.fill.enabled = false;
+        return m;
+    };
+    auto fused = makeMap(false), twoSteps = makeMap(false), growing = makeMap(true);
+    multibin::sensors::SensorModelState state, growingState;
+    size_t observations = 0, stereo = 0, growthChecked = 0;
+    const size_t keyframes = std::min<size_t>(simplemap.size(), 40);
+    for (size_t k = 0; k < keyframes; k++) {
+        const auto& [posePdf, sf] = simplemap.get(k);
+        mrpt::poses::CPose3DPDFGaussian pdf;
+        const auto [cov, mean] = posePdf->getCovarianceAndMean();
+        pdf.mean = mean;
+        pdf.cov = cov;
+        for (const auto& obs : *sf) {
+            fused->insertObservation(*obs, pdf);
+            growing->insertObservation(*obs, pdf);
+            if (!twoSteps->acceptsLabel(obs->sensorLabel)) continue;
+            obs->load();
+            const auto& io = twoSteps->insertionOptions;
+            InsertStats sensorStats;
+            multibin::sensors::SensorPoints sensed;
+            if (!multibin::sensors::observationToSensorPoints(*obs, pdf, io.sensors, io.min_range_m,
+                                                              io.max_range_m, state, sensorStats,
+                                                              sensed) ||
+                sensed.points.empty())
+                continue;
+            observations++;
+            stereo += sensed.points.size() > 2000;
+            const PosePropagator propagator(pdf, sensed.sensorPose);
+            PointsWithCov mapPoints;
+            propagator.apply(sensed.points, mapPoints);
+            twoSteps->insertPoints(mapPoints, sensed.continuityBound_m,
+                                   propagator.sensorOriginInMap_m());
+            // Growing map: every point that may grow the map (within max_size_m / 2 of the
+            // sensor, passing the eq 13 gate) lies inside its window afterwards, i.e. the fused
+            // path was never taken when the window had to grow.
+            multibin::sensors::SensorPoints again;
+            ASSERT_TRUE(multibin::sensors::observationToSensorPoints(
+                *obs, pdf, io.sensors, io.min_range_m, io.max_range_m, growingState, sensorStats,
+                again));
+            propagator.apply(again.points, mapPoints);
+            const BinGrid& g = growing->grid();
+            const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
+            const double half = 0.5 * growing->creationOptions.max_size_m;
+            const BinUpdateParams gate{0.05, 1.0f, io.max_elevation_uncertainty_m};
+            for (const PointWithCov& p : mapPoints) {
+                if (!(std::abs(p.point_m.x() - s.x()) <= half &&
+                      std::abs(p.point_m.y() - s.y()) <= half) ||
+                    std::isnan(p.cov_m2.zz) || !gate.passesEq13(p.cov_m2.zz))
+                    continue;
+                ASSERT_TRUE(
+                    g.window().contains(g.cellIndex(p.point_m.x()), g.cellIndex(p.point_m.y())));
+                growthChecked++;
+            }
+        }
+    }
+    EXPECT_GT(observations, 40u);
+    EXPECT_GT(stereo, 3u);
+    EXPECT_GT(growthChecked, 50000u);
+    EXPECT_GT(fused->grid().binCount(), 10000u);
+    EXPECT_EQ(fused->insertStats().accepted, twoSteps->insertStats().accepted);
+    EXPECT_EQ(fused->visibilityStats().binsRemoved, twoSteps->visibilityStats().binsRemoved);
+    EXPECT_EQ(fused->visibilityStats().binsWeakened, twoSteps->visibilityStats().binsWeakened);
+    EXPECT_TRUE(binBytes(fused->grid()) == binBytes(twoSteps->grid()));
 }
