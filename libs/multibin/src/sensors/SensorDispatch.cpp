@@ -56,30 +56,13 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
     const StereoCovarianceTable& table = *cached;
     st.pairs++;
     out.clear();
-    const int step = opts.subsample;
-    out.reserve(size_t(g.width / step + 1) * size_t(g.height / step + 1));
-    for (int v = 0; v < g.height; v += step)
-        for (int u = 0; u < g.width; u += step) {
-            st.pixels++;
-            const float d = disp.at(u, v);
-            if (!(d - (g.cx - g.cxRight) > 0)) {
-                st.noDisparity++;
-                continue;
-            }
-            const Eigen::Vector3d p = g.triangulate(u, v, d);
-            if (p.z() < opts.minDepth_m) {
-                st.tooNear++;
-                continue;
-            }
-            const double r = p.norm();
-            if (r < minRange_m || r > maxRange_m) {
-                st.outOfRange++;
-                continue;
-            }
-            out.push_back(
-                {p.cast<float>(), SymmetricCov3::fromMatrix(table.pointCovariance(u, v, d))});
-            st.kept++;
-        }
+    const StereoPixelCounts c =
+        table.appendPoints(disp, opts.subsample, opts.minDepth_m, minRange_m, maxRange_m, out);
+    st.pixels += c.pixels;
+    st.noDisparity += c.noDisparity;
+    st.tooNear += c.tooNear;
+    st.outOfRange += c.outOfRange;
+    st.kept += c.kept;
 }
 
 bool observationToSensorPoints(const mrpt::obs::CObservation& obs,

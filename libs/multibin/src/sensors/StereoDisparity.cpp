@@ -26,10 +26,11 @@ DisparityImage decodeDisparityImage(const mrpt::img::CImage& image16) {
             "CObservationStereoImages::imageDisparity: expected a single-channel 16-bit image "
             "(disparity * 16, 0 = invalid)");
     DisparityImage out(m.cols, m.rows);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
     for (int v = 0; v < m.rows; v++) {
         const uint16_t* row = m.ptr<uint16_t>(v);
-        for (int u = 0; u < m.cols; u++)
-            if (row[u] > 0) out.at(u, v) = float(row[u]) / 16.f;
+        float* o = out.disparity_px.data() + size_t(v) * size_t(m.cols);
+        for (int u = 0; u < m.cols; u++) o[u] = row[u] > 0 ? float(row[u]) / 16.f : nan;
     }
     return out;
 }
@@ -82,79 +83,162 @@ DisparityImage computeDisparitySGBM(const mrpt::img::CImage& left, const mrpt::i
 size_t removeHalos(DisparityImage& d, const StereoModelOptions& o) {
     // Smallest valid disparity in the window: erosion with invalid pixels set to +large.
     cv::Mat m(d.height, d.width, CV_32F);
-    for (int v = 0; v < d.height; v++)
-        for (int u = 0; u < d.width; u++) m.at<float>(v, u) = d.valid(u, v) ? d.at(u, v) : 1e9f;
+    for (int v = 0; v < d.height; v++) {
+        const float* in = d.disparity_px.data() + size_t(v) * size_t(d.width);
+        float* row = m.ptr<float>(v);
+        for (int u = 0; u < d.width; u++) row[u] = std::isfinite(in[u]) ? in[u] : 1e9f;
+    }
     cv::Mat minWin;
     const int k = 2 * o.haloRadius_px + 1;
     cv::erode(m, minWin, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const double jump = o.haloJump_px;
     size_t removed = 0;
-    for (int v = 0; v < d.height; v++)
-        for (int u = 0; u < d.width; u++)
-            if (d.valid(u, v) && d.at(u, v) - minWin.at<float>(v, u) > o.haloJump_px) {
-                d.at(u, v) = std::numeric_limits<float>::quiet_NaN();
-                removed++;
-            }
+    for (int v = 0; v < d.height; v++) {
+        float* row = d.disparity_px.data() + size_t(v) * size_t(d.width);
+        const float* mins = minWin.ptr<float>(v);
+        size_t rowRemoved = 0;  // branch-free, so the loop vectorises
+        for (int u = 0; u < d.width; u++) {
+            const bool halo = std::isfinite(row[u]) & (row[u] - mins[u] > jump);
+            row[u] = halo ? nan : row[u];
+            rowRemoved += halo;
+        }
+        removed += rowRemoved;
+    }
     return removed;
 }
 
-size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
+namespace {
+/** The near-cluster decision for one region, given one of its pixels: a flood fill of the region
+ * (neighbour order +u, -u, +v, -v; depth first), collecting the distinct valid pixels across a
+ * jump from its members; if the region has fewer than maxArea pixels and its mean disparity
+ * exceeds their median by more than the jump (or nothing surrounds it), its pixels are
+ * invalidated. Returns the number removed. `mark` (one entry per pixel, zero or older stamps)
+ * holds, for the fill `id` (> 0), id * 4 + 1 (member) | 2 (counted around). */
+size_t decideRegion(DisparityImage& d, const StereoModelOptions& o, int start, uint32_t id,
+                    std::vector<uint32_t>& mark, std::vector<int>& stack, std::vector<int>& members,
+                    std::vector<float>& around) {
     const int W = d.width, H = d.height;
-    std::vector<int32_t> label(size_t(W) * size_t(H), -1);
+    float* disp = d.disparity_px.data();
+    const uint32_t tag = id << 2;
+    auto flags = [&](int q) { return (mark[size_t(q)] >> 2) == id ? mark[size_t(q)] & 3u : 0u; };
+    stack.assign(1, start);
+    members.clear();
+    around.clear();
+    mark[size_t(start)] = tag | 1u;
+    double sum = 0;
+    bool small = true;
+    const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+    while (!stack.empty()) {
+        const int p = stack.back();
+        stack.pop_back();
+        members.push_back(p);
+        const float dp = disp[p];
+        sum += dp;
+        const int u = p % W, v = p / W;
+        for (int k = 0; k < 4; k++) {
+            const int uu = u + du[k], vv = v + dv[k];
+            if (uu < 0 || vv < 0 || uu >= W || vv >= H) continue;
+            const int q = vv * W + uu;
+            const float dq = disp[q];
+            if (!std::isfinite(dq)) continue;
+            const uint32_t f = flags(q);
+            if (std::abs(dq - dp) <= o.nearClusterStep_px) {
+                if (!(f & 1u)) {
+                    mark[size_t(q)] = tag | f | 1u;
+                    stack.push_back(q);
+                }
+            } else if (small && !(f & 2u)) {
+                mark[size_t(q)] = tag | f | 2u;
+                around.push_back(dq);
+            }
+        }
+        if (small && int(members.size()) >= o.nearClusterMaxArea_px) small = false;
+    }
+    if (!small) return 0;
+    bool remove = around.empty();
+    if (!remove) {
+        std::nth_element(around.begin(), around.begin() + long(around.size() / 2), around.end());
+        const double median = around[around.size() / 2];
+        remove = sum / double(members.size()) > median + o.nearClusterJump_px;
+    }
+    if (!remove) return 0;
+    for (int p : members) disp[p] = std::numeric_limits<float>::quiet_NaN();
+    return members.size();
+}
+
+/** Union-find over row runs, the smaller index always the root (so a root is its region's first
+ * run in raster order). */
+int32_t findRoot(std::vector<int32_t>& parent, int32_t a) {
+    while (parent[size_t(a)] != a) {
+        parent[size_t(a)] = parent[size_t(parent[size_t(a)])];  // path halving
+        a = parent[size_t(a)];
+    }
+    return a;
+}
+}  // namespace
+
+size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
+    // Regions are found first without the flood fill: runs of horizontally connected pixels per
+    // row, joined through their vertical connections by union-find; a region's size is the sum
+    // of its runs. Only regions below the size limit are then filled one by one, in raster order
+    // of their first pixel and on the image as the earlier removals left it, exactly as a flood
+    // fill of every region in raster order decides (large regions are never removed and never
+    // change another region's decision).
+    const int W = d.width, H = d.height;
+    if (W <= 0 || H <= 0) return 0;
+    const float* disp = d.disparity_px.data();
+    const double step = o.nearClusterStep_px;
+    std::vector<int32_t> parent, length, first;  // per run: union-find parent, pixels, 1st pixel
+    parent.reserve(size_t(H) * 16);
+    length.reserve(size_t(H) * 16);
+    first.reserve(size_t(H) * 16);
+    std::vector<int32_t> runAbove(size_t(W), -1), runHere(size_t(W), -1);
+    for (int v = 0; v < H; v++) {
+        const float* row = disp + size_t(v) * size_t(W);
+        const float* above = row - W;
+        int32_t run = -1, joinedRun = -1, joinedAbove = -1;
+        for (int u = 0; u < W; u++) {
+            const float dp = row[u];
+            if (!std::isfinite(dp)) {
+                runHere[size_t(u)] = run = -1;
+                continue;
+            }
+            if (run < 0 || !(std::abs(dp - row[u - 1]) <= step)) {
+                run = int32_t(parent.size());
+                parent.push_back(run);
+                length.push_back(0);
+                first.push_back(v * W + u);
+            }
+            length[size_t(run)]++;
+            runHere[size_t(u)] = run;
+            const int32_t a = v > 0 ? runAbove[size_t(u)] : -1;
+            if (a >= 0 && (a != joinedAbove || run != joinedRun) &&
+                std::abs(dp - above[u]) <= step) {
+                const int32_t ra = findRoot(parent, a), rb = findRoot(parent, run);
+                if (ra < rb) parent[size_t(rb)] = ra;
+                if (rb < ra) parent[size_t(ra)] = rb;
+                joinedAbove = a;
+                joinedRun = run;
+            }
+        }
+        std::swap(runAbove, runHere);
+    }
+    // Region sizes at the roots (a root precedes its runs).
+    const int32_t runs = int32_t(parent.size());
+    for (int32_t r = 0; r < runs; r++) {
+        const int32_t root = findRoot(parent, r);
+        if (root != r) length[size_t(root)] += length[size_t(r)];
+    }
+    std::vector<uint32_t> mark;
     std::vector<int> stack, members;
     std::vector<float> around;
-    std::vector<int32_t> aroundSeen;  // pixel -> component that last counted it as surrounding
-    aroundSeen.assign(label.size(), -1);
+    uint32_t id = 0;
     size_t removed = 0;
-    int32_t next = 0;
-    const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
-    for (int start = 0; start < W * H; start++) {
-        if (label[size_t(start)] >= 0 || !std::isfinite(d.disparity_px[size_t(start)])) continue;
-        const int32_t id = next++;
-        stack.assign(1, start);
-        members.clear();
-        around.clear();
-        label[size_t(start)] = id;
-        double sum = 0;
-        bool small = true;
-        while (!stack.empty()) {
-            const int p = stack.back();
-            stack.pop_back();
-            members.push_back(p);
-            const float dp = d.disparity_px[size_t(p)];
-            sum += dp;
-            const int u = p % W, v = p / W;
-            for (int k = 0; k < 4; k++) {
-                const int uu = u + du[k], vv = v + dv[k];
-                if (uu < 0 || vv < 0 || uu >= W || vv >= H) continue;
-                const int q = vv * W + uu;
-                const float dq = d.disparity_px[size_t(q)];
-                if (!std::isfinite(dq)) continue;
-                if (std::abs(dq - dp) <= o.nearClusterStep_px) {
-                    if (label[size_t(q)] < 0) {
-                        label[size_t(q)] = id;
-                        stack.push_back(q);
-                    }
-                } else if (small && aroundSeen[size_t(q)] != id) {
-                    aroundSeen[size_t(q)] = id;
-                    around.push_back(dq);
-                }
-            }
-            // Keep labelling a large region (so it is visited once) but stop collecting.
-            if (small && int(members.size()) >= o.nearClusterMaxArea_px) small = false;
-        }
-        if (!small) continue;
-        bool remove = around.empty();
-        if (!remove) {
-            std::nth_element(around.begin(), around.begin() + long(around.size() / 2),
-                             around.end());
-            const double median = around[around.size() / 2];
-            remove = sum / double(members.size()) > median + o.nearClusterJump_px;
-        }
-        if (remove) {
-            for (int p : members)
-                d.disparity_px[size_t(p)] = std::numeric_limits<float>::quiet_NaN();
-            removed += members.size();
-        }
+    for (int32_t r = 0; r < runs; r++) {
+        if (parent[size_t(r)] != r || length[size_t(r)] >= o.nearClusterMaxArea_px) continue;
+        if (mark.empty()) mark.assign(size_t(W) * size_t(H), 0);
+        removed += decideRegion(d, o, first[size_t(r)], ++id, mark, stack, members, around);
     }
     return removed;
 }

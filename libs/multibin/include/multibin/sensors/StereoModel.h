@@ -6,7 +6,9 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "multibin/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
+#include "multibin/sensors/StereoDisparity.h"
 
 namespace multibin::sensors {
 
@@ -51,11 +53,21 @@ struct StereoGeometry {
 /** Diagonal calibration covariance (variances) from the option sigmas. */
 CalibrationVector calibrationVariances(const StereoModelOptions& opts);
 
+/** What StereoCovarianceTable::appendPoints() did with the pixels it visited. */
+struct StereoPixelCounts {
+    size_t pixels = 0;       //!< pixels visited (after subsampling)
+    size_t noDisparity = 0;  //!< no valid disparity (NaN, or d <= cx - cxRight)
+    size_t tooNear = 0;      //!< depth under minDepth_m
+    size_t outOfRange = 0;   //!< range outside [minRange_m, maxRange_m]
+    size_t kept = 0;         //!< appended as points
+};
+
 /** Per-pixel table of the calibration part of the pixel covariance, computed once for a
  * calibration: for each left pixel the 2x2 covariance of (u, v) from the left intrinsics, for each
- * right pixel the variance of u from the right intrinsics and the (depth-independent) Jacobian of
- * u w.r.t. the extrinsic rotation. The depth-dependent translation part and the matching noise are
- * added per point (a few multiplications). */
+ * right pixel the variance of u from the right intrinsics and the (depth-independent) variance of
+ * u from the extrinsic rotation. The depth-dependent translation part and the matching noise are
+ * added per point (a few multiplications). Stored as separate arrays (structure of arrays), so a
+ * row of pixels reads contiguous memory. */
 class StereoCovarianceTable {
 public:
     StereoCovarianceTable(const StereoGeometry& geometry, const StereoModelOptions& opts);
@@ -69,15 +81,28 @@ public:
      * instead of the paper's sigma_d = sigma_ul + sigma_ur bound) plus matching noise
      * 2 sigma_m^2 on d (independent per image). */
     Eigen::Matrix3d pixelCovariance(int u_px, int v_px, double d_px) const;
-    /** Eq 10: covariance [m^2] of the triangulated point in the left camera frame. */
+    /** Eq 10: covariance [m^2] of the triangulated point in the left camera frame. Computed by
+     * the same code as appendPoints(). Throws std::out_of_range outside the image. */
     Eigen::Matrix3d pointCovariance(int u_px, int v_px, double d_px) const;
+
+    /** Points [m] (left camera frame, eqs 8-9) with covariances [m^2] (eq 10) of every
+     * `step_px`-th pixel in u and v of `disparity` (the table's image size), appended to `out` in
+     * raster order. Pixels without a valid disparity, nearer than `minDepth_m` or with a range
+     * outside [minRange_m, maxRange_m] are skipped and counted, in that order of tests. No heap
+     * allocation per pixel; per row, what depends only on the row is computed once. Throws
+     * std::invalid_argument if the image size differs from the table's or step_px < 1. */
+    StereoPixelCounts appendPoints(const DisparityImage& disparity, int step_px, double minDepth_m,
+                                   double minRange_m, double maxRange_m, PointsWithCov& out) const;
 
 private:
     StereoGeometry m_geometry;
     CalibrationVector m_var;
     double m_matchingVar_px2 = 0;
-    std::vector<float> m_left;   //!< per pixel: var u, cov uv, var v [px^2]
-    std::vector<float> m_right;  //!< per pixel: var u [px^2], d u / d (rx, ry, rz) [px/rad]
+    // Per pixel, row-major: left var u, cov uv, var v [px^2]; right var u [px^2] from the
+    // intrinsics; right var u [px^2] from the extrinsic rotation (double: summed from the
+    // float-rounded rotation Jacobian, as before the table was split into arrays).
+    std::vector<float> m_luu, m_luv, m_lvv, m_ruu;
+    std::vector<double> m_rotVar;
 };
 
 }  // namespace multibin::sensors
