@@ -1,4 +1,5 @@
-/* End-to-end benchmarks through mrpt::maps::CMultiBinElevationMap: one 683-beam laser scan, one
+/* End-to-end benchmarks through mrpt::maps::CMultiBinElevationMap: one 683-beam laser scan, the
+ * laser scans of the shipped mock-up (rough terrain, the mapper's workload), one
  * 640 x 480 stereo frame from a disparity image, one 640 x 480 frame of map-frame points, each
  * with the visibility constraint on and off (its share of the observation's update), and OpenCV
  * SGBM on a 640 x 480 crop of the Middlebury Aloe pair, reported separately. Run e.g.:
@@ -6,12 +7,16 @@
  * --benchmark_report_aggregates_only=true The sensor models (laser, stereo) are measured as they
  * are in the tree at build time. */
 #include <benchmark/benchmark.h>
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 
 #include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "multibin/PosePropagation.h"
 #include "multibin/sensors/StereoDisparity.h"
@@ -122,6 +127,53 @@ static void BM_LaserScanEndToEnd(benchmark::State& state) {
     runMap(state, map, [&] { map.insertObservation(scan, pdf); });
 }
 BENCHMARK(BM_LaserScanEndToEnd)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
+
+// The laser scans of the shipped mock-up (rawlogs/mockup.simplemap: rocks and boards up to
+// 0.13 m, the robot driving over them) with their keyframe pose PDFs, through a map configured as
+// ini/mockup.ini does (its laser keys) with sensor_labels = LASER: the mapper's own workload,
+// rough terrain instead of the floor above. One iteration maps every scan into a fresh map;
+// counter `scans_per_s` (CPU time; us per scan = 1e6 / it).
+static void BM_LaserScansMockup(benchmark::State& state) {
+    mrpt::maps::CSimpleMap simplemap;
+    if (!simplemap.loadFromFile(std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/mockup.simplemap")) {
+        state.SkipWithError("rawlogs/mockup.simplemap not found");
+        return;
+    }
+    std::vector<std::pair<mrpt::obs::CObservation::Ptr, mrpt::poses::CPose3DPDFGaussian>> scans;
+    mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
+        simplemap,
+        [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
+            if (!dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) return;
+            obs.load();
+            scans.emplace_back(
+                std::dynamic_pointer_cast<mrpt::obs::CObservation>(obs.duplicateGetSmartPtr()),
+                pdf);
+        });
+    const mrpt::config::CConfigFileMemory ini(
+        "[c]\nresolution = 0.015\nbin_height = 0.05\n"
+        "[i]\nlaser_agc = LASER:512\nsensor_labels = LASER\nvisibility_constraint = " +
+        std::string(state.range(0) != 0 ? "true" : "false") + "\n");
+    mrpt::maps::CMultiBinElevationMap::TCreationOptions creation;
+    creation.loadFromConfigFile(ini, "c");
+    mrpt::maps::CMultiBinElevationMap::TInsertionOptions insertion;
+    insertion.loadFromConfigFile(ini, "i");
+    state.SetLabel(insertion.visibility.enabled ? "visibility on" : "visibility off");
+    size_t accepted = 0, cellsVisited = 0, rays = 0;
+    for (auto _ : state) {
+        mrpt::maps::CMultiBinElevationMap map(creation);
+        map.insertionOptions = insertion;
+        for (const auto& [obs, pdf] : scans) map.insertObservation(*obs, pdf);
+        accepted = map.insertStats().accepted;
+        cellsVisited = map.visibilityStats().cellsVisited;
+        rays = map.visibilityStats().raysCast;
+    }
+    state.counters["scans"] = double(scans.size());
+    state.counters["points_per_scan"] = double(accepted) / double(scans.size());
+    state.counters["cells_tested_per_ray"] = rays ? double(cellsVisited) / double(rays) : 0.0;
+    state.counters["scans_per_s"] = benchmark::Counter(
+        double(scans.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_LaserScansMockup)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
 // One 640 x 480 stereo frame end to end from its disparity image: halo and near-cluster filters,
 // triangulation with the calibration covariance table (eqs 4-10), propagation, bin update,
