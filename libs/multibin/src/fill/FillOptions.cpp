@@ -40,6 +40,13 @@ void FillOptions::read(StrictConfigSection& s) {
     s.read("fill_support_margin", supportMargin_cells);
     s.read("fill_max_training_points", maxTrainingPoints);
     s.read("fill_residual_correction", residualCorrection);
+    s.readChoice<ResidualModel>(
+        "fill_residual_model", residualModel,
+        {{"kriging", ResidualModel::Kriging}, {"harmonic", ResidualModel::Harmonic}});
+    s.readChoice<CovarianceFamily>(
+        "fill_kriging_covariance", krigingCovariance,
+        {{"exponential", CovarianceFamily::Exponential}, {"matern32", CovarianceFamily::Matern32}});
+    s.read("fill_model_averaging", modelAveraging);
     s.read("fill_extrapolation_margin", extrapolationMargin);
     s.readChoice<ModelCriterion>("fill_model_criterion", criterion,
                                  {{"aic", ModelCriterion::AICc},
@@ -76,6 +83,12 @@ void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
     c.write(section, "fill_support_margin", supportMargin_cells);
     c.write(section, "fill_max_training_points", maxTrainingPoints);
     c.write(section, "fill_residual_correction", residualCorrection);
+    c.write(section, "fill_residual_model",
+            std::string(residualModel == ResidualModel::Harmonic ? "harmonic" : "kriging"));
+    c.write(
+        section, "fill_kriging_covariance",
+        std::string(krigingCovariance == CovarianceFamily::Matern32 ? "matern32" : "exponential"));
+    c.write(section, "fill_model_averaging", modelAveraging);
     c.write(section, "fill_extrapolation_margin", extrapolationMargin);
     c.write(section, "fill_model_criterion", std::string(criterionName(criterion)));
     c.write(section, "fill_max_terms", maxTerms);

@@ -30,6 +30,16 @@ double bayesianCriterion(double chi2, int n, int k) {
     return n * std::log(std::max(chi2 / n, 1e-12)) + k * std::log(double(n));
 }
 
+double amplitudePriorPrecision(const std::vector<SurfaceSample>& samples) {
+    double lo = samples.at(0).h_m, hi = lo, maxSigma = 0;
+    for (const auto& s : samples) {
+        lo = std::min(lo, s.h_m), hi = std::max(hi, s.h_m);
+        maxSigma = std::max(maxSigma, s.sigma_m);
+    }
+    const double sigmaC = std::max(hi - lo, 3 * maxSigma);
+    return 1.0 / (sigmaC * sigmaC);
+}
+
 namespace {
 
 /** Shape parameters of one term in normalised coordinates u = (i - centre) / halfSide:
@@ -59,18 +69,11 @@ struct Fitter {
         const int n = int(samples.size());
         sqrtW.resize(n);
         y.resize(n);
-        double lo = samples[0].h_m, hi = lo, maxSigma = 0;
         for (int k = 0; k < n; k++) {
             sqrtW[k] = 1.0 / samples[k].sigma_m;
             y[k] = sqrtW[k] * samples[k].h_m;
-            lo = std::min(lo, samples[k].h_m), hi = std::max(hi, samples[k].h_m);
-            maxSigma = std::max(maxSigma, samples[k].sigma_m);
         }
-        // Gaussian prior on the amplitudes c_q (q >= 1), sigma_c = the data's height range: it
-        // does nothing to a term the data support and keeps a term that sits in the gap (its
-        // column almost zero at every sample) from taking an arbitrary amplitude.
-        const double sigmaC = std::max(hi - lo, 3 * maxSigma);
-        amplitudePrior = 1.0 / (sigmaC * sigmaC);
+        amplitudePrior = amplitudePriorPrecision(samples);
         yy = y.squaredNorm();
     }
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "multibin/fill/GaussianSurface.h"
+#include "multibin/fill/Kriging.h"
 
 namespace mrpt::config {
 class CConfigFileBase;
@@ -29,6 +30,19 @@ enum class FillSigmaModel {
     Paper
 };
 
+/** How the residuals of the measured cells about the fitted eq 16 surface are carried into a gap
+ * (when FillOptions::residualCorrection is on). */
+enum class ResidualModel {
+    /** Universal kriging: eq 16 is the trend (amplitudes by generalised least squares), the
+     * residuals are interpolated with a covariance fitted to their semivariogram, the kriging
+     * variance gives the filled cell's sigma, and m is chosen by AIC on this Gaussian-process
+     * likelihood (see doc/gap-filling.md). */
+    Kriging,
+    /** Harmonic function (Laplace equation) with the rim residuals as Dirichlet data; m chosen
+     * by AIC on independent residuals; sigma from the semivariogram of the heights. */
+    Harmonic
+};
+
 /** Options of gap filling. Ini keys (all prefixed `fill_` so they can live in the map's
  * insertion-options section) are given in brackets. */
 struct FillOptions {
@@ -52,6 +66,14 @@ struct FillOptions {
     /** [fill_residual_correction] beyond the paper: add to the fitted surface the residuals of
      * the rim cells, carried into the gap as a harmonic function, so the fill meets the rim. */
     bool residualCorrection = true;
+    /** [fill_residual_model] kriging|harmonic: see ResidualModel. */
+    ResidualModel residualModel = ResidualModel::Kriging;
+    /** [fill_kriging_covariance] exponential|matern32: correlation family of the kriging. */
+    CovarianceFamily krigingCovariance = CovarianceFamily::Matern32;
+    /** [fill_model_averaging] kriging only: average the fills of the m visited by the search
+     * with Akaike weights exp(-dAIC/2) (and add their spread to the variance) instead of
+     * keeping the single best m. */
+    bool modelAveraging = true;
     /** [fill_extrapolation_margin] Gaussian-filled heights are kept within the training heights'
      * range widened by this fraction of it on each side [-]. 0.25 cut overshoot into rock-board
      * gaps (doc/gap-filling.md) but also flattens a hidden hill top higher than that. */
@@ -69,7 +91,7 @@ struct FillOptions {
     FillSigmaModel sigmaModel =
         FillSigmaModel::Calibrated;   //!< [fill_sigma_model] calibrated|paper
     double medianSigmaGain = 0.77;    //!< [fill_median_sigma_gain] calibrated gain [-]
-    double gaussianSigmaGain = 0.88;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
+    double gaussianSigmaGain = 1.43;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
     double sigmaFloor_m = 0.002;      //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
 
     /** The Gaussian-fit settings these options imply. */

@@ -75,6 +75,12 @@ double correctedAic(double chi2, int n, int k);
  * weights: n ln(chi2 / n) + k ln n. */
 double bayesianCriterion(double chi2, int n, int k);
 
+/** Precision 1 / sigma_c^2 [1/m^2] of the weak Gaussian prior on the amplitudes c_q (q >= 1):
+ * sigma_c = the samples' height range (at least 3 times their largest sigma). It does nothing to
+ * a term the data support and keeps a term sitting in the gap, where no sample constrains it,
+ * from taking an arbitrary amplitude. */
+double amplitudePriorPrecision(const std::vector<SurfaceSample>& samples);
+
 /** Fits eq 16 with exactly m Gaussians to samples on a side x side support area: amplitudes by
  * weighted linear least squares (Gram matrix, Eigen LDLT), centres and widths by particle
  * swarm minimising chi2, then refined by Levenberg-Marquardt from the swarm's best. `seed` (may be
