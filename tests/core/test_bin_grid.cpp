@@ -226,13 +226,18 @@ TEST(BinGrid, BlockHeightBoundCoversEveryBin) {
             }
     }
     EXPECT_GT(checkedBins, 10000u);
-    // Blocks are 8 cells: -13 >> 3 = -2 (cells -16..-9), and a block beyond the window has none.
-    EXPECT_EQ(BinGrid::blockOf(-13), -2);
-    EXPECT_EQ(BinGrid::blockOf(-8), -1);
-    EXPECT_EQ(BinGrid::blockOf(7), 0);
+    // Block indices floor-divide cell indices, negative ones included.
+    constexpr int K = BinGrid::kBlockCells;
+    EXPECT_EQ(BinGrid::blockOf(-1), -1);
+    EXPECT_EQ(BinGrid::blockOf(-K), -1);
+    EXPECT_EQ(BinGrid::blockOf(-K - 1), -2);
+    EXPECT_EQ(BinGrid::blockOf(K - 1), 0);
+    EXPECT_EQ(BinGrid::blockOf(K), 1);
+    // One bin in cell (3, K + 1): block (0, 1) holds it, its neighbour none, a block beyond the
+    // window none.
     BinGrid fresh(0.05);
-    fresh.reset(0.05, CellWindow{0, 0, 16, 16});
-    fresh.insertPoints({pointAt(0.05 * 3.5, 0.05 * 9.5, 0.3, 0.003)}, p);
+    fresh.reset(0.05, CellWindow{0, 0, 3 * K, 3 * K});
+    fresh.insertPoints({pointAt(0.05 * 3.5, 0.05 * (K + 1.5), 0.3, 0.003)}, p);
     EXPECT_EQ(fresh.blockMaxHeight_m(0, 1), 0.3f);
     EXPECT_EQ(fresh.blockMaxHeight_m(1, 1), -std::numeric_limits<float>::infinity());
     EXPECT_EQ(fresh.blockMaxHeight_m(5, 1), -std::numeric_limits<float>::infinity());

@@ -77,7 +77,7 @@ struct CellWindow {
  * Storage is a circular buffer over the cell window (grid_map style): cell (ix, iy) lives in slot
  * (ix mod nx) + (iy mod ny) nx, so moving the window only clears the slots of the cells that enter,
  * and growing it re-slots the cell heads without touching any bin. Memory: 12 B per cell of the
- * window (chain head, update-cycle stamp and index), 12 B per block of 64 cells (local height
+ * window (chain head, update-cycle stamp and index), 12 B per block of 256 cells (local height
  * bound) and 24 B per bin. */
 class BinGrid {
 public:
@@ -197,7 +197,7 @@ public:
      * compare per run of points); conservative on removal: the bound never goes down while the
      * block stays in the window, which costs the visibility constraint time, never correctness.
      * @{ */
-    static constexpr int kBlockShift = 3;
+    static constexpr int kBlockShift = 4;
     static constexpr int kBlockCells = 1 << kBlockShift;
     /** Block index of a cell index (floor division by kBlockCells). */
     static int blockOf(int cellIndex) { return cellIndex >> kBlockShift; }  // arithmetic shift
@@ -227,7 +227,7 @@ public:
     /** Memory held by the grid [bytes]: per cell of the window a bin-chain head and an
      * update-cycle stamp and index (12 B), the bin pool (24 B per bin, with the vector's spare
      * capacity), the list of cells updated in the current cycle and the block height bounds
-     * (12 B per block of 64 cells). Independent of the vertical extent. */
+     * (12 B per block of 256 cells). Independent of the vertical extent. */
     size_t memoryBytes() const {
         return m_cells.capacity() * sizeof(CellSlot) + m_pool.capacity() * sizeof(Bin) +
                m_updated.capacity() * sizeof(UpdatedCell) + m_blocks.capacity() * sizeof(BlockSlot);

@@ -41,21 +41,78 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     // line: far above the rounding of the sample positions (~1e-15 of the coordinates).
     constexpr double kSlack_m = 1e-6;
 
-    for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
-        const Bin* winner = grid.winningBin(u.ix, u.iy);
-        const float targetCertainty = winner ? winner->certainty : 0.f;
+    const CellWindow& w = grid.window();  // edits never change it
+    // The window's block range: the sweep below ends where the ray leaves it.
+    const int blockXLo = BinGrid::blockOf(w.ix0), blockXHi = BinGrid::blockOf(w.ix0 + w.nx - 1);
+    const int blockYLo = BinGrid::blockOf(w.iy0), blockYHi = BinGrid::blockOf(w.iy0 + w.ny - 1);
+
+    // The whole update at once: every line of sight runs between its updated cell and the
+    // sensor, so no lower than the lowest of them, over cells within the box spanned by the
+    // updated cells and the sensor's cell (one cell wider for rounding). If no block meeting that
+    // box can hold a bin above that height by more than the smallest conflict margin, nothing
+    // conflicts (a floor seen from above: most laser scans). Only the rays are counted.
+    const std::vector<BinGrid::UpdatedCell>& updated = grid.updatedCells();
+    if (!updated.empty()) {
+        int ixLo = grid.cellIndex(sensor_m.x()), ixHi = ixLo;
+        int iyLo = grid.cellIndex(sensor_m.y()), iyHi = iyLo;
+        double lowest_m = sensor_m.z();
+        for (const BinGrid::UpdatedCell& u : updated) {
+            ixLo = std::min(ixLo, u.ix);
+            ixHi = std::max(ixHi, u.ix);
+            iyLo = std::min(iyLo, u.iy);
+            iyHi = std::max(iyHi, u.iy);
+            lowest_m = std::min(lowest_m, double(u.maxHeight_m));  // a NaN sensor z drops out
+        }
+        const int bxLo = BinGrid::blockOf(std::max(ixLo - 1, w.ix0));
+        const int bxHi = BinGrid::blockOf(std::min(ixHi + 1, w.ix0 + w.nx - 1));
+        const int byLo = BinGrid::blockOf(std::max(iyLo - 1, w.iy0));
+        const int byHi = BinGrid::blockOf(std::min(iyHi + 1, w.iy0 + w.ny - 1));
+        if ((bxHi - bxLo + 1) * (byHi - byLo + 1) <= 1024) {
+            float bound_m = -std::numeric_limits<float>::infinity();
+            for (int by = byLo; by <= byHi; by++)
+                for (int bx = bxLo; bx <= bxHi; bx++)
+                    bound_m = std::max(bound_m, grid.blockMaxHeight_m(bx, by));
+            if (!blockMayConflict(bound_m, lowest_m)) {
+                for (const BinGrid::UpdatedCell& u : updated) {
+                    const double dx = sensor_m.x() - grid.cellCenter_m(u.ix);
+                    const double dy = sensor_m.y() - grid.cellCenter_m(u.iy);
+                    stats.raysCast += !(std::sqrt(dx * dx + dy * dy) < cell);
+                }
+                return stats;
+            }
+        }
+    }
+
+    for (const BinGrid::UpdatedCell& u : updated) {
         const double tz = u.maxHeight_m;
         const float decrement = vis.certaintyDecrement * float(u.points);
+        // The certainty of the cell's winning bin before its own edit (below); needed only when
+        // a ray meets a conflicting bin. Rays never edit updated cells, so a late look-up gives
+        // the same value unless the cell's own edit ran: then it is taken first.
+        float targetCertainty = 0;
+        bool haveTarget = false;
+        auto target = [&]() {
+            if (!haveTarget) {
+                const Bin* winner = grid.winningBin(u.ix, u.iy);
+                targetCertainty = winner ? winner->certainty : 0.f;
+                haveTarget = true;
+            }
+            return targetCertainty;
+        };
 
         // Bins of the updated cell above all that was measured in it now.
-        grid.editBins(u.ix, u.iy, [&](Bin& b) {
-            if (!conflicts(b, tz)) return true;
-            b.certainty -= decrement;
-            stats.binsWeakened++;
-            if (b.certainty > 0) return true;
-            stats.binsRemoved++;
-            return false;
-        });
+        if (blockMayConflict(grid.blockMaxHeight_m(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
+                             tz)) {
+            target();
+            grid.editBins(u.ix, u.iy, [&](Bin& b) {
+                if (!conflicts(b, tz)) return true;
+                b.certainty -= decrement;
+                stats.binsWeakened++;
+                if (b.certainty > 0) return true;
+                stats.binsRemoved++;
+                return false;
+            });
+        }
 
         // Walk the line of sight from the updated cell back to the sensor.
         const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
@@ -63,6 +120,50 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const double length = std::sqrt(dx * dx + dy * dy);  // libm hypot is several times slower
         if (length < cell) continue;
         stats.raysCast++;
+
+        // Sweep the ray's block columns (rows if it runs more along y), with its direction and
+        // slope to rounding (the slack covers it): over each, the blocks the line can touch and
+        // the ray's lowest height there. `reach` ends the last stretch of the ray below some
+        // block's bound: no sample beyond it can meet a conflicting bin.
+        double reach = 0;
+        {
+            const bool xMajor = std::abs(dx) >= std::abs(dy);
+            const double da0 = xMajor ? dx : dy, db0 = xMajor ? dy : dx;
+            // One division for 1 / length and 1 / ua (ua = da0 / length, |ua| >= 0.707).
+            const double r = 1.0 / (length * da0);
+            const double invLength = da0 * r, invUa = length * length * r;
+            const double ub = db0 * invLength;
+            const double aSlope = (sensor_m.z() - tz) * invLength;
+            const double aRise = std::abs(aSlope) * 0.7072 * cell;
+            const double a0 = xMajor ? tx : ty, b0 = xMajor ? ty : tx;
+            const int stepA = da0 > 0 ? 1 : -1;
+            const int endA =
+                da0 > 0 ? (xMajor ? blockXHi : blockYHi) + 1 : (xMajor ? blockXLo : blockYLo) - 1;
+            int ka = BinGrid::blockOf(xMajor ? u.ix : u.iy);
+            for (double da = 0; da < length && ka != endA; ka += stepA) {
+                // A rising ray is lowest where the stretch starts.
+                const double startZ_m = tz + aSlope * (da - kSlack_m) - kSlack_m;
+                // Past here the samples stop: the ray clears the highest stored bin (below).
+                if (aSlope > 0 && startZ_m - aRise > stopHeight) break;
+                const double exit = ((da0 > 0 ? ka + 1 : ka) * block_m - a0) * invUa;
+                const double db = std::min(exit, length);
+                const double bLo = b0 + ub * (ub > 0 ? da - kSlack_m : db + kSlack_m) - kSlack_m;
+                const double bHi = b0 + ub * (ub > 0 ? db + kSlack_m : da - kSlack_m) + kSlack_m;
+                float bound_m = -std::numeric_limits<float>::infinity();
+                for (int kb = BinGrid::floorToInt(bLo * invBlock),
+                         kbEnd = BinGrid::floorToInt(bHi * invBlock);
+                     kb <= kbEnd; kb++)
+                    bound_m = std::max(bound_m, xMajor ? grid.blockMaxHeight_m(ka, kb)
+                                                       : grid.blockMaxHeight_m(kb, ka));
+                const double lowest_m =
+                    aSlope > 0 ? startZ_m : tz + aSlope * (db + kSlack_m) - kSlack_m;
+                if (blockMayConflict(bound_m, lowest_m + aRise)) reach = db + kSlack_m;
+                da = exit;
+            }
+        }
+        if (!(reach >= step)) continue;  // the first sample lies beyond it
+
+        // The samples, exactly as the global-bound walk takes them.
         const double slope = (sensor_m.z() - tz) / length;  // ray height gained per metre back
         // The ray's highest point within a cell lies at most half a diagonal from a sample.
         const double inCellRise = std::abs(slope) * 0.7072 * cell;
@@ -80,7 +181,6 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         // The ray starts inside the window, which is convex: past the point where it leaves the
         // window no sample can touch a cell of the grid. Without this, a sensor far from the map
         // (a corrupt pose) costs 10^11 samples per updated cell.
-        const CellWindow& w = grid.window();
         double walk = length;
         auto clipAxis = [&](double origin, double dir, int i0, int n) {
             if (dir > 0) walk = std::min(walk, ((i0 + n) * cell - origin) / dir + cell);
@@ -88,36 +188,6 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         };
         clipAxis(tx, ux, w.ix0, w.nx);
         clipAxis(ty, uy, w.iy0, w.ny);
-        // The samples never go past the global bound (below) or the window.
-        const double globalReach =
-            slope > 0 ? (stopHeight + inCellRise - tz) / slope + kSlack_m : walk;
-        // Walk the ray's block columns (rows if it runs more along y): over each, the blocks the
-        // line can touch, and the lowest ray height there. `reach` ends the last stretch of the
-        // ray below some block's bound: no sample beyond it can meet a conflicting bin.
-        double reach = 0;
-        {
-            const bool xMajor = std::abs(ux) >= std::abs(uy);
-            const double a0 = xMajor ? tx : ty, b0 = xMajor ? ty : tx;
-            const double ua = xMajor ? ux : uy, ub = xMajor ? uy : ux;  // |ua| >= 0.707
-            const double invUa = 1.0 / ua;
-            const double limit = std::min(walk, globalReach);
-            int ka = BinGrid::blockOf(xMajor ? u.ix : u.iy);
-            for (double da = 0; da<limit; ka += ua> 0 ? 1 : -1) {
-                const double exit = ((ua > 0 ? ka + 1 : ka) * block_m - a0) * invUa;
-                const double db = std::min(exit, limit);
-                const double bLo = b0 + ub * (ub > 0 ? da - kSlack_m : db + kSlack_m) - kSlack_m;
-                const double bHi = b0 + ub * (ub > 0 ? db + kSlack_m : da - kSlack_m) + kSlack_m;
-                float bound_m = -std::numeric_limits<float>::infinity();
-                for (int kb = BinGrid::floorToInt(bLo * invBlock),
-                         kbEnd = BinGrid::floorToInt(bHi * invBlock);
-                     kb <= kbEnd; kb++)
-                    bound_m = std::max(bound_m, xMajor ? grid.blockMaxHeight_m(ka, kb)
-                                                       : grid.blockMaxHeight_m(kb, ka));
-                const double lowest_m = tz + slope * (slope > 0 ? da - kSlack_m : db + kSlack_m);
-                if (blockMayConflict(bound_m, lowest_m + inCellRise)) reach = db + kSlack_m;
-                da = exit;
-            }
-        }
         int lastIx = u.ix, lastIy = u.iy;
         for (double d = step; d < walk; d += step) {
             if (d > reach) break;
@@ -128,15 +198,16 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             if (ix == lastIx && iy == lastIy) continue;
             lastIx = ix;
             lastIy = iy;
-            if (!grid.window().contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
             const double rayHigh = rayZ + inCellRise;
+            // The block bound first: a small table, and most cells stop here.
             if (!blockMayConflict(grid.blockMaxHeight_m(BinGrid::blockOf(ix), BinGrid::blockOf(iy)),
                                   rayHigh))
                 continue;
+            if (!w.contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
             stats.cellsVisited++;
             grid.editBins(ix, iy, [&](Bin& b) {
                 if (!conflicts(b, rayHigh)) return true;
-                if (b.certainty < targetCertainty) {
+                if (b.certainty < target()) {
                     stats.binsRemoved++;
                     return false;
                 }
