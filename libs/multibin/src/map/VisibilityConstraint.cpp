@@ -14,9 +14,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     if (!vis.enabled) return stats;
     const double cell = grid.cellSize_m();
     const double step = 0.5 * cell;
-    const double maxStoredHeight = grid.maxHeight_m();
-    const double stopHeight = maxStoredHeight + vis.margin_m;  // hoisted: editBins writes memory
-    const double invCell = 1.0 / cell;                         // computed as BinGrid's own [1/m]
+    // Rays stop once they clear every bin they could still meet by the margin: the highest
+    // stored anywhere, or (below) the highest in the region of this update.
+    double stopHeight = grid.maxHeight_m() + vis.margin_m;  // hoisted: editBins writes memory
+    const double invCell = 1.0 / cell;                      // computed as BinGrid's own [1/m]
     constexpr double kNoClamp = 1e8;  // [cells]; cellIndex() clamps beyond 5.3e8
     auto conflictMargin = [&](const Bin& b) {
         return vis.margin_m + 3.0 * BinGrid::sigma_m(b, binParams);
@@ -72,6 +73,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             for (int by = byLo; by <= byHi; by++)
                 for (int bx = bxLo; bx <= bxHi; bx++)
                     bound_m = std::max(bound_m, grid.blockMaxHeight_m(bx, by));
+            // Every sample lies in this region: its bound caps what a ray can meet.
+            stopHeight =
+                std::min(stopHeight,
+                         double(bound_m) + 1e-6 * (1.0 + std::abs(double(bound_m))) + vis.margin_m);
             if (!blockMayConflict(bound_m, lowest_m)) {
                 for (const BinGrid::UpdatedCell& u : updated) {
                     const double dx = sensor_m.x() - grid.cellCenter_m(u.ix);
