@@ -40,9 +40,14 @@ struct VisibilityStats {
  * - within an updated cell, a bin above everything measured in it now would have occluded those
  *   measurements: it loses `certaintyDecrement` per new point, so the next-best hypothesis wins.
  *
- * Heights can therefore go down as well as up. The rays are walked from the updated cell back
- * towards the sensor and stop where the line of sight rises above every stored height, so the cost
- * grows with the distinct updated cells, not with the points. */
+ * Heights can therefore go down as well as up. The rays are sampled every half cell from the
+ * updated cell back towards the sensor. BinGrid's block height bounds (BinGrid::blockMaxHeight_m)
+ * decide where a bin can conflict at all: a ray is walked only as far as the last block it
+ * passes too low over, a cell is tested only if its block's bound lies above the ray by the
+ * smallest conflict margin, and an update whose whole region (the blocks between the sensor and
+ * the updated cells) lies below every line of sight costs no walk at all. The bins edited are
+ * exactly those of a walk to the highest bin stored anywhere; the cost grows with the distinct
+ * updated cells, not with the points, and with the relief near the lines of sight. */
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
                                           const VisibilityParams& visibility,
                                           const BinUpdateParams& binParams);
