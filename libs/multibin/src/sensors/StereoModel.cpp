@@ -166,8 +166,7 @@ StereoCovarianceTable::StereoCovarianceTable(const StereoGeometry& g,
     m_luu.resize(n);
     m_luv.resize(n);
     m_lvv.resize(n);
-    m_ruu.resize(n);
-    m_rotVar.resize(n);
+    m_rightVar.resize(n);
     const Eigen::Matrix<double, 9, 1> vl = m_var.segment<9>(kLeft), vr = m_var.segment<9>(kRight);
     for (int v = 0; v < g.height; v++)
         for (int u = 0; u < g.width; u++) {
@@ -180,16 +179,16 @@ StereoCovarianceTable::StereoCovarianceTable(const StereoGeometry& g,
             m_luu[i] = float(Cl(0, 0));
             m_luv[i] = float(Cl(0, 1));
             m_lvv[i] = float(Cl(1, 1));
-            // Right pixel (u, v): u variance from the right intrinsics and from the extrinsic
-            // rotation (its Jacobian rounded to float, as the table has always stored it).
+            // Right pixel (u, v): u variance from the right intrinsics plus that from the
+            // extrinsic rotation (both rounded as the table stored them when they were apart).
             const double xr = (u - g.cxRight) / g.fx;
             const Eigen::Matrix<double, 1, 9> Jr = intrinsicsJacobian(xr, y, g.fx, g.fy).row(0);
-            m_ruu[i] = float((Jr * vr.asDiagonal() * Jr.transpose())(0, 0));
+            const float intrinsic = float((Jr * vr.asDiagonal() * Jr.transpose())(0, 0));
             const Eigen::RowVector3d Jrot = rightRotationJacobian(xr, y, g.fx);
             double rot = 0;
             for (int k = 0; k < 3; k++)
                 rot += m_var[kExt + k] * double(float(Jrot[k])) * double(float(Jrot[k]));
-            m_rotVar[i] = rot;
+            m_rightVar[i] = double(intrinsic) + rot;
         }
 }
 
@@ -204,7 +203,7 @@ struct PointConstants {
     double offset_px;   //!< cx - cxRight: d - offset is the disparity of the triangulation
     double baselineFx;  //!< baseline [m] * fx [px]
     double cx, cy, cxRight, fx, fy;
-    double invFx, invFy, invBaseline;
+    double invFx, invFy, invBaseline, invBaselineFx;
     double varTx, varTz;  //!< extrinsic translation variances [m^2] (ty does not move u_r)
     double matchingVar2;  //!< 2 sigma_m^2 [px^2]
 
@@ -219,38 +218,44 @@ struct PointConstants {
           invFx(1 / g.fx),
           invFy(1 / g.fy),
           invBaseline(1 / g.baseline_m),
+          invBaselineFx(1 / (g.baseline_m * g.fx)),
           varTx(var[kExt + 3]),
           varTz(var[kExt + 5]),
           matchingVar2(2 * matchingVar) {}
 
     /** Column of the right pixel of the match, nearest to u - d, clamped to the image (equal to
-     * clamp(lround(u - d)): u - d + 0.5 is exact wherever u - d is near a half). */
-    int rightColumn(double u, double d, int width) const {
-        return int(std::min(std::max(u - d, 0.0), double(width - 1)) + 0.5);
+     * clamp(lround(u - d)): u - d + 0.5 is exact wherever u - d is near a half); 0 for a NaN d. */
+    static int rightColumn(double u, double d, int width) {
+        return int(std::min(std::max(0.0, u - d), double(width - 1)) + 0.5);
+    }
+
+    /** Variance of the disparity [px^2] at left column u with disparity d: the left u
+     * variance, the right pixel's u variance from its intrinsics and the extrinsic rotation
+     * (table entry `rightVar`), from the extrinsic translation (d u_r / d t = fx / z (1, 0, -x_r),
+     * fx / z = (d - offset) / baseline), and the matching noise of both images. */
+    double disparityVariance(double u, double d, double luu, double rightVar) const {
+        const double xr = (u - d - cxRight) * invFx;
+        const double jtx = (d - offset_px) * invBaseline, jtz = -xr * jtx;
+        return luu + rightVar + varTx * jtx * jtx + varTz * jtz * jtz + matchingVar2;
     }
 
     /** Eqs 8-10 for left pixel column u, row offset dv = v - cy [px], disparity d [px] and the
-     * table entries of the pixel (luu, luv, lvv) and of its right pixel (ruu, rotVar): the point
+     * table entries of the pixel (luu, luv, lvv) and of its right pixel (rightVar): the point
      * [m] (x, y, z) and the upper triangle of its covariance [m^2] in SymmetricCov3's order. The
      * point is computed exactly as StereoGeometry::triangulate(); the covariance is
      * J_p C_uvd J_p^T written out with the zeros of J_p and C_uvd's repeated entries left out and
-     * the divisions by d, z and fx replaced by products (within a few 1e-16 of the plain
-     * product). */
-    void point(double u, double dv, double d, double luu, double luv, double lvv, double ruu,
-               double rotVar, double* p, double* c) const {
+     * the divisions by d and fx replaced by products (a few 1e-16 relative from the plain
+     * matrix product: tested to round to the same floats in practically every entry). */
+    void point(double u, double dv, double d, double luu, double luv, double lvv, double rightVar,
+               double* p, double* c) const {
         const double dd = d - offset_px;
         const double z = baselineFx / dd;
         const double x = (u - cx) * z / fx, y = dv * z / fy;
         p[0] = x;
         p[1] = y;
         p[2] = z;
-        // Pixel covariance: d's variance adds the right pixel's (intrinsics, rotation,
-        // translation: d u_r / d t = fx / z (1, 0, -x_r), fx / z = dd / baseline) and matching.
-        const double invDd = 1 / dd;
-        const double xr = (u - d - cxRight) * invFx;
-        const double jtx = dd * invBaseline, jtz = -xr * jtx;
-        const double vd =
-            luu + ruu + (rotVar + varTx * jtx * jtx + varTz * jtz * jtz) + matchingVar2;
+        const double vd = disparityVariance(u, d, luu, rightVar);
+        const double invDd = z * invBaselineFx;  // 1 / dd
         // Triangulation Jacobian [[a 0 b] [0 cc e] [0 0 f]] (eq 10's J_p).
         const double a = z * invFx, b = -x * invDd, cc = z * invFy, e = -y * invDd, f = -z * invDd;
         // T = J_p C_uvd (the entries needed), then J_p^T's columns.
@@ -271,50 +276,67 @@ struct PointConstants {
 #define MULTIBIN_STEREO_CLONES
 #endif
 
-/** Scratch arrays of one image row (structure of arrays), sized once per frame. */
+/** What became of a pixel: kept, or which test skipped it (in the order of the tests). */
+enum PixelStatus : int32_t { kKept = 0, kNoDisparity = 1, kTooNear = 2, kOutOfRange = 3 };
+
+/** Per-frame inputs of rowPoints() besides the row. */
+struct RowInputs {
+    int width, step;
+    double minDepth_m, minRange2_m2, maxRange2_m2;  //!< range limits as squares (see below)
+};
+
+/** Results for the pixels of one image row (structure of arrays), allocated once per frame. */
 struct RowBuffers {
-    std::vector<double> u, d;  //!< columns with a usable disparity, their disparities [px]
-    std::vector<double> luu, luv, lvv, ruu, rotVar;  //!< their table entries
-    std::vector<double> p[3];                        //!< points [m]
-    std::vector<double> r2;                          //!< squared ranges [m^2]
-    std::vector<float> c[6];                         //!< covariances [m^2]
-    explicit RowBuffers(size_t n) : u(n), d(n), luu(n), luv(n), lvv(n), ruu(n), rotVar(n), r2(n) {
+    std::vector<float> p[3];         //!< points [m]
+    std::vector<float> c[6];         //!< covariances [m^2], SymmetricCov3's order
+    std::vector<int32_t> status;     //!< PixelStatus (int: vectorises with the doubles)
+    std::vector<PointWithCov> kept;  //!< the kept ones, packed, before they go to the output
+    explicit RowBuffers(size_t n) : status(n), kept(n) {
         for (auto& a : p) a.resize(n);
         for (auto& a : c) a.resize(n);
     }
 };
 
-/** Points and covariances of the n compacted pixels of one row: straight-line code over
- * separate arrays, which the compiler vectorises (4 doubles a step with AVX2). */
+/** Points, covariances and status of the n pixels u = 0, step, 2 step... of one row: straight-
+ * line code over arrays, which the compiler vectorises (4 doubles a step with AVX2; the right
+ * pixel's table entries are gathered). `drow` and the table pointers point at the row. */
 MULTIBIN_STEREO_CLONES
-void rowPoints(const PointConstants& constants, double dv, size_t n, RowBuffers& b) {
-    const PointConstants k = constants;  // a local copy: no aliasing with the outputs
-    const double* __restrict us = b.u.data();
-    const double* __restrict ds = b.d.data();
-    const double* __restrict luu = b.luu.data();
-    const double* __restrict luv = b.luv.data();
-    const double* __restrict lvv = b.lvv.data();
-    const double* __restrict ruu = b.ruu.data();
-    const double* __restrict rot = b.rotVar.data();
-    double* __restrict px = b.p[0].data();
-    double* __restrict py = b.p[1].data();
-    double* __restrict pz = b.p[2].data();
-    double* __restrict rr = b.r2.data();
+void rowPoints(const PointConstants& constants, const RowInputs& in, double dv, size_t n,
+               const float* __restrict drow, const float* __restrict luu,
+               const float* __restrict luv, const float* __restrict lvv,
+               const double* __restrict rightVar, RowBuffers& b) {
+    const PointConstants k = constants;  // local copies: no aliasing with the outputs
+    const RowInputs r = in;
+    float* __restrict px = b.p[0].data();
+    float* __restrict py = b.p[1].data();
+    float* __restrict pz = b.p[2].data();
     float* __restrict c0 = b.c[0].data();
     float* __restrict c1 = b.c[1].data();
     float* __restrict c2 = b.c[2].data();
     float* __restrict c3 = b.c[3].data();
     float* __restrict c4 = b.c[4].data();
     float* __restrict c5 = b.c[5].data();
-#pragma GCC ivdep  // the arrays are distinct vectors (GCC ignores restrict on local pointers)
+    int32_t* __restrict status = b.status.data();
+#pragma GCC ivdep  // the arrays are distinct (GCC ignores restrict on local pointers)
     for (size_t i = 0; i < n; i++) {
+        const int u = int(i) * r.step;  // int: converts to double in vector registers
+        const double d = drow[u];
+        const bool usable = d - k.offset_px > 0;  // false for NaN
+        const int ur = PointConstants::rightColumn(double(u), d, r.width);
         double p[3], c[6];
-        k.point(us[i], dv, ds[i], luu[i], luv[i], lvv[i], ruu[i], rot[i], p, c);
-        px[i] = p[0];
-        py[i] = p[1];
-        pz[i] = p[2];
+        k.point(double(u), dv, d, luu[u], luv[u], lvv[u], rightVar[ur], p, c);
         // As Eigen's squaredNorm(): (x^2 + y^2) + z^2.
-        rr[i] = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        const double range2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        const bool inRange = !(range2 < r.minRange2_m2) & !(range2 > r.maxRange2_m2);
+        // Branch-free (so the loop vectorises): the first failing test, in the order of the
+        // tests (disparity, depth, range).
+        const int tooNear = p[2] < r.minDepth_m;
+        const int unusable = !usable, outside = !inRange;
+        status[i] = unusable * kNoDisparity +
+                    (1 - unusable) * (tooNear * kTooNear + (1 - tooNear) * outside * kOutOfRange);
+        px[i] = float(p[0]);
+        py[i] = float(p[1]);
+        pz[i] = float(p[2]);
         c0[i] = float(c[0]);
         c1[i] = float(c[1]);
         c2[i] = float(c[2]);
@@ -322,6 +344,30 @@ void rowPoints(const PointConstants& constants, double dv, size_t n, RowBuffers&
         c4[i] = float(c[4]);
         c5[i] = float(c[5]);
     }
+}
+
+/** Appends the kept pixels of a row to `out` (through a packed row buffer: one bulk copy) and
+ * counts the skipped ones. */
+void packRow(size_t n, RowBuffers& b, PointsWithCov& out, StereoPixelCounts& counts) {
+    const float *px = b.p[0].data(), *py = b.p[1].data(), *pz = b.p[2].data();
+    const float *c0 = b.c[0].data(), *c1 = b.c[1].data(), *c2 = b.c[2].data(), *c3 = b.c[3].data(),
+                *c4 = b.c[4].data(), *c5 = b.c[5].data();
+    const int32_t* status = b.status.data();
+    PointWithCov* kept = b.kept.data();
+    size_t m = 0, byStatus[4] = {0, 0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        byStatus[status[i]]++;
+        if (status[i] != kKept) continue;
+        PointWithCov& q = kept[m++];
+        q.point_m = Eigen::Vector3f(px[i], py[i], pz[i]);
+        q.cov_m2 = {c0[i], c1[i], c2[i], c3[i], c4[i], c5[i]};
+    }
+    out.insert(out.end(), kept, kept + m);
+    counts.pixels += n;
+    counts.kept += m;
+    counts.noDisparity += byStatus[kNoDisparity];
+    counts.tooNear += byStatus[kTooNear];
+    counts.outOfRange += byStatus[kOutOfRange];
 }
 
 /** The smallest s >= 0 with sqrt(s) >= r_m: sqrt(s) < r_m exactly when s < this (sqrt is
@@ -354,10 +400,7 @@ Eigen::Matrix3d StereoCovarianceTable::pixelCovariance(int u, int v, double d) c
     const size_t i = size_t(v) * size_t(g.width) + size_t(u);
     const size_t j = size_t(v) * size_t(g.width) + size_t(k.rightColumn(u, d, g.width));
     const double luu = m_luu[i], luv = m_luv[i], lvv = m_lvv[i];
-    const double xr = (u - d - g.cxRight) * k.invFx;
-    const double jtx = (d - k.offset_px) * k.invBaseline, jtz = -xr * jtx;
-    const double vd = luu + double(m_ruu[j]) +
-                      (m_rotVar[j] + k.varTx * jtx * jtx + k.varTz * jtz * jtz) + k.matchingVar2;
+    const double vd = k.disparityVariance(u, d, luu, m_rightVar[j]);
     Eigen::Matrix3d C;
     C << luu, luv, luu, luv, lvv, luv, luu, luv, vd;
     return C;
@@ -371,7 +414,7 @@ Eigen::Matrix3d StereoCovarianceTable::pointCovariance(int u, int v, double d) c
     const size_t i = size_t(v) * size_t(g.width) + size_t(u);
     const size_t j = size_t(v) * size_t(g.width) + size_t(k.rightColumn(u, d, g.width));
     double p[3], c[6];
-    k.point(u, v - g.cy, d, m_luu[i], m_luv[i], m_lvv[i], m_ruu[j], m_rotVar[j], p, c);
+    k.point(u, v - g.cy, d, m_luu[i], m_luv[i], m_lvv[i], m_rightVar[j], p, c);
     Eigen::Matrix3d C;
     C << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
     return C;
@@ -389,50 +432,17 @@ StereoPixelCounts StereoCovarianceTable::appendPoints(const DisparityImage& disp
         throw std::invalid_argument("StereoCovarianceTable::appendPoints: step_px must be >= 1");
     const PointConstants k(g, m_var, m_matchingVar_px2);
     const size_t perRow = size_t((g.width + step - 1) / step);
+    const RowInputs in{g.width, step, minDepth_m, smallestSquareReaching(minRange_m),
+                       largestSquareWithin(maxRange_m)};
     RowBuffers b(perRow);
-    const double minRange2 = smallestSquareReaching(minRange_m),
-                 maxRange2 = largestSquareWithin(maxRange_m);
     StereoPixelCounts counts;
     out.reserve(out.size() + perRow * size_t((g.height + step - 1) / step));
     for (int v = 0; v < g.height; v += step) {
         const size_t row = size_t(v) * size_t(g.width);
-        const float* drow = disp.disparity_px.data() + row;
-        // Compact the pixels with a usable disparity (NaN fails the test) with their table
-        // entries, so the arithmetic runs over contiguous arrays.
-        const float *luu = m_luu.data() + row, *luv = m_luv.data() + row, *lvv = m_lvv.data() + row,
-                    *ruu = m_ruu.data() + row;
-        const double* rotVar = m_rotVar.data() + row;
-        size_t n = 0;
-        for (int u = 0; u < g.width; u += step) {
-            const double d = drow[u];
-            if (!(d - k.offset_px > 0)) continue;
-            const int ur = k.rightColumn(u, d, g.width);
-            b.u[n] = u;
-            b.d[n] = d;
-            b.luu[n] = luu[u];
-            b.luv[n] = luv[u];
-            b.lvv[n] = lvv[u];
-            b.ruu[n] = ruu[ur];
-            b.rotVar[n] = rotVar[ur];
-            n++;
-        }
-        counts.pixels += perRow;
-        counts.noDisparity += perRow - n;
-        rowPoints(k, v - g.cy, n, b);
-        for (size_t i = 0; i < n; i++) {
-            if (b.p[2][i] < minDepth_m) {
-                counts.tooNear++;
-                continue;
-            }
-            if (b.r2[i] < minRange2 || b.r2[i] > maxRange2) {
-                counts.outOfRange++;
-                continue;
-            }
-            out.push_back({Eigen::Vector3f(float(b.p[0][i]), float(b.p[1][i]), float(b.p[2][i])),
-                           {b.c[0][i], b.c[1][i], b.c[2][i], b.c[3][i], b.c[4][i], b.c[5][i]}});
-        }
+        rowPoints(k, in, v - g.cy, perRow, disp.disparity_px.data() + row, m_luu.data() + row,
+                  m_luv.data() + row, m_lvv.data() + row, m_rightVar.data() + row, b);
+        packRow(perRow, b, out, counts);
     }
-    counts.kept = counts.pixels - counts.noDisparity - counts.tooNear - counts.outOfRange;
     return counts;
 }
 

@@ -99,10 +99,9 @@ private:
     CalibrationVector m_var;
     double m_matchingVar_px2 = 0;
     // Per pixel, row-major: left var u, cov uv, var v [px^2]; right var u [px^2] from the
-    // intrinsics; right var u [px^2] from the extrinsic rotation (double: summed from the
-    // float-rounded rotation Jacobian, as before the table was split into arrays).
-    std::vector<float> m_luu, m_luv, m_lvv, m_ruu;
-    std::vector<double> m_rotVar;
+    // intrinsics and the extrinsic rotation.
+    std::vector<float> m_luu, m_luv, m_lvv;
+    std::vector<double> m_rightVar;
 };
 
 }  // namespace multibin::sensors
