@@ -253,12 +253,20 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
     const FillOptions krigBest = with([](FillOptions& o) { o.modelAveraging = false; });
     const FillOptions krigFlat = with([](FillOptions& o) { o.maxTerms = 0; });
     const FillOptions krigBic = with([](FillOptions& o) { o.criterion = ModelCriterion::BIC; });
-    const FillOptions harmonic =
-        with([](FillOptions& o) { o.residualModel = ResidualModel::Harmonic; });
-    const FillOptions pure = with([](FillOptions& o) { o.residualCorrection = false; });
+    const FillOptions anywhere = with([](FillOptions& o) { o.termsOutsideGap = false; });
+    // The previous method (terms anywhere, harmonic rim residuals), as measured before kriging.
+    const FillOptions harmonic = with([](FillOptions& o) {
+        o.residualModel = ResidualModel::Harmonic;
+        o.termsOutsideGap = false;
+    });
+    const FillOptions pure = with([](FillOptions& o) {
+        o.residualCorrection = false;
+        o.termsOutsideGap = false;
+    });
     const FillOptions holdout = with([](FillOptions& o) {
         o.residualModel = ResidualModel::Harmonic;
         o.criterion = ModelCriterion::Holdout;
+        o.termsOutsideGap = false;
     });
     const FillOptions flat = with([](FillOptions& o) {  // m = 0: harmonic interpolation
         o.residualModel = ResidualModel::Harmonic;
@@ -271,12 +279,18 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
         {"default: eq 16 trend + kriging, AIC on the kriging likelihood, Akaike-weighted m",
          fill(opt)},
         {"eq 16 trend + kriging, single m by AIC (fill_model_averaging = false)", fill(krigBest)},
+        {"eq 16 trend + kriging, AIC, averaged, term centres anywhere (fill_terms_outside_gap = "
+         "false)",
+         fill(anywhere)},
         {"eq 16 trend + kriging, m by BIC (fill_model_criterion = bic)", fill(krigBic)},
         {"eq 16 with m = 0 + kriging (ordinary kriging; fill_max_terms = 0)", fill(krigFlat)},
-        {"eq 16 + harmonic rim residuals, m by AIC (fill_residual_model = harmonic)",
+        {"eq 16 + harmonic rim residuals, m by AIC (previous default: fill_residual_model = "
+         "harmonic, fill_terms_outside_gap = false)",
          fill(harmonic)},
-        {"eq 16 alone, m by AIC (paper; fill_residual_correction = false)", fill(pure)},
-        {"eq 16 + harmonic rim residuals, m by held-out rim (fill_model_criterion = holdout)",
+        {"eq 16 alone, m by AIC (paper; fill_residual_correction = false, terms anywhere)",
+         fill(pure)},
+        {"eq 16 + harmonic rim residuals, m by held-out rim (fill_model_criterion = holdout, "
+         "terms anywhere)",
          fill(holdout)},
         {"eq 16 with m = 0 + harmonic rim residuals (harmonic interpolation)", fill(flat)},
         {"weighted median, repeated rim-inwards",

@@ -46,6 +46,8 @@ void FillOptions::read(StrictConfigSection& s) {
     s.readChoice<CovarianceFamily>(
         "fill_kriging_covariance", krigingCovariance,
         {{"exponential", CovarianceFamily::Exponential}, {"matern32", CovarianceFamily::Matern32}});
+    s.read("fill_terms_outside_gap", termsOutsideGap);
+    s.read("fill_kriging_max_points", krigingMaxPoints);
     s.read("fill_model_averaging", modelAveraging);
     s.read("fill_extrapolation_margin", extrapolationMargin);
     s.readChoice<ModelCriterion>("fill_model_criterion", criterion,
@@ -88,6 +90,8 @@ void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
     c.write(
         section, "fill_kriging_covariance",
         std::string(krigingCovariance == CovarianceFamily::Matern32 ? "matern32" : "exponential"));
+    c.write(section, "fill_terms_outside_gap", termsOutsideGap);
+    c.write(section, "fill_kriging_max_points", krigingMaxPoints);
     c.write(section, "fill_model_averaging", modelAveraging);
     c.write(section, "fill_extrapolation_margin", extrapolationMargin);
     c.write(section, "fill_model_criterion", std::string(criterionName(criterion)));
@@ -114,6 +118,8 @@ void FillOptions::validate() const {
     if (supportMargin_cells < 1 || supportMargin_cells > 100)
         bad("fill_support_margin", "must be from 1 to 100 [cells]");
     if (maxTrainingPoints < 10) bad("fill_max_training_points", "must be >= 10");
+    if (krigingMaxPoints < 20 || krigingMaxPoints > 5000)
+        bad("fill_kriging_max_points", "must be from 20 to 5000");
     if (maxTerms < 0 || maxTerms > 20) bad("fill_max_terms", "must be from 0 to 20");
     if (!(extrapolationMargin >= 0) || !std::isfinite(extrapolationMargin))
         bad("fill_extrapolation_margin", "must be >= 0");

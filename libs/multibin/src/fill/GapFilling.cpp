@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 
@@ -330,10 +332,11 @@ std::vector<double> harmonicResiduals(const HeightRaster& r, const GaussianSurfa
  * residuals; m grows while the criterion (AICc or BIC) on the kriging likelihood improves. The
  * gap gets the kriged heights of the best m, or their Akaike-weighted mean (modelAveraging),
  * and sigma from the kriging variance (plus, when averaging, the models' spread). */
-void fillByKriging(const HeightRaster& r, const FillOptions& o, const std::vector<int>& cells,
-                   const std::vector<SurfaceSample>& samples, int side, int sx, int sy,
+void fillByKriging(const HeightRaster& r, const FillOptions& o,
+                   const GaussianFitOptions& fitOptions, const std::vector<int>& cells,
+                   const std::vector<SurfaceSample>& samples,
+                   const std::vector<SurfaceSample>& near, int side, int sx, int sy,
                    FillResult& out) {
-    const GaussianFitOptions fitOptions = o.gaussianFitOptions();
     const int n = int(samples.size());
     const double prior = amplitudePriorPrecision(samples);
     double sensorVar = 0, hLo = samples[0].h_m, hHi = hLo, meanSigma = 0;
@@ -351,6 +354,7 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o, const std::vecto
     struct Model {
         double criterion;
         int m;
+        std::unique_ptr<UniversalKriging> kriging;
         std::vector<double> mean_m, var_m2;
     };
     std::vector<Model> models;
@@ -366,17 +370,17 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o, const std::vecto
     };
     auto criterion = [&](const UniversalKriging& uk, const GaussianSurface& g) {
         const int k = g.parameters() + 3;  // eq 16's, plus sill, range and nugget
+        const int nk = int(near.size());   // the likelihood is that of the neighbourhood
         const double penalty = o.criterion == ModelCriterion::BIC
-                                   ? k * std::log(double(n))
-                                   : (n > k + 1 ? 2.0 * k + 2.0 * k * (k + 1.0) / (n - k - 1.0)
-                                                : std::numeric_limits<double>::infinity());
+                                   ? k * std::log(double(nk))
+                                   : (nk > k + 1 ? 2.0 * k + 2.0 * k * (k + 1.0) / (nk - k - 1.0)
+                                                 : std::numeric_limits<double>::infinity());
         return uk.minusTwoLogLikelihood() + penalty;
     };
     auto evaluate = [&](const GaussianSurface& g, const Covariance& cov) {
-        const UniversalKriging uk(samples, g, cov, prior);
-        Model md{criterion(uk, g), int(g.terms.size()), {}, {}};
-        uk.predict(ci, cj, md.mean_m, md.var_m2);
-        models.push_back(std::move(md));
+        auto uk = std::make_unique<UniversalKriging>(near, g, cov, prior);
+        const double c = criterion(*uk, g);
+        models.push_back(Model{c, int(g.terms.size()), std::move(uk), {}, {}});
     };
     GaussianSurface prev = fitGaussianSurfaceFixed(samples, side, 0, fitOptions);
     size_t best = 0;
@@ -396,20 +400,27 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o, const std::vecto
     }
     std::vector<double> w(models.size(), 0.0);
     if (o.modelAveraging) {
+        // Akaike weights; a model more than 20 below the best (weight < 5e-5) is not predicted.
         double sw = 0;
-        for (size_t q = 0; q < models.size(); q++)
-            sw += w[q] = std::exp(-0.5 * (models[q].criterion - models[best].criterion));
+        for (size_t q = 0; q < models.size(); q++) {
+            const double d = models[q].criterion - models[best].criterion;
+            sw += w[q] = d < 20 ? std::exp(-0.5 * d) : 0.0;
+        }
         for (auto& v : w) v /= sw;
     } else {
         w[best] = 1;
     }
+    for (size_t q = 0; q < models.size(); q++)
+        if (w[q] > 0) models[q].kriging->predict(ci, cj, models[q].mean_m, models[q].var_m2);
     out.stats.supportAreas++;
     out.stats.termsChosen.push_back(models[best].m);
     const double slack = o.extrapolationMargin * (hHi - hLo);
     for (size_t c = 0; c < cells.size(); c++) {
         double mean = 0, var = 0;
-        for (size_t q = 0; q < models.size(); q++) mean += w[q] * models[q].mean_m[c];
+        for (size_t q = 0; q < models.size(); q++)
+            if (w[q] > 0) mean += w[q] * models[q].mean_m[c];
         for (size_t q = 0; q < models.size(); q++) {
+            if (!(w[q] > 0)) continue;
             const double d = models[q].mean_m[c] - mean;
             var += w[q] * (models[q].var_m2[c] + d * d);
         }
@@ -489,12 +500,26 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
     samples.reserve(cand.size());
     for (const auto& c : cand) samples.push_back(c.s);
 
+    GaussianFitOptions fitOptions = o.gaussianFitOptions();
+    if (o.termsOutsideGap) {
+        // Centres on the rim cells or beyond: the gap's bounding box widened by half a cell.
+        fitOptions.excludeI0 = x0 - sx - 0.5, fitOptions.excludeI1 = x1 - sx + 0.5;
+        fitOptions.excludeJ0 = y0 - sy - 0.5, fitOptions.excludeJ1 = y1 - sy + 0.5;
+    }
     if (o.residualCorrection && o.residualModel == ResidualModel::Kriging &&
         o.criterion != ModelCriterion::Holdout) {
-        fillByKriging(r, o, cells, samples, side, sx, sy, out);
+        // The kriging neighbourhood: the training points nearest the gap (its cost is cubic).
+        std::vector<SurfaceSample> near;
+        if (int(cand.size()) > o.krigingMaxPoints) {
+            std::stable_sort(cand.begin(), cand.end(),
+                             [](const Cand& a, const Cand& b) { return a.gapDist < b.gapDist; });
+            for (int k = 0; k < o.krigingMaxPoints; k++) near.push_back(cand[size_t(k)].s);
+        } else {
+            near = samples;
+        }
+        fillByKriging(r, o, fitOptions, cells, samples, near, side, sx, sy, out);
         return true;
     }
-    const GaussianFitOptions fitOptions = o.gaussianFitOptions();
     GaussianSurface g;
     if (o.criterion == ModelCriterion::Holdout) {
         // Hide the two rings of measured cells nearest the gap, fit on the rest, fill the

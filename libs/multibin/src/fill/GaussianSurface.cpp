@@ -61,6 +61,20 @@ struct Fitter {
     Eigen::VectorXd rhs;
     Eigen::LDLT<Eigen::MatrixXd, Eigen::Lower> ldlt;
 
+    // Excluded box for the centres in normalised coordinates (lo > hi: none).
+    double exI0 = 1, exI1 = 0, exJ0 = 1, exJ1 = 0;
+
+    /** Moves a centre (u, v) out of the excluded box, to its nearest side. */
+    void project(double& u, double& v) const {
+        if (!(exI0 < exI1) || u <= exI0 || u >= exI1 || v <= exJ0 || v >= exJ1) return;
+        const double d[4] = {u - exI0, exI1 - u, v - exJ0, exJ1 - v};
+        const int k = int(std::min_element(d, d + 4) - d);
+        if (k == 0) u = exI0;
+        if (k == 1) u = exI1;
+        if (k == 2) v = exJ0;
+        if (k == 3) v = exJ1;
+    }
+
     Fitter(const std::vector<SurfaceSample>& s, int sideCells)
         : samples(s),
           side(sideCells),
@@ -87,10 +101,12 @@ struct Fitter {
             const double* p = shape + kShapeParams * q;
             const double s1 = std::exp(p[2]), s2 = std::exp(p[3]);
             const double k1 = -0.5 / (s1 * s1), k2 = -0.5 / (s2 * s2);
+            double a1 = p[0], a2 = p[1];
+            project(a1, a2);
             for (int i = 0; i < side; i++) {
                 const double u = (i - centre) / halfSide;
-                rowTab(i, q) = std::exp(k1 * (u - p[0]) * (u - p[0]));
-                colTab(i, q) = std::exp(k2 * (u - p[1]) * (u - p[1]));
+                rowTab(i, q) = std::exp(k1 * (u - a1) * (u - a1));
+                colTab(i, q) = std::exp(k2 * (u - a2) * (u - a2));
             }
         }
         A.resize(n, m + 1);
@@ -174,8 +190,10 @@ struct Fitter {
         for (int q = 0; q < m; q++) {
             const double* p = shape + kShapeParams * q;
             const double s1 = std::exp(p[2]) * halfSide, s2 = std::exp(p[3]) * halfSide;
-            g.terms.push_back(GaussianTerm{c[q + 1], -0.5 / (s1 * s1), centre + p[0] * halfSide,
-                                           -0.5 / (s2 * s2), centre + p[1] * halfSide});
+            double a1 = p[0], a2 = p[1];
+            project(a1, a2);
+            g.terms.push_back(GaussianTerm{c[q + 1], -0.5 / (s1 * s1), centre + a1 * halfSide,
+                                           -0.5 / (s2 * s2), centre + a2 * halfSide});
         }
         g.samples = int(samples.size());
         g.chi2 = chi2;
@@ -214,6 +232,12 @@ GaussianSurface fitGaussianSurfaceFixed(const std::vector<SurfaceSample>& sample
                                         const GaussianSurface* seed) {
     checkInputs(samples, side, m);
     Fitter f(samples, side);
+    if (options.excludeI0 < options.excludeI1 && options.excludeJ0 < options.excludeJ1) {
+        f.exI0 = (options.excludeI0 - f.centre) / f.halfSide;
+        f.exI1 = (options.excludeI1 - f.centre) / f.halfSide;
+        f.exJ0 = (options.excludeJ0 - f.centre) / f.halfSide;
+        f.exJ1 = (options.excludeJ1 - f.centre) / f.halfSide;
+    }
     if (m == 0) return f.build(nullptr, 0);
 
     const double lnMin = std::log(std::max(options.minWidth_cells, 0.3) / f.halfSide);

@@ -161,12 +161,24 @@ void UniversalKriging::predict(const std::vector<double>& ci, const std::vector<
                                std::vector<double>& mean, std::vector<double>& var) const {
     const int n = int(m_samples.size()), p = int(m_W.cols()), t = int(ci.size());
     Eigen::MatrixXd k(n, t);
-    for (int c = 0; c < t; c++)
+    std::vector<double> rho;  // by squared distance, for targets on the cell grid
+    for (int c = 0; c < t; c++) {
+        const bool onGrid = ci[size_t(c)] == std::floor(ci[size_t(c)]) &&
+                            cj[size_t(c)] == std::floor(cj[size_t(c)]);
         for (int s = 0; s < n; s++) {
             const double di = ci[size_t(c)] - m_samples[size_t(s)].i;
             const double dj = cj[size_t(c)] - m_samples[size_t(s)].j;
-            k(s, c) = m_cov.sill_m2 * m_cov.correlation(std::sqrt(di * di + dj * dj));
+            const double d2 = di * di + dj * dj;
+            if (onGrid && d2 < 1e6) {
+                const size_t key = size_t(d2);
+                while (rho.size() <= key)
+                    rho.push_back(m_cov.correlation(std::sqrt(double(rho.size()))));
+                k(s, c) = m_cov.sill_m2 * rho[key];
+            } else {
+                k(s, c) = m_cov.sill_m2 * m_cov.correlation(std::sqrt(d2));
+            }
         }
+    }
     const Eigen::VectorXd kAlpha = k.transpose() * m_alpha;
     m_llt.matrixL().solveInPlace(k);                 // k <- L^-1 k
     const Eigen::MatrixXd Wk = m_W.transpose() * k;  // A^T K^-1 k, p x t

@@ -70,6 +70,13 @@ struct FillOptions {
     ResidualModel residualModel = ResidualModel::Kriging;
     /** [fill_kriging_covariance] exponential|matern32: correlation family of the kriging. */
     CovarianceFamily krigingCovariance = CovarianceFamily::Matern32;
+    /** [fill_terms_outside_gap] the centres of the Gaussian terms stay out of the gap's bounding
+     * box (on its rim cells or beyond): a term then peaks where data constrain it instead of
+     * bulging into the gap. */
+    bool termsOutsideGap = true;
+    /** [fill_kriging_max_points] the kriging (and its likelihood) uses at most this many
+     * training points, the nearest to the gap: its cost grows as the cube [-]. */
+    int krigingMaxPoints = 200;
     /** [fill_model_averaging] kriging only: average the fills of the m visited by the search
      * with Akaike weights exp(-dAIC/2) (and add their spread to the variance) instead of
      * keeping the single best m. */
@@ -91,7 +98,7 @@ struct FillOptions {
     FillSigmaModel sigmaModel =
         FillSigmaModel::Calibrated;   //!< [fill_sigma_model] calibrated|paper
     double medianSigmaGain = 0.77;    //!< [fill_median_sigma_gain] calibrated gain [-]
-    double gaussianSigmaGain = 1.43;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
+    double gaussianSigmaGain = 1.31;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
     double sigmaFloor_m = 0.002;      //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
 
     /** The Gaussian-fit settings these options imply. */

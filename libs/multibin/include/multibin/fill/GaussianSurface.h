@@ -62,6 +62,10 @@ struct GaussianFitOptions {
     /** Widest Gaussian, as a multiple of the support-area side [-] (wide terms act as slopes). */
     double maxWidthFactor = 2.0;
     ParticleSwarmOptions swarm;  //!< PSO settings for each m
+    /** Centres of the terms are kept out of this box [cells] (i0, i1, j0, j1 in support-area
+     * cells; a centre inside is moved to the nearest side): a term must peak where data are,
+     * not inside a gap where nothing constrains its height. Empty (i0 > i1): no restriction. */
+    double excludeI0 = 1, excludeI1 = 0, excludeJ0 = 1, excludeJ1 = 0;
     /** Levenberg-Marquardt iterations that refine the swarm's best centres and widths (0: the
      * swarm's answer as is) [-]. */
     int polishIterations = 20;
