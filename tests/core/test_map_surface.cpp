@@ -61,3 +61,20 @@ TEST(CellSurface, ReliefOfASlopeAddsItsHeightSpreadToSigma) {
     ASSERT_TRUE(map.getHeight(0.05, 0.05, h, s));
     EXPECT_NEAR(s, sigma, 1e-6);
 }
+
+TEST(CellSurface, OtherSurfacesInTheCellAddTheirCertaintyWeightedSpreadToSigma) {
+    // One isolated cell (no neighbours: no slope term) holding a step: three points on its top at
+    // 0.11 m and two on its foot at 0.01 m, 3 mm each. The top wins; the cell's truth, the mean
+    // over its area, lies between the two, so sigma^2 gains (c_foot / (c_top + c_foot)) * 0.1^2.
+    CMultiBinElevationMap map = fixedMap(0.1);
+    for (int i = 0; i < 3; i++) insert(map, 0.55, 0.55, 0.11, 0.003);
+    for (int i = 0; i < 2; i++) insert(map, 0.55, 0.55, 0.01, 0.003);
+    double h, s;
+    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    EXPECT_NEAR(h, 0.11, 1e-6);
+    const double kalman2 = 0.003 * 0.003 / 3;  // the winning bin: 3 points of 3 mm
+    EXPECT_NEAR(s * s, kalman2 + 2.0 / 5.0 * 0.1 * 0.1, 1e-9);
+    map.insertionOptions.relief_sigma = false;  // the paper's sigma: the winning bin's alone
+    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    EXPECT_NEAR(s * s, kalman2, 1e-9);
+}

@@ -318,6 +318,7 @@ namespace {
  * hypotheses. */
 struct CellSurface {
     double height_m = 0, variance_m2 = 0, certainty = 0;
+    int firstBin = 0, lastBin = 0;  //!< the bin indices merged into the surface
 };
 bool cellSurface(const multibin::BinGrid& grid, double x_m, double y_m,
                  const multibin::BinUpdateParams& p, CellSurface& out) {
@@ -328,6 +329,7 @@ bool cellSurface(const multibin::BinGrid& grid, double x_m, double y_m,
     double info = 1.0 / std::max<double>(win->variance_m2, floor_m2);
     double weighted_m = info * win->height_m;
     out.certainty = win->certainty;
+    out.firstBin = out.lastBin = win->index;
     for (const int dir : {-1, 1}) {
         for (int n = win->index + dir;; n += dir) {
             const multibin::Bin* next = nullptr;
@@ -341,6 +343,7 @@ bool cellSurface(const multibin::BinGrid& grid, double x_m, double y_m,
             info += 1.0 / v;
             weighted_m += next->height_m / v;
             out.certainty += next->certainty;
+            (dir < 0 ? out.firstBin : out.lastBin) = n;
         }
     }
     out.height_m = weighted_m / info;
@@ -371,6 +374,17 @@ void addReliefVariance(const multibin::BinGrid& grid, double x_m, double y_m,
         slope2 += g * g;
     }
     cell.variance_m2 += slope2 * s * s / 12.0;
+    // Certain bins outside the surface: the cell also holds surfaces at other heights (a step
+    // inside the cell, its top and its foot seen from different places). The truth of the cell,
+    // the mean over its area, lies between them: their spread around the reported height,
+    // weighted by each bin's share of the cell's certainty, is part of the cell's uncertainty.
+    double otherCertainty = 0, otherSpread_m2 = 0;
+    grid.forEachBin(grid.cellIndex(x_m), grid.cellIndex(y_m), [&](const multibin::Bin& b) {
+        if (b.certainty <= 0 || (b.index >= cell.firstBin && b.index <= cell.lastBin)) return;
+        otherCertainty += b.certainty;
+        otherSpread_m2 += b.certainty * (b.height_m - cell.height_m) * (b.height_m - cell.height_m);
+    });
+    if (otherCertainty > 0) cell.variance_m2 += otherSpread_m2 / (otherCertainty + cell.certainty);
 }
 }  // namespace
 

@@ -122,9 +122,11 @@ public:
          * (key `dem_return_filled`). MRPT documents dem_get_z as false for unobserved cells; set
          * false for that behaviour. */
         bool dem_return_filled = true;
-        /** The reported sigma of a cell includes its relief, (g s)^2 / 12 with g the local slope
-         * from the neighbours and s the cell size (key `relief_sigma`): the cell's one height
-         * stands for a sloped patch. Off: the bins' Kalman sigma alone (the paper's). */
+        /** The reported sigma of a cell includes its relief (key `relief_sigma`): (g s)^2 / 12
+         * with g the local slope from the neighbours and s the cell size (the cell's one height
+         * stands for a sloped patch), plus the certainty-weighted spread of the cell's other
+         * certain bins around the reported height (a cell holding a step holds surfaces at
+         * several heights). Off: the bins' Kalman sigma alone (the paper's). */
         bool relief_sigma = true;
 
         void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
