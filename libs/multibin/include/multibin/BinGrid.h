@@ -201,9 +201,10 @@ public:
     static constexpr int kBlockCells = 1 << kBlockShift;
     /** Block index of a cell index (floor division by kBlockCells). */
     static int blockOf(int cellIndex) { return cellIndex >> kBlockShift; }  // arithmetic shift
-    /** An upper bound on the height of every bin stored in a cell of block (bx, by) [m]: the
-     * highest height fused into it since it entered the window, rounded up to float; -infinity
-     * if none (or the block lies outside the window). */
+    /** An upper bound on the height of every bin stored in a cell of block (bx, by) [m], to
+     * within 1e-6 (1 + |bound|): the highest height fused into it since it entered the window,
+     * rounded to float (bins hold float heights, weighted means of what was fused); -infinity if
+     * none (or the block lies outside the window). */
     float blockMaxHeight_m(int bx, int by) const {
         int sx = bx - m_blockX0, sy = by - m_blockY0;
         if (sx < 0 || sy < 0 || sx >= m_blockNx || sy >= m_blockNy)
@@ -308,6 +309,9 @@ private:
     int m_blockX0 = 0, m_blockY0 = 0;  //!< block of the window's first cell
     int m_blockNx = 0, m_blockNy = 0;  //!< table size: ceil(nx / kBlockCells) + 1, likewise y
     int m_blockOriginX = 0, m_blockOriginY = 0;  //!< m_blockX0 mod m_blockNx, likewise y
+    /** The block raised last and its slot (tagged with it); forgotten when the table changes. */
+    int m_lastBlockX = std::numeric_limits<int>::min(), m_lastBlockY = 0;
+    size_t m_lastBlockSlot = 0;
     uint32_t m_freeHead = kNoBin;
     size_t m_freeCount = 0;
 };
@@ -315,16 +319,23 @@ private:
 // Inline: called per run of points; out of line they would go through the PLT.
 inline void BinGrid::raiseBlock(int ix, int iy, double height_m) {
     const int bx = blockOf(ix), by = blockOf(iy);
+    const float h = static_cast<float>(height_m);    // rounded to nearest: see blockMaxHeight_m
+    if (bx == m_lastBlockX && by == m_lastBlockY) {  // consecutive runs mostly share a block
+        BlockSlot& b = m_blocks[m_lastBlockSlot];
+        if (h > b.maxHeight_m) b.maxHeight_m = h;
+        return;
+    }
     int sx = bx - m_blockX0 + m_blockOriginX, sy = by - m_blockY0 + m_blockOriginY;
     if (sx >= m_blockNx) sx -= m_blockNx;
     if (sy >= m_blockNy) sy -= m_blockNy;
-    BlockSlot& b = m_blocks[size_t(sx) + size_t(sy) * size_t(m_blockNx)];
-    float h = static_cast<float>(height_m);
-    if (double(h) < height_m) h = std::nextafter(h, std::numeric_limits<float>::infinity());
-    if (b.bx != bx || b.by != by) {
+    m_lastBlockSlot = size_t(sx) + size_t(sy) * size_t(m_blockNx);
+    m_lastBlockX = bx;
+    m_lastBlockY = by;
+    BlockSlot& b = m_blocks[m_lastBlockSlot];
+    if (b.bx == bx && b.by == by) {
+        if (h > b.maxHeight_m) b.maxHeight_m = h;
+    } else {
         b = {bx, by, h};  // the slot's previous block has left the window
-    } else if (h > b.maxHeight_m) {
-        b.maxHeight_m = h;
     }
 }
 

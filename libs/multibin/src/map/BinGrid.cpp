@@ -85,10 +85,12 @@ void BinGrid::setWindow(const CellWindow& w) {
     m_blockNy = w.ny > 0 ? (w.ny + kBlockCells - 1) / kBlockCells + 1 : 0;
     m_blockOriginX = residue(m_blockX0, m_blockNx);
     m_blockOriginY = residue(m_blockY0, m_blockNy);
+    m_lastBlockX = std::numeric_limits<int>::min();
 }
 
 void BinGrid::rebuildBlocks() {
     m_blocks.assign(size_t(m_blockNx) * size_t(m_blockNy), BlockSlot{});
+    m_lastBlockX = std::numeric_limits<int>::min();
     const CellWindow& w = m_window;
     for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
         for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
