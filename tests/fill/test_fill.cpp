@@ -566,6 +566,11 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
     a.swarmSeed = 42;
     a.residualCorrection = false;
     a.criterion = ModelCriterion::Holdout;
+    a.residualModel = ResidualModel::Harmonic;
+    a.krigingCovariance = CovarianceFamily::Exponential;
+    a.termsOutsideGap = false;
+    a.krigingMaxPoints = 321;
+    a.modelAveraging = false;
     mrpt::config::CConfigFileMemory ini;
     a.saveToConfigFile(ini, "insertOpts");
     FillOptions b;
@@ -578,6 +583,11 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
     EXPECT_EQ(b.swarmSeed, 42u);
     EXPECT_FALSE(b.residualCorrection);
     EXPECT_EQ(b.criterion, ModelCriterion::Holdout);
+    EXPECT_EQ(b.residualModel, ResidualModel::Harmonic);
+    EXPECT_EQ(b.krigingCovariance, CovarianceFamily::Exponential);
+    EXPECT_FALSE(b.termsOutsideGap);
+    EXPECT_EQ(b.krigingMaxPoints, 321);
+    EXPECT_FALSE(b.modelAveraging);
 
     // Keys shared with the map's own section: the caller's strict reader owns finish().
     mrpt::config::CConfigFileMemory shared;
@@ -605,5 +615,8 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
     expectError("fill_sigma_model", "bayes");
     expectError("fill_model_criterion", "cv");
     expectError("fill_max_gap_cells", "0");
+    expectError("fill_residual_model", "spline");
+    expectError("fill_kriging_covariance", "gaussian");
+    expectError("fill_kriging_max_points", "5");
     expectError("fill_medain_window", "5");  // typo: unknown key
 }

@@ -390,7 +390,8 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o,
         evaluate(g, covarianceOf(g));
         // Forward selection as in the paper's search: stop at the first m that does not improve
         // the criterion. Each m is a whole model, trend plus its own covariance. Measured on the
-        // seed-1 / seed-2 placements (doc/gap-filling.md): searching every m up to maxTerms gave
+        // seed-1 / seed-2 placements (doc/gap-filling.md; kriging on all training points, centres
+        // anywhere): searching every m up to maxTerms gave
         // 17.8 / 18.3 mm instead of 16.5 / 17.1 mm (and twice the time); judging m against m - 1
         // under the covariance of m's residuals (a nested test) counts known Gaussians better but
         // gave 17.4 / 18.5 mm.
