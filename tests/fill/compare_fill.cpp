@@ -272,6 +272,14 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
         o.residualModel = ResidualModel::Harmonic;
         o.maxTerms = 0;
     });
+    const FillOptions biharmonic = with([](FillOptions& o) {
+        o.residualModel = ResidualModel::Biharmonic;
+        o.termsOutsideGap = false;
+    });
+    const FillOptions biFlat = with([](FillOptions& o) {  // m = 0: biharmonic interpolation
+        o.residualModel = ResidualModel::Biharmonic;
+        o.maxTerms = 0;
+    });
     auto fill = [](const FillOptions& o) {
         return [o](const HeightRaster& r) { return heights(fillGaps(r, o)); };
     };
@@ -293,6 +301,10 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
          "terms anywhere)",
          fill(holdout)},
         {"eq 16 with m = 0 + harmonic rim residuals (harmonic interpolation)", fill(flat)},
+        {"eq 16 + biharmonic rim residuals, m by AIC (fill_residual_model = biharmonic, terms "
+         "anywhere)",
+         fill(biharmonic)},
+        {"eq 16 with m = 0 + biharmonic rim residuals (thin-plate interpolation)", fill(biFlat)},
         {"weighted median, repeated rim-inwards",
          [&](const HeightRaster& r) { return heights(weightedMedianFill(r, opt, true)); }},
         {"cv::inpaint TELEA, float, radius 3",

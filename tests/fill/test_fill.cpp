@@ -470,6 +470,31 @@ TEST(FillGaps, KrigingAicTakesAHiddenHillTerm) {
     EXPECT_LT(worstError(d), 0.010);
 }
 
+TEST(FillGaps, BiharmonicResidualsReproduceAQuadraticAndHarmonicOnesDoNot) {
+    // z = 0.02 + 0.0004 (x - 15)^2 + 0.0002 (x - 15)(y - 15) [m]: its squared discrete Laplacian
+    // is zero (the 13-point stencil is exact on quadratics) but its Laplacian is not, so with
+    // m = 0 (a constant trend) the biharmonic fill reproduces it and the harmonic one sags.
+    auto bowl = [](int ix, int iy) {
+        return 0.02 + 0.0004 * (ix - 15.0) * (ix - 15.0) + 0.0002 * (ix - 15.0) * (iy - 15.0);
+    };
+    auto r = rasterFrom(30, bowl, 0.001f);
+    hide(r, 10, 10, 10, 10);
+    FillOptions o;
+    o.maxTerms = 0;
+    o.residualModel = ResidualModel::Biharmonic;
+    auto worst = [&](const FillResult& f) {
+        double w = 0;
+        for (int iy = 10; iy < 20; iy++)
+            for (int ix = 10; ix < 20; ix++)
+                w = std::max(w, std::abs(f.height_m[f.index(ix, iy)] - bowl(ix, iy)));
+        return w;
+    };
+    EXPECT_LT(worst(fillGaps(r, o)), 1e-6);
+    o.residualModel = ResidualModel::Harmonic;
+    // Harmonic: the Laplacian 0.0008 m per cell^2 is lost over a 10-cell gap, ~4 mm at the centre.
+    EXPECT_GT(worst(fillGaps(r, o)), 0.002);
+}
+
 TEST(FillGaps, SigmaGrowsTowardsTheMiddleOfAGap) {
     // A rolling surface (wavelengths 12-20 cells): heights drift apart with distance, so the
     // semivariogram grows and so does the sigma of cells farther from the rim.

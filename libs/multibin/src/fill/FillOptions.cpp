@@ -40,9 +40,10 @@ void FillOptions::read(StrictConfigSection& s) {
     s.read("fill_support_margin", supportMargin_cells);
     s.read("fill_max_training_points", maxTrainingPoints);
     s.read("fill_residual_correction", residualCorrection);
-    s.readChoice<ResidualModel>(
-        "fill_residual_model", residualModel,
-        {{"kriging", ResidualModel::Kriging}, {"harmonic", ResidualModel::Harmonic}});
+    s.readChoice<ResidualModel>("fill_residual_model", residualModel,
+                                {{"kriging", ResidualModel::Kriging},
+                                 {"harmonic", ResidualModel::Harmonic},
+                                 {"biharmonic", ResidualModel::Biharmonic}});
     s.readChoice<CovarianceFamily>(
         "fill_kriging_covariance", krigingCovariance,
         {{"exponential", CovarianceFamily::Exponential}, {"matern32", CovarianceFamily::Matern32}});
@@ -86,7 +87,9 @@ void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
     c.write(section, "fill_max_training_points", maxTrainingPoints);
     c.write(section, "fill_residual_correction", residualCorrection);
     c.write(section, "fill_residual_model",
-            std::string(residualModel == ResidualModel::Harmonic ? "harmonic" : "kriging"));
+            std::string(residualModel == ResidualModel::Harmonic     ? "harmonic"
+                        : residualModel == ResidualModel::Biharmonic ? "biharmonic"
+                                                                     : "kriging"));
     c.write(
         section, "fill_kriging_covariance",
         std::string(krigingCovariance == CovarianceFamily::Matern32 ? "matern32" : "exponential"));

@@ -1,6 +1,9 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/fill/GapFilling.h"
 
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
 #include "multibin/fill/Kriging.h"
 
 #include <algorithm>
@@ -326,6 +329,72 @@ std::vector<double> harmonicResiduals(const HeightRaster& r, const GaussianSurfa
     return out;
 }
 
+/** The residual h - g of the measured cells around a gap, carried into the gap as a biharmonic
+ * function (thin-plate equation: the 13-point stencil of the squared Laplacian set to zero at
+ * every gap cell, the two rings of measured cells around it as boundary data), solved directly
+ * (sparse LU). A gap cell whose stencil reaches a cell that is neither measured nor in the gap
+ * (raster edge, another gap) takes the harmonic equation over its measured or gap neighbours.
+ * Returns one value per gap cell [m]. */
+std::vector<double> biharmonicResiduals(const HeightRaster& r, const GaussianSurface& g,
+                                        const std::vector<int>& cells, int sx, int sy) {
+    std::vector<int> unknown(r.size(), -1);
+    for (size_t c = 0; c < cells.size(); c++) unknown[size_t(cells[c])] = int(c);
+    auto known = [&](int ix, int iy) { return r.inside(ix, iy) && r.isMeasured(r.index(ix, iy)); };
+    auto residual = [&](int ix, int iy) {
+        return r.height_m[r.index(ix, iy)] - g(ix - sx, iy - sy);
+    };
+    struct Tap {
+        int di, dj;
+        double w;
+    };
+    static const Tap bi[] = {{0, 0, 20}, {1, 0, -8}, {-1, 0, -8}, {0, 1, -8},  {0, -1, -8},
+                             {1, 1, 2},  {1, -1, 2}, {-1, 1, 2},  {-1, -1, 2}, {2, 0, 1},
+                             {-2, 0, 1}, {0, 2, 1},  {0, -2, 1}};
+    static const Tap lap[] = {{0, 0, 4}, {1, 0, -1}, {-1, 0, -1}, {0, 1, -1}, {0, -1, -1}};
+    const int n = int(cells.size());
+    std::vector<Eigen::Triplet<double>> trip;
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+    for (int c = 0; c < n; c++) {
+        const int ix = cells[size_t(c)] % r.nx, iy = cells[size_t(c)] / r.nx;
+        bool full = true;
+        for (const auto& t : bi) {
+            const int x = ix + t.di, y = iy + t.dj;
+            if (!(r.inside(x, y) && (unknown[r.index(x, y)] >= 0 || known(x, y)))) full = false;
+        }
+        if (full) {
+            for (const auto& t : bi) {
+                const int x = ix + t.di, y = iy + t.dj;
+                const int u = unknown[r.index(x, y)];
+                if (u >= 0)
+                    trip.emplace_back(c, u, t.w);
+                else
+                    rhs[c] -= t.w * residual(x, y);
+            }
+        } else {
+            double diag = 0;
+            for (const auto& t : lap) {
+                if (!t.di && !t.dj) continue;
+                const int x = ix + t.di, y = iy + t.dj;
+                if (!r.inside(x, y)) continue;
+                const int u = unknown[r.index(x, y)];
+                if (u >= 0)
+                    trip.emplace_back(c, u, -1.0), diag += 1;
+                else if (known(x, y))
+                    rhs[c] += residual(x, y), diag += 1;
+            }
+            trip.emplace_back(c, c, std::max(diag, 1.0));
+        }
+    }
+    Eigen::SparseMatrix<double> A(n, n);
+    A.setFromTriplets(trip.begin(), trip.end());
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(A);
+    std::vector<double> out(size_t(n), 0.0);
+    if (lu.info() != Eigen::Success) return out;
+    const Eigen::VectorXd x = lu.solve(rhs);
+    for (int c = 0; c < n; c++) out[size_t(c)] = x[c];
+    return out;
+}
+
 /** The kriging path of fillWithGaussianSurface (ResidualModel::Kriging): eq 16 fitted for
  * m = 0, 1, ... as usual (seeded swarm, iid Mahalanobis fitness), each fit then taken as the
  * trend of a universal kriging whose residual covariance is fitted to the semivariogram of its
@@ -597,9 +666,10 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
         for (const auto& s : samples) meanSigma += s.sigma_m;
         meanSigma /= double(samples.size());
     }
-    const std::vector<double> resid = o.residualCorrection
-                                          ? harmonicResiduals(r, g, cells, sx, sy, ex, ey)
-                                          : std::vector<double>(cells.size(), 0.0);
+    const std::vector<double> resid = !o.residualCorrection ? std::vector<double>(cells.size(), 0.0)
+                                      : o.residualModel == ResidualModel::Biharmonic
+                                          ? biharmonicResiduals(r, g, cells, sx, sy)
+                                          : harmonicResiduals(r, g, cells, sx, sy, ex, ey);
     for (size_t c = 0; c < cells.size(); c++) {
         const int ix = cells[c] % r.nx, iy = cells[c] / r.nx;
         const double h = std::clamp(g(ix - sx, iy - sy) + resid[c], hLo - slack, hHi + slack);

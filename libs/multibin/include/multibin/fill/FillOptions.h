@@ -40,7 +40,10 @@ enum class ResidualModel {
     Kriging,
     /** Harmonic function (Laplace equation) with the rim residuals as Dirichlet data; m chosen
      * by AIC on independent residuals; sigma from the semivariogram of the heights. */
-    Harmonic
+    Harmonic,
+    /** As Harmonic, but a biharmonic (thin-plate) function with the two rings of measured cells
+     * around the gap as boundary data: continuous slopes across the rim. */
+    Biharmonic
 };
 
 /** Options of gap filling. Ini keys (all prefixed `fill_` so they can live in the map's
@@ -66,7 +69,7 @@ struct FillOptions {
     /** [fill_residual_correction] beyond the paper: add to the fitted surface the residuals of
      * the rim cells, carried into the gap as a harmonic function, so the fill meets the rim. */
     bool residualCorrection = true;
-    /** [fill_residual_model] kriging|harmonic: see ResidualModel. */
+    /** [fill_residual_model] kriging|harmonic|biharmonic: see ResidualModel. */
     ResidualModel residualModel = ResidualModel::Kriging;
     /** [fill_kriging_covariance] exponential|matern32: correlation family of the kriging. */
     CovarianceFamily krigingCovariance = CovarianceFamily::Matern32;
