@@ -203,19 +203,22 @@ size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
         const float* row = disp + size_t(v) * size_t(W);
         const float* above = row - W;
         int32_t run = -1, joinedRun = -1, joinedAbove = -1;
+        int runStart = 0;  // the current run's first column; its length is set when it ends
         for (int u = 0; u < W; u++) {
             const float dp = row[u];
             if (!std::isfinite(dp)) {
+                if (run >= 0) length[size_t(run)] = u - runStart;
                 runHere[size_t(u)] = run = -1;
                 continue;
             }
             if (run < 0 || !(std::abs(dp - row[u - 1]) <= step)) {
+                if (run >= 0) length[size_t(run)] = u - runStart;
                 run = int32_t(parent.size());
+                runStart = u;
                 parent.push_back(run);
                 length.push_back(0);
                 first.push_back(v * W + u);
             }
-            length[size_t(run)]++;
             runHere[size_t(u)] = run;
             const int32_t a = v > 0 ? runAbove[size_t(u)] : -1;
             if (a >= 0 && (a != joinedAbove || run != joinedRun) &&
@@ -227,6 +230,7 @@ size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
                 joinedRun = run;
             }
         }
+        if (run >= 0) length[size_t(run)] = W - runStart;
         std::swap(runAbove, runHere);
     }
     // Region sizes at the roots (a root precedes its runs).
