@@ -587,8 +587,13 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
         } else {
             near = samples;
         }
-        fillByKriging(r, o, fitOptions, cells, samples, near, side, sx, sy, out);
-        return true;
+        try {
+            fillByKriging(r, o, fitOptions, cells, samples, near, side, sx, sy, out);
+            return true;
+        } catch (const std::runtime_error&) {
+            // K not positive definite (not seen; K has every sample's sensor variance on its
+            // diagonal): fill this gap by the harmonic path below instead of failing the map.
+        }
     }
     GaussianSurface g;
     if (o.criterion == ModelCriterion::Holdout) {
