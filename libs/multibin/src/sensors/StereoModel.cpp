@@ -354,13 +354,10 @@ void packRow(size_t n, RowBuffers& b, PointsWithCov& out, StereoPixelCounts& cou
                 *c4 = b.c[4].data(), *c5 = b.c[5].data();
     const int32_t* status = b.status.data();
     PointWithCov* kept = b.kept.data();
-    size_t m = 0, noDisparity = 0, tooNear = 0, outOfRange = 0;  // in registers
+    size_t m = 0, byStatus[4] = {0, 0, 0, 0};
     for (size_t i = 0; i < n; i++) {
-        const int32_t s = status[i];
-        noDisparity += s == kNoDisparity;
-        tooNear += s == kTooNear;
-        outOfRange += s == kOutOfRange;
-        if (s != kKept) continue;
+        byStatus[status[i]]++;
+        if (status[i] != kKept) continue;
         PointWithCov& q = kept[m++];
         q.point_m = Eigen::Vector3f(px[i], py[i], pz[i]);
         q.cov_m2 = {c0[i], c1[i], c2[i], c3[i], c4[i], c5[i]};
@@ -368,9 +365,9 @@ void packRow(size_t n, RowBuffers& b, PointsWithCov& out, StereoPixelCounts& cou
     out.insert(out.end(), kept, kept + m);
     counts.pixels += n;
     counts.kept += m;
-    counts.noDisparity += noDisparity;
-    counts.tooNear += tooNear;
-    counts.outOfRange += outOfRange;
+    counts.noDisparity += byStatus[kNoDisparity];
+    counts.tooNear += byStatus[kTooNear];
+    counts.outOfRange += byStatus[kOutOfRange];
 }
 
 /** The smallest s >= 0 with sqrt(s) >= r_m: sqrt(s) < r_m exactly when s < this (sqrt is
