@@ -103,36 +103,15 @@ std::vector<int> labelGaps(const HeightRaster& r, std::vector<int>& sizes) {
 std::vector<double> semivariogram(const HeightRaster& r, int x0, int y0, int w, int h, int maxLag) {
     const int xa = std::max(x0, 0), ya = std::max(y0, 0);
     const int xb = std::min(x0 + w, r.nx), yb = std::min(y0 + h, r.ny);
-    maxLag = std::max(maxLag, 1);
-    std::vector<double> sum(size_t(maxLag) + 1, 0.0), cnt(size_t(maxLag) + 1, 0.0);
+    const int bw = std::max(xb - xa, 0), bh = std::max(yb - ya, 0);
+    std::vector<double> box(size_t(bw) * size_t(bh), std::numeric_limits<double>::quiet_NaN());
     for (int iy = ya; iy < yb; iy++)
         for (int ix = xa; ix < xb; ix++) {
             const size_t k = r.index(ix, iy);
-            if (!r.isMeasured(k)) continue;
-            const double z = r.height_m[k];
-            for (int lag = 1; lag <= maxLag; lag++) {
-                if (ix + lag < xb) {
-                    const size_t kk = k + size_t(lag);
-                    if (r.isMeasured(kk)) {
-                        const double d = r.height_m[kk] - z;
-                        sum[lag] += d * d;
-                        cnt[lag]++;
-                    }
-                }
-                if (iy + lag < yb) {
-                    const size_t kk = r.index(ix, iy + lag);
-                    if (r.isMeasured(kk)) {
-                        const double d = r.height_m[kk] - z;
-                        sum[lag] += d * d;
-                        cnt[lag]++;
-                    }
-                }
-            }
+            if (r.isMeasured(k))
+                box[size_t(iy - ya) * size_t(bw) + size_t(ix - xa)] = r.height_m[k];
         }
-    std::vector<double> gamma(size_t(maxLag) + 1, 0.0);
-    for (int lag = 1; lag <= maxLag; lag++)
-        gamma[lag] = cnt[lag] > 0 ? 0.5 * sum[lag] / cnt[lag] : gamma[lag - 1];
-    return gamma;
+    return gridSemivariogram(box, bw, bh, maxLag);
 }
 
 namespace {
