@@ -380,3 +380,32 @@ TEST(StereoModel, UnrectifiedPairIsRefused) {
     obs.rightCameraPose = mrpt::poses::CPose3DQuat(mrpt::poses::CPose3D(0.09, 0, 0, 0.01, 0, 0));
     EXPECT_THROW(StereoGeometry::fromObservation(obs), std::invalid_argument);
 }
+
+TEST(StereoModel, AppendPointsGivesPointCovarianceAndRefusesBadArguments) {
+    const StereoGeometry g = stocGeometry();
+    const StereoModelOptions o = uncertainOptions();
+    const StereoCovarianceTable table(g, o);
+    DisparityImage disp(g.width, g.height);
+    disp.at(400, 300) = 40.f;  // z = 1.1 m: kept
+    disp.at(80, 420) = 2.f;    // z = 22.5 m: beyond the 10 m range
+    disp.at(10, 10) = 400.f;   // z = 0.11 m: nearer than 0.2 m
+    PointsWithCov out;
+    const StereoPixelCounts c = table.appendPoints(disp, 1, 0.2, 0.5, 10.0, out);
+    EXPECT_EQ(c.pixels, size_t(g.width) * size_t(g.height));
+    EXPECT_EQ(c.kept, 1u);
+    EXPECT_EQ(c.tooNear, 1u);
+    EXPECT_EQ(c.outOfRange, 1u);
+    EXPECT_EQ(c.noDisparity, c.pixels - 3);
+    ASSERT_EQ(out.size(), 1u);
+    const Eigen::Vector3d p = g.triangulate(400, 300, 40.0);
+    EXPECT_EQ(out[0].point_m, p.cast<float>());  // exactly eqs 8-9
+    const Eigen::Matrix3d C = table.pointCovariance(400, 300, 40.0);
+    EXPECT_EQ(out[0].cov_m2.toMatrix(), SymmetricCov3::fromMatrix(C).toMatrix());
+    // Every other pixel with step 2: (400, 300) is visited, (80, 420) too, (10, 10) too.
+    out.clear();
+    EXPECT_EQ(table.appendPoints(disp, 2, 0.2, 0.5, 10.0, out).pixels, size_t(320 * 240));
+    EXPECT_EQ(out.size(), 1u);
+    EXPECT_THROW(table.appendPoints(disp, 0, 0.2, 0.5, 10.0, out), std::invalid_argument);
+    EXPECT_THROW(table.appendPoints(DisparityImage(g.width - 1, g.height), 1, 0.2, 0.5, 10.0, out),
+                 std::invalid_argument);
+}
