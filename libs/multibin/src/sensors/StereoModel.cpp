@@ -330,9 +330,9 @@ void rowPoints(const PointConstants& constants, const RowInputs& in, double dv, 
         // Branch-free (so the loop vectorises): the first failing test, in the order of the
         // tests (disparity, depth, range).
         const int tooNear = p[2] < r.minDepth_m;
-        const int unusable = !usable, outside = !inRange;
-        status[i] = unusable * kNoDisparity +
-                    (1 - unusable) * (tooNear * kTooNear + (1 - tooNear) * outside * kOutOfRange);
+        // Mutually exclusive 0/1 flags, combined with bit operations only.
+        const int ok = usable, near = ok & tooNear, out = ok & (tooNear ^ 1) & int(!inRange);
+        status[i] = (ok ^ 1) * kNoDisparity | near * kTooNear | out * kOutOfRange;
         px[i] = float(p[0]);
         py[i] = float(p[1]);
         pz[i] = float(p[2]);
