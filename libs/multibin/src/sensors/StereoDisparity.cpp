@@ -198,7 +198,9 @@ size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
     parent.reserve(size_t(H) * 16);
     length.reserve(size_t(H) * 16);
     first.reserve(size_t(H) * 16);
-    std::vector<int32_t> runAbove(size_t(W), -1), runHere(size_t(W), -1);
+    std::vector<int32_t> runs2(2 * size_t(W), -1);  // run of each column: row above, this row
+    int32_t* runAbove = runs2.data();  // raw pointers: not reloaded after each push_back
+    int32_t* runHere = runAbove + W;
     for (int v = 0; v < H; v++) {
         const float* row = disp + size_t(v) * size_t(W);
         const float* above = row - W;
@@ -208,7 +210,7 @@ size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
             const float dp = row[u];
             if (!std::isfinite(dp)) {
                 if (run >= 0) length[size_t(run)] = u - runStart;
-                runHere[size_t(u)] = run = -1;
+                runHere[u] = run = -1;
                 continue;
             }
             if (run < 0 || !(std::abs(dp - row[u - 1]) <= step)) {
@@ -219,8 +221,8 @@ size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
                 length.push_back(0);
                 first.push_back(v * W + u);
             }
-            runHere[size_t(u)] = run;
-            const int32_t a = v > 0 ? runAbove[size_t(u)] : -1;
+            runHere[u] = run;
+            const int32_t a = v > 0 ? runAbove[u] : -1;
             if (a >= 0 && (a != joinedAbove || run != joinedRun) &&
                 std::abs(dp - above[u]) <= step) {
                 const int32_t ra = findRoot(parent, a), rb = findRoot(parent, run);
