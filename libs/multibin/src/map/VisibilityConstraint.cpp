@@ -78,10 +78,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 std::min(stopHeight,
                          double(bound_m) + 1e-6 * (1.0 + std::abs(double(bound_m))) + vis.margin_m);
             if (!blockMayConflict(bound_m, lowest_m)) {
+                // As the walk counts them (length >= cell), the square root only near the edge.
+                const double cell2Lo = cell * cell * (1 - 1e-9), cell2Hi = cell * cell * (1 + 1e-9);
                 for (const BinGrid::UpdatedCell& u : updated) {
                     const double dx = sensor_m.x() - grid.cellCenter_m(u.ix);
                     const double dy = sensor_m.y() - grid.cellCenter_m(u.iy);
-                    stats.raysCast += !(std::sqrt(dx * dx + dy * dy) < cell);
+                    const double d2 = dx * dx + dy * dy;
+                    stats.raysCast += d2 > cell2Hi ? 1 : d2 < cell2Lo ? 0 : !(std::sqrt(d2) < cell);
                 }
                 return stats;
             }
