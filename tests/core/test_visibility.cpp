@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstring>
+#include <limits>
 #include <random>
 
 #include "multibin/VisibilityConstraint.h"
@@ -260,6 +261,7 @@ TEST(Visibility, LocalHeightBoundEditsTheSameBinsAsTheGlobalWalk) {
         if (kind < 0.2) sensor.y() = g.cellCenter_m(w.iy0 + int(unit(rng) * w.ny));
         if (kind > 0.2 && kind < 0.3) sensor.x() = g.cellCenter_m(w.ix0 + int(unit(rng) * w.nx));
         if (kind > 0.95) sensor.x() += 50.0;  // far outside the window
+        if (kind > 0.93 && kind < 0.95) sensor.z() = std::numeric_limits<double>::quiet_NaN();
         BinGrid reference = g;
         const VisibilityStats s = applyVisibilityConstraint(g, sensor, v, p);
         const VisibilityStats r = referenceVisibility(reference, sensor, v, p);

@@ -56,13 +56,15 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     if (!updated.empty()) {
         int ixLo = grid.cellIndex(sensor_m.x()), ixHi = ixLo;
         int iyLo = grid.cellIndex(sensor_m.y()), iyHi = iyLo;
-        double lowest_m = sensor_m.z();
+        // A NaN sensor height makes every ray comparison fail (no ray edits): leave it out.
+        double lowest_m =
+            std::isnan(sensor_m.z()) ? std::numeric_limits<double>::infinity() : sensor_m.z();
         for (const BinGrid::UpdatedCell& u : updated) {
             ixLo = std::min(ixLo, u.ix);
             ixHi = std::max(ixHi, u.ix);
             iyLo = std::min(iyLo, u.iy);
             iyHi = std::max(iyHi, u.iy);
-            lowest_m = std::min(lowest_m, double(u.maxHeight_m));  // a NaN sensor z drops out
+            lowest_m = std::min(lowest_m, double(u.maxHeight_m));
         }
         const int bxLo = BinGrid::blockOf(std::max(ixLo - 1, w.ix0));
         const int bxHi = BinGrid::blockOf(std::min(ixHi + 1, w.ix0 + w.nx - 1));
