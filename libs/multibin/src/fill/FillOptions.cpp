@@ -49,6 +49,11 @@ void FillOptions::read(StrictConfigSection& s) {
         {{"exponential", CovarianceFamily::Exponential}, {"matern32", CovarianceFamily::Matern32}});
     s.read("fill_terms_outside_gap", termsOutsideGap);
     s.read("fill_kriging_max_points", krigingMaxPoints);
+    s.read("fill_moving_rim_check", movingRimCheck);
+    s.readChoice<KrigingNeighbourhood>("fill_kriging_neighbourhood", krigingNeighbourhood,
+                                       {{"auto", KrigingNeighbourhood::Auto},
+                                        {"moving", KrigingNeighbourhood::Moving},
+                                        {"unique", KrigingNeighbourhood::Unique}});
     s.read("fill_model_averaging", modelAveraging);
     s.read("fill_extrapolation_margin", extrapolationMargin);
     s.readChoice<ModelCriterion>("fill_model_criterion", criterion,
@@ -95,6 +100,11 @@ void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
         std::string(krigingCovariance == CovarianceFamily::Matern32 ? "matern32" : "exponential"));
     c.write(section, "fill_terms_outside_gap", termsOutsideGap);
     c.write(section, "fill_kriging_max_points", krigingMaxPoints);
+    c.write(section, "fill_moving_rim_check", movingRimCheck);
+    c.write(section, "fill_kriging_neighbourhood",
+            std::string(krigingNeighbourhood == KrigingNeighbourhood::Moving   ? "moving"
+                        : krigingNeighbourhood == KrigingNeighbourhood::Unique ? "unique"
+                                                                               : "auto"));
     c.write(section, "fill_model_averaging", modelAveraging);
     c.write(section, "fill_extrapolation_margin", extrapolationMargin);
     c.write(section, "fill_model_criterion", std::string(criterionName(criterion)));

@@ -374,6 +374,87 @@ std::vector<double> biharmonicResiduals(const HeightRaster& r, const GaussianSur
     return out;
 }
 
+/** The training points nearest a gap: `cand` sorted by distance to the gap, cut to `count`.
+ * Where the cut falls inside a ring (more points at the cut-off distance than places left),
+ * the places go to points evenly spread by angle about the gap's centre (ci, cj), so the kept
+ * points still surround the gap: the raster order would keep one side of a long rim only. */
+template <class Cand>
+void keepNearestToGap(std::vector<Cand>& cand, size_t count, double ci, double cj) {
+    if (cand.size() <= count) return;
+    std::stable_sort(cand.begin(), cand.end(),
+                     [](const Cand& a, const Cand& b) { return a.gapDist < b.gapDist; });
+    const int cut = cand[count - 1].gapDist;
+    const auto lo =
+        std::find_if(cand.begin(), cand.end(), [&](const Cand& c) { return c.gapDist == cut; });
+    const auto hi = std::find_if(lo, cand.end(), [&](const Cand& c) { return c.gapDist > cut; });
+    const size_t left = count - size_t(lo - cand.begin()), ring = size_t(hi - lo);
+    if (left < ring) {
+        auto angle = [&](const Cand& c) { return std::atan2(c.s.j - cj, c.s.i - ci); };
+        std::stable_sort(lo, hi, [&](const Cand& a, const Cand& b) { return angle(a) < angle(b); });
+        // Place t of `left` takes the ring's point floor((t + 0.5) ring / left): evenly spread.
+        for (size_t t = 0; t < left; t++)
+            *(lo + std::ptrdiff_t(t)) = *(lo + std::ptrdiff_t((2 * t + 1) * ring / (2 * left)));
+    }
+    cand.resize(count);
+}
+
+/** Moving-neighbourhood kriging: the gap cells are cut into tiles of kTile x kTile cells, each
+ * kriged from its own `k` training points nearest the tile (distance to the tile's box), under
+ * each weighted model's trend shapes and covariance (the amplitudes re-estimated by GLS on the
+ * tile's points, as a local universal kriging does). Fills models[q].mean_m / var_m2. */
+template <class Model>
+void krigeByTiles(const std::vector<double>& ci, const std::vector<double>& cj,
+                  const std::vector<SurfaceSample>& samples, int k, double prior,
+                  std::vector<Model>& models, const std::vector<double>& w) {
+    // 8 x 8 cells: 64 predictions per factorisation, and a tile's far cells stay within a few
+    // cells of the points nearest its box.
+    constexpr int kTile = 8;
+    for (size_t q = 0; q < models.size(); q++)
+        if (w[q] > 0)
+            models[q].mean_m.assign(ci.size(), 0.0), models[q].var_m2.assign(ci.size(), 0.0);
+    std::vector<std::pair<long long, size_t>> byTile(ci.size());
+    for (size_t c = 0; c < ci.size(); c++) {
+        const long long ti = (long long)std::floor(ci[c] / kTile),
+                        tj = (long long)std::floor(cj[c] / kTile);
+        byTile[c] = {tj * 1000003LL + ti, c};
+    }
+    std::sort(byTile.begin(), byTile.end());
+    std::vector<std::pair<double, size_t>> dist(samples.size());
+    std::vector<SurfaceSample> local;
+    std::vector<double> ti, tj, mean, var;
+    for (size_t a = 0; a < byTile.size();) {
+        size_t b = a;
+        while (b < byTile.size() && byTile[b].first == byTile[a].first) b++;
+        double i0 = ci[byTile[a].second], i1 = i0, j0 = cj[byTile[a].second], j1 = j0;
+        ti.clear(), tj.clear();
+        for (size_t t = a; t < b; t++) {
+            const size_t c = byTile[t].second;
+            i0 = std::min(i0, ci[c]), i1 = std::max(i1, ci[c]);
+            j0 = std::min(j0, cj[c]), j1 = std::max(j1, cj[c]);
+            ti.push_back(ci[c]), tj.push_back(cj[c]);
+        }
+        for (size_t s = 0; s < samples.size(); s++) {
+            const double di = std::max({i0 - samples[s].i, samples[s].i - i1, 0.0});
+            const double dj = std::max({j0 - samples[s].j, samples[s].j - j1, 0.0});
+            dist[s] = {di * di + dj * dj, s};
+        }
+        const size_t n = std::min(samples.size(), size_t(k));
+        std::nth_element(dist.begin(), dist.begin() + std::ptrdiff_t(n - 1), dist.end());
+        local.clear();
+        for (size_t s = 0; s < n; s++) local.push_back(samples[dist[s].second]);
+        for (size_t q = 0; q < models.size(); q++) {
+            if (!(w[q] > 0)) continue;
+            const UniversalKriging uk(local, models[q].shapes, models[q].cov, prior);
+            uk.predict(ti, tj, mean, var);
+            for (size_t t = a; t < b; t++) {
+                models[q].mean_m[byTile[t].second] = mean[t - a];
+                models[q].var_m2[byTile[t].second] = var[t - a];
+            }
+        }
+        a = b;
+    }
+}
+
 /** The kriging path of fillWithGaussianSurface (ResidualModel::Kriging): eq 16 fitted for
  * m = 0, 1, ... as usual (seeded swarm, iid Mahalanobis fitness), each fit then taken as the
  * trend of a universal kriging whose residual covariance is fitted to the semivariogram of its
@@ -383,8 +464,10 @@ std::vector<double> biharmonicResiduals(const HeightRaster& r, const GaussianSur
 void fillByKriging(const HeightRaster& r, const FillOptions& o,
                    const GaussianFitOptions& fitOptions, const std::vector<int>& cells,
                    const std::vector<SurfaceSample>& samples,
-                   const std::vector<SurfaceSample>& near, int side, int sx, int sy,
-                   FillResult& out) {
+                   const std::vector<SurfaceSample>& near, const std::vector<SurfaceSample>* moving,
+                   const std::vector<SurfaceSample>& rim,
+                   const std::vector<SurfaceSample>& beyondRim, const GaussianSurface* alternative,
+                   int side, int sx, int sy, FillResult& out) {
     const int n = int(samples.size());
     const double prior = amplitudePriorPrecision(samples);
     double sensorVar = 0, hLo = samples[0].h_m, hHi = hLo, meanSigma = 0;
@@ -402,6 +485,8 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o,
     struct Model {
         double criterion;
         int m;
+        GaussianSurface shapes;  // the swarm's fit; the kriging re-estimates its amplitudes
+        Covariance cov;
         std::unique_ptr<UniversalKriging> kriging;
         std::vector<double> mean_m, var_m2;
     };
@@ -428,7 +513,7 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o,
     auto evaluate = [&](const GaussianSurface& g, const Covariance& cov) {
         auto uk = std::make_unique<UniversalKriging>(near, g, cov, prior);
         const double c = criterion(*uk, g);
-        models.push_back(Model{c, int(g.terms.size()), std::move(uk), {}, {}});
+        models.push_back(Model{c, int(g.terms.size()), g, cov, std::move(uk), {}, {}});
     };
     GaussianSurface prev = fitGaussianSurfaceFixed(samples, side, 0, fitOptions);
     size_t best = 0;
@@ -459,11 +544,52 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o,
     } else {
         w[best] = 1;
     }
-    for (size_t q = 0; q < models.size(); q++)
-        if (w[q] > 0) models[q].kriging->predict(ci, cj, models[q].mean_m, models[q].var_m2);
+    if (!moving) {
+        for (size_t q = 0; q < models.size(); q++)
+            if (w[q] > 0) models[q].kriging->predict(ci, cj, models[q].mean_m, models[q].var_m2);
+    } else {
+        krigeByTiles(ci, cj, *moving, o.krigingMaxPoints, prior, models, w);
+        out.stats.movingNeighbourhoods++;
+    }
     out.stats.supportAreas++;
     out.stats.termsChosen.push_back(models[best].m);
     const double slack = o.extrapolationMargin * (hHi - hLo);
+    std::vector<double> harmonic;  // the gap's heights by harmonic residuals, if they won
+    if (alternative && rim.size() >= 4) {
+        // Rim check: hide the two rings of measured cells around the gap and predict them as the
+        // gap would be filled, by this kriging (best m, moving neighbourhoods from the cells
+        // beyond the rings) and by the alternative (eq 16 by AIC on independent residuals plus
+        // harmonic rim residuals); the gap takes the method that predicted its rim better.
+        struct One {
+            GaussianSurface shapes;
+            Covariance cov;
+            std::vector<double> mean_m, var_m2;
+        };
+        std::vector<One> one{{models[best].shapes, models[best].cov, {}, {}}};
+        std::vector<double> ri, rj;
+        std::vector<int> both = cells;
+        for (const auto& s : rim) {
+            ri.push_back(s.i), rj.push_back(s.j);
+            both.push_back(int(r.index(sx + s.i, sy + s.j)));
+        }
+        krigeByTiles(ri, rj, beyondRim, o.krigingMaxPoints, prior, one, {1.0});
+        const int ex = std::min(sx + side, r.nx), ey = std::min(sy + side, r.ny);
+        const auto hr = harmonicResiduals(r, *alternative, both, sx, sy, ex, ey);
+        double ek = 0, eh = 0;
+        for (size_t k = 0; k < rim.size(); k++) {
+            const double dh =
+                rim[k].h_m - ((*alternative)(rim[k].i, rim[k].j) + hr[cells.size() + k]);
+            const double dk = rim[k].h_m - one[0].mean_m[k];
+            eh += dh * dh, ek += dk * dk;
+        }
+        if (eh < ek) {
+            const auto hg = harmonicResiduals(r, *alternative, cells, sx, sy, ex, ey);
+            harmonic.resize(cells.size());
+            for (size_t c = 0; c < cells.size(); c++)
+                harmonic[c] = (*alternative)(ci[c], cj[c]) + hg[c];
+            out.stats.rimCheckHarmonic++;
+        }
+    }
     for (size_t c = 0; c < cells.size(); c++) {
         double mean = 0, var = 0;
         for (size_t q = 0; q < models.size(); q++)
@@ -477,6 +603,7 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o,
         if (o.sigmaModel == FillSigmaModel::Calibrated)
             sigma = std::max(o.gaussianSigmaGain * std::sqrt(var), o.sigmaFloor_m);
         const size_t k = size_t(cells[c]);
+        if (!harmonic.empty()) mean = harmonic[c];
         out.height_m[k] = float(std::clamp(mean, hLo - slack, hHi + slack));
         out.sigma_m[k] = float(sigma);
         out.source[k] = FillSource::Gaussian;
@@ -538,11 +665,15 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
             cand.push_back({SurfaceSample{ix - sx, iy - sy, r.height_m[k], r.sigma_m[k]},
                             gapDist[size_t(iy - sy) * size_t(bw) + size_t(ix - sx)]});
         }
-    if (int(cand.size()) > o.maxTrainingPoints) {
-        std::stable_sort(cand.begin(), cand.end(),
-                         [](const Cand& a, const Cand& b) { return a.gapDist < b.gapDist; });
-        cand.resize(size_t(o.maxTrainingPoints));
+    std::vector<SurfaceSample> all;  // every measured cell of the area: the moving neighbourhoods
+    std::vector<SurfaceSample> rim, beyondRim;  // within 2 cells of the gap, and the others
+    for (const auto& c : cand) {
+        all.push_back(c.s);
+        (c.gapDist <= 2 ? rim : beyondRim).push_back(c.s);
     }
+    const size_t rimCells = rim.size();
+    const double gi = 0.5 * (x0 + x1) - sx, gj = 0.5 * (y0 + y1) - sy;  // gap centre
+    keepNearestToGap(cand, size_t(o.maxTrainingPoints), gi, gj);
     // Fewer than this and even m = 1 cannot be judged by the criterion.
     if (cand.size() < 12) return false;
     std::vector<SurfaceSample> samples;
@@ -558,16 +689,25 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
     if (o.residualCorrection && o.residualModel == ResidualModel::Kriging &&
         o.criterion != ModelCriterion::Holdout) {
         // The kriging neighbourhood: the training points nearest the gap (its cost is cubic).
+        // Its likelihood (the choice of m) is that of these points.
+        std::vector<Cand> nearCand = cand;
+        keepNearestToGap(nearCand, size_t(o.krigingMaxPoints), gi, gj);
         std::vector<SurfaceSample> near;
-        if (int(cand.size()) > o.krigingMaxPoints) {
-            std::stable_sort(cand.begin(), cand.end(),
-                             [](const Cand& a, const Cand& b) { return a.gapDist < b.gapDist; });
-            for (int k = 0; k < o.krigingMaxPoints; k++) near.push_back(cand[size_t(k)].s);
-        } else {
-            near = samples;
-        }
+        for (const auto& c : nearCand) near.push_back(c.s);
+        // One neighbourhood for the whole gap only if it holds the two rings of measured cells
+        // around it; otherwise (a long shadow, a sprawling gap) part of the gap would be
+        // extrapolated from one side of its rim: krige each tile from its own nearest points.
+        const bool moving =
+            o.krigingNeighbourhood == KrigingNeighbourhood::Moving ||
+            (o.krigingNeighbourhood == KrigingNeighbourhood::Auto && rimCells > near.size());
+        // A gap too long or sprawling for one neighbourhood: the rim check against eq 16 by
+        // AIC with harmonic rim residuals (see fillByKriging).
+        GaussianSurface alternative;
+        if (moving && o.movingRimCheck) alternative = fitGaussianSurface(samples, side, fitOptions);
         try {
-            fillByKriging(r, o, fitOptions, cells, samples, near, side, sx, sy, out);
+            fillByKriging(r, o, fitOptions, cells, samples, near, moving ? &all : nullptr, rim,
+                          beyondRim, moving && o.movingRimCheck ? &alternative : nullptr, side, sx,
+                          sy, out);
             return true;
         } catch (const std::runtime_error&) {
             // K not positive definite (not seen; K has every sample's sensor variance on its

@@ -30,6 +30,9 @@ enum class FillSigmaModel {
     Paper
 };
 
+/** Kriging neighbourhood of a gap (see FillOptions::krigingNeighbourhood). */
+enum class KrigingNeighbourhood { Auto, Moving, Unique };
+
 /** How the residuals of the measured cells about the fitted eq 16 surface are carried into a gap
  * (when FillOptions::residualCorrection is on). */
 enum class ResidualModel {
@@ -80,6 +83,19 @@ struct FillOptions {
     /** [fill_kriging_max_points] the kriging (and its likelihood) uses at most this many
      * training points, the nearest to the gap: its cost grows as the cube [-]. */
     int krigingMaxPoints = 200;
+    /** [fill_kriging_neighbourhood] auto|moving|unique: where each gap cell is kriged from.
+     * unique: the krigingMaxPoints training points nearest the gap, one factorisation for the
+     * whole gap; moving: each tile of 8 x 8 gap cells from its own krigingMaxPoints nearest
+     * training points (the trend's amplitudes re-estimated there); auto: unique when those
+     * points hold the two whole rings of measured cells around the gap, else moving (a long or
+     * sprawling gap, whose rim does not fit in one neighbourhood). */
+    KrigingNeighbourhood krigingNeighbourhood = KrigingNeighbourhood::Auto;
+    /** [fill_moving_rim_check] a gap kriged in moving neighbourhoods is also filled, on its two
+     * hidden rings of measured cells, by eq 16 (m by AIC on independent residuals) plus harmonic
+     * rim residuals; if that predicts the hidden rings better than the kriging does, the gap is
+     * filled that way (the kriging sigma kept). A step hidden in a long shadow is what the
+     * smooth kriging carries too far. */
+    bool movingRimCheck = true;
     /** [fill_model_averaging] kriging only: average the fills of the m visited by the search
      * with Akaike weights exp(-dAIC/2) (and add their spread to the variance) instead of
      * keeping the single best m. */

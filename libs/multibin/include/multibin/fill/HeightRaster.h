@@ -63,6 +63,8 @@ struct FillResult {
         int gapComponents = 0;         //!< connected gaps found (4-connected never-observed cells)
         int supportAreas = 0;          //!< gaps filled by a Gaussian surface
         std::vector<int> termsChosen;  //!< AIC-chosen number m of Gaussians, per support area
+        int movingNeighbourhoods = 0;  //!< gaps kriged in moving neighbourhoods (tiles)
+        int rimCheckHarmonic = 0;      //!< of those, gaps the rim check gave to the harmonic path
     } stats;
 
     size_t index(int ix, int iy) const { return size_t(iy) * size_t(nx) + size_t(ix); }
