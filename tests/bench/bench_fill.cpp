@@ -80,4 +80,21 @@ static void BM_WeightedMedian133(benchmark::State& state) {
 }
 BENCHMARK(BM_WeightedMedian133)->Arg(10)->Arg(30)->Unit(benchmark::kMillisecond);
 
+/** A long shadow on the 2 x 2 m grid of boards (133 x 133 cells, all measured but the gap): an 80
+ * x 12-cell strip joined to 26 one-cell slits of 28 cells (1688 cells), whose rim fits in no single
+ * kriging neighbourhood: moving neighbourhoods plus the rim check (the mapper's shadow gaps; test
+ * FillGaps.LongShadowBesideAStepStaysWithinItsOwnRim has the same geometry). */
+static void BM_FillLongShadow133(benchmark::State& state) {
+    HeightRaster r = tiledRaster(boards(), 133, 1);
+    hideBox(r, 26, 60, 80, 12);
+    for (int ix = 28; ix <= 103; ix += 3) hideBox(r, ix, 32, 1, 28);
+    const FillOptions o;
+    FillResult f;
+    for (auto _ : state) benchmark::DoNotOptimize(f = fillGaps(r, o));
+    report(state, f);
+    state.counters["moving"] = f.stats.movingNeighbourhoods;
+    state.counters["rim_check_harmonic"] = f.stats.rimCheckHarmonic;
+}
+BENCHMARK(BM_FillLongShadow133)->Unit(benchmark::kMillisecond);
+
 BENCHMARK_MAIN();

@@ -117,7 +117,7 @@ struct FillOptions {
     FillSigmaModel sigmaModel =
         FillSigmaModel::Calibrated;   //!< [fill_sigma_model] calibrated|paper
     double medianSigmaGain = 0.77;    //!< [fill_median_sigma_gain] calibrated gain [-]
-    double gaussianSigmaGain = 1.31;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
+    double gaussianSigmaGain = 1.33;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
     double sigmaFloor_m = 0.002;      //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
 
     /** The Gaussian-fit settings these options imply. */
