@@ -280,7 +280,12 @@ std::vector<double> harmonicResiduals(const HeightRaster& r, const GaussianSurfa
             kind[at(ix, iy)] = 1;
             res[at(ix, iy)] = r.height_m[k] - g(ix - sx, iy - sy);
         }
-    for (int k : cells) kind[at(k % r.nx, k / r.nx)] = 2;
+    for (int k : cells) {
+        // A held-out measured cell starts from 0 like the others: its own residual must not
+        // leak into the solution if the iteration stops early.
+        kind[at(k % r.nx, k / r.nx)] = 2;
+        res[at(k % r.nx, k / r.nx)] = 0;
+    }
     constexpr double kOmega = 1.8;         // over-relaxation factor
     constexpr double kTolerance_m = 1e-5;  // well below any sensor noise
     for (int it = 0; it < 2000; it++) {
@@ -439,6 +444,7 @@ void krigeByTiles(const std::vector<double>& ci, const std::vector<double>& cj,
             dist[s] = {di * di + dj * dj, s};
         }
         const size_t n = std::min(samples.size(), size_t(k));
+        if (n == 0) throw std::runtime_error("krigeByTiles: no samples");
         std::nth_element(dist.begin(), dist.begin() + std::ptrdiff_t(n - 1), dist.end());
         local.clear();
         for (size_t s = 0; s < n; s++) local.push_back(samples[dist[s].second]);
@@ -555,7 +561,7 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o,
     out.stats.termsChosen.push_back(models[best].m);
     const double slack = o.extrapolationMargin * (hHi - hLo);
     std::vector<double> harmonic;  // the gap's heights by harmonic residuals, if they won
-    if (alternative && rim.size() >= 4) {
+    if (alternative && rim.size() >= 4 && beyondRim.size() >= 12) {
         // Rim check: hide the two rings of measured cells around the gap and predict them as the
         // gap would be filled, by this kriging (best m, moving neighbourhoods from the cells
         // beyond the rings) and by the alternative (eq 16 by AIC on independent residuals plus
