@@ -437,15 +437,17 @@ TEST(FillGaps, KrigingAicChoosesTheTrueNumberOfGaussians) {
     EXPECT_GE(exact, cases / 2);
 }
 
+/** A Gaussian hill (6 cm, sigma 6 cells) on a plate 2 cm high, centred at cell (20, 18) [m]. */
+static double hillTerrain_m(int ix, int iy) {
+    return 0.02 +
+           0.06 * std::exp(-((ix - 20.0) * (ix - 20.0) + (iy - 18.0) * (iy - 18.0)) / (2 * 36.0));
+}
+
 TEST(FillGaps, KrigingAicTakesAHiddenHillTerm) {
     // A Gaussian hill (6 cm, 6 cells wide) on a flat plate, its top hidden by a 10 x 10 gap:
     // the criterion on the kriging likelihood must take the term (m = 1, then stop) and the
     // fill must follow the hill.
-    auto hill = [](int ix, int iy) {
-        return 0.02 + 0.06 * std::exp(-((ix - 20.0) * (ix - 20.0) + (iy - 18.0) * (iy - 18.0)) /
-                                      (2 * 36.0));
-    };
-    auto r = rasterFrom(40, hill, 0.001f);
+    auto r = rasterFrom(40, hillTerrain_m, 0.001f);
     hide(r, 15, 13, 10, 10);
     FillOptions o;
     o.extrapolationMargin = 1.0;  // the top rises above the visible heights
@@ -454,7 +456,8 @@ TEST(FillGaps, KrigingAicTakesAHiddenHillTerm) {
         double worst = 0;
         for (int iy = 13; iy < 23; iy++)
             for (int ix = 15; ix < 25; ix++)
-                worst = std::max(worst, std::abs(f.height_m[f.index(ix, iy)] - hill(ix, iy)));
+                worst =
+                    std::max(worst, std::abs(f.height_m[f.index(ix, iy)] - hillTerrain_m(ix, iy)));
         return worst;
     };
     const auto f = fillGaps(r, o);
@@ -582,18 +585,14 @@ TEST(FillGaps, LongShadowBesideAStepStaysWithinItsOwnRim) {
 
 TEST(FillGaps, HoldoutCriterionKeepsRealTermsAndDropsNoise) {
     // A hill whose top is hidden: predicting the hidden rim needs the Gaussian term.
-    auto hill = [](int ix, int iy) {
-        return 0.02 + 0.06 * std::exp(-((ix - 20.0) * (ix - 20.0) + (iy - 18.0) * (iy - 18.0)) /
-                                      (2 * 36.0));
-    };
-    auto r = rasterFrom(40, hill, 0.001f);
+    auto r = rasterFrom(40, hillTerrain_m, 0.001f);
     hide(r, 15, 13, 10, 10);
     FillOptions o;
     o.criterion = ModelCriterion::Holdout;
     // The default clamp (visible range + 25 %) flattens this top, which rises 18 mm above the
     // highest visible cell (0.0624 m at (20, 23)).
     const auto clamped = fillGaps(r, o);
-    EXPECT_LT(clamped.height_m[clamped.index(20, 18)], hill(20, 18) - 0.005);
+    EXPECT_LT(clamped.height_m[clamped.index(20, 18)], hillTerrain_m(20, 18) - 0.005);
     o.extrapolationMargin = 1.0;
     const auto f = fillGaps(r, o);
     ASSERT_EQ(f.stats.termsChosen.size(), 1u);
@@ -601,7 +600,7 @@ TEST(FillGaps, HoldoutCriterionKeepsRealTermsAndDropsNoise) {
     double worst = 0;
     for (int iy = 13; iy < 23; iy++)
         for (int ix = 15; ix < 25; ix++)
-            worst = std::max(worst, std::abs(f.height_m[f.index(ix, iy)] - hill(ix, iy)));
+            worst = std::max(worst, std::abs(f.height_m[f.index(ix, iy)] - hillTerrain_m(ix, iy)));
     EXPECT_LT(worst, 0.004);
 
     // White noise on a plane: no term predicts held-out cells better than the constant.

@@ -10,6 +10,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace multibin::sensors {
 
@@ -392,15 +393,22 @@ double largestSquareWithin(double r_m) {
     while (s < inf && std::sqrt(std::nextafter(s, inf)) <= r_m) s = std::nextafter(s, inf);
     return s;
 }
+
+/** Table indices of the left pixel (u, v) and of its match at disparity d in the right image;
+ * throws if (u, v) lies outside the image. */
+std::pair<size_t, size_t> pixelPairIndices(const StereoGeometry& g, const PointConstants& k, int u,
+                                           int v, double d) {
+    if (u < 0 || v < 0 || u >= g.width || v >= g.height)
+        throw std::out_of_range("StereoCovarianceTable: pixel outside the image");
+    const size_t row = size_t(v) * size_t(g.width);
+    return {row + size_t(u), row + size_t(k.rightColumn(u, d, g.width))};
+}
 }  // namespace
 
 Eigen::Matrix3d StereoCovarianceTable::pixelCovariance(int u, int v, double d) const {
     const StereoGeometry& g = m_geometry;
-    if (u < 0 || v < 0 || u >= g.width || v >= g.height)
-        throw std::out_of_range("StereoCovarianceTable: pixel outside the image");
     const PointConstants k(g, m_var, m_matchingVar_px2);
-    const size_t i = size_t(v) * size_t(g.width) + size_t(u);
-    const size_t j = size_t(v) * size_t(g.width) + size_t(k.rightColumn(u, d, g.width));
+    const auto [i, j] = pixelPairIndices(g, k, u, v, d);
     const double luu = m_luu[i], luv = m_luv[i], lvv = m_lvv[i];
     const double vd = k.disparityVariance(u, d, luu, m_rightVar[j]);
     Eigen::Matrix3d C;
@@ -410,11 +418,8 @@ Eigen::Matrix3d StereoCovarianceTable::pixelCovariance(int u, int v, double d) c
 
 Eigen::Matrix3d StereoCovarianceTable::pointCovariance(int u, int v, double d) const {
     const StereoGeometry& g = m_geometry;
-    if (u < 0 || v < 0 || u >= g.width || v >= g.height)
-        throw std::out_of_range("StereoCovarianceTable: pixel outside the image");
     const PointConstants k(g, m_var, m_matchingVar_px2);
-    const size_t i = size_t(v) * size_t(g.width) + size_t(u);
-    const size_t j = size_t(v) * size_t(g.width) + size_t(k.rightColumn(u, d, g.width));
+    const auto [i, j] = pixelPairIndices(g, k, u, v, d);
     double p[3], c[6];
     k.point(u, v - g.cy, d, m_luu[i], m_luv[i], m_lvv[i], m_rightVar[j], p, c);
     Eigen::Matrix3d C;
