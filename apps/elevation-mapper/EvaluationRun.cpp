@@ -218,6 +218,7 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
         MethodEstimate mrf;
         mrf.name = "mrpt_height_grid_mrf";
         mrf.baseline = "raw_all";
+        mrf.coversWholeArea = false;  // its crop must not narrow the others' shared cells
         mrf.insert_s = m_mrf_s;
         mrf.fill_s = secondsSince(t0);
         mrf.height_m = sampleDem(*m_mrf, m_lattice, &m_mrfLattice);

@@ -163,3 +163,20 @@ TEST(Evaluation, SubLatticeKeepsTheCellsWhoseCentresLieInTheArea) {
     EXPECT_THROW(subLattice(L, {1.0, 0.0, 0.0, 1.0}), std::invalid_argument);  // xmin > xmax
     EXPECT_THROW(subLattice(L, {0.0, 1.0}), std::invalid_argument);            // two numbers
 }
+
+// MRPT's GMRF map is built on a crop only: it must not narrow the cells the whole-area methods
+// share, and its own shared PI compares it with its baseline inside its crop.
+TEST(Evaluation, ACropOnlyMethodDoesNotNarrowTheSharedCells) {
+    const CellArray truth = array2x2(0.10f, 0.20f, 0.30f, 0.40f);
+    const CellArray raw = array2x2(0.13f, 0.24f, 0.31f, 0.35f);  // errors .03 .04 .01 -.05
+    const CellArray full = array2x2(0.11f, 0.18f, 0.30f, NAN);   // errors .01 -.02 0
+    const CellArray crop = array2x2(NAN, NAN, 0.32f, 0.41f);     // errors .02 .01
+    MethodEstimate cropOnly{"crop", crop, {}, "raw", 0, 0};
+    cropOnly.coversWholeArea = false;
+    const auto scores = scoreMethods(
+        truth, {{"raw", raw, {}, "raw", 0, 0}, {"full", full, {}, "raw", 0, 0}, cropOnly});
+    // Shared by raw and full: cells 0, 1, 2 -> (1 + 4 + 0) / (9 + 16 + 1).
+    EXPECT_NEAR(scores.at("full").piShared, 5.0 / 26.0, 1e-5);
+    // The crop inside the shared cells: cell 2 only -> 4 / 1.
+    EXPECT_NEAR(scores.at("crop").piShared, 4.0, 1e-4);
+}

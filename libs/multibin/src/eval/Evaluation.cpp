@@ -128,9 +128,10 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
                                         "' does not cover the evaluation lattice");
         byName[m.name] = &m;
     }
-    // Cells every method covers (and the truth knows): the shared PI.
+    // Cells every whole-area method covers (and the truth knows): the shared PI.
     Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> shared = truth_m.isFinite();
-    for (const auto& m : methods) shared = shared && m.height_m.isFinite();
+    for (const auto& m : methods)
+        if (m.coversWholeArea) shared = shared && m.height_m.isFinite();
 
     const size_t truthCells = size_t(truth_m.isFinite().count());
     std::map<std::string, MethodScore> scores;
@@ -146,8 +147,11 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
         s.validCells = own.cells;
         s.rmse_m = std::sqrt(own.mse_m2);
         s.pi = performanceIndex(own, raw);
-        s.piShared = performanceIndex(meanSquaredError(m.height_m, truth_m, &shared),
-                                      meanSquaredError(base->second->height_m, truth_m, &shared));
+        // A crop-only method and its baseline are compared over the shared cells of its crop.
+        const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> cells =
+            m.coversWholeArea ? shared : (shared && m.height_m.isFinite()).eval();
+        s.piShared = performanceIndex(meanSquaredError(m.height_m, truth_m, &cells),
+                                      meanSquaredError(base->second->height_m, truth_m, &cells));
         s.coverage = truthCells ? double(own.cells) / double(truthCells) : 0.0;
         if (m.sigma_m.size() > 0) {
             size_t inside = 0;

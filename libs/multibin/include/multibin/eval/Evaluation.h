@@ -65,6 +65,9 @@ struct MethodEstimate {
     std::string baseline;  //!< the raw method that is this method's PI denominator (eq 17)
     double insert_s = 0;   //!< wall time to insert [s]
     double fill_s = 0;     //!< wall time to fill [s]
+    /** false for a method built on a crop only (MRPT's GMRF map): it does not narrow the cells
+     * every method covers (`pi_shared`) to its crop. */
+    bool coversWholeArea = true;
 };
 
 /** Mean squared error over the cells where both the estimate and the truth are finite (and the
@@ -84,9 +87,10 @@ double performanceIndex(const SquaredError& method, const SquaredError& raw);
 /** What the evaluation reports for one method (report.json). */
 struct MethodScore {
     double rmse_m = 0;
-    double pi = 0;                       //!< eq 17 over each map's own valid cells
-    double piShared = 0;                 //!< eq 17 over the cells every method covers
-    double coverage = 0;                 //!< share of truth cells with an estimate
+    double pi = 0;        //!< eq 17 over each map's own valid cells
+    double piShared = 0;  //!< eq 17 over the cells every whole-area method covers (and, for a
+                          //!< crop-only method, inside its crop)
+    double coverage = 0;  //!< share of truth cells with an estimate
     std::optional<double> within3Sigma;  //!< share of valid cells with |h - h_t| <= 3 sigma
     size_t validCells = 0;
     double insert_s = 0, fill_s = 0;
