@@ -7,6 +7,7 @@
  * --benchmark_report_aggregates_only=true The sensor models (laser, stereo) are measured as they
  * are in the tree at build time. */
 #include <benchmark/benchmark.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CSimpleMap.h>
@@ -115,6 +116,27 @@ void setVisibility(mrpt::maps::CMultiBinElevationMap& map, benchmark::State& sta
     map.insertionOptions.visibility.enabled = state.range(0) != 0;
     state.SetLabel(map.insertionOptions.visibility.enabled ? "visibility on" : "visibility off");
 }
+
+/** The observations of the shipped mock-up (rawlogs/mockup.simplemap, loaded into memory) with
+ * their keyframe pose PDFs, in order; only the laser scans if `lasersOnly`. */
+using ObservationsWithPdf =
+    std::vector<std::pair<mrpt::obs::CObservation::Ptr, mrpt::poses::CPose3DPDFGaussian>>;
+bool loadMockup(ObservationsWithPdf& out, bool lasersOnly) {
+    mrpt::maps::CSimpleMap simplemap;
+    if (!simplemap.loadFromFile(std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/mockup.simplemap"))
+        return false;
+    mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
+        simplemap,
+        [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
+            if (lasersOnly && !dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs))
+                return;
+            obs.load();
+            out.emplace_back(
+                std::dynamic_pointer_cast<mrpt::obs::CObservation>(obs.duplicateGetSmartPtr()),
+                pdf);
+        });
+    return true;
+}
 }  // namespace
 
 // One 683-beam pitched laser scan end to end: laser model (intensity, mixed pixels, range
@@ -134,21 +156,11 @@ BENCHMARK(BM_LaserScanEndToEnd)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 // rough terrain instead of the floor above. One iteration maps every scan into a fresh map;
 // counter `scans_per_s` (CPU time; us per scan = 1e6 / it).
 static void BM_LaserScansMockup(benchmark::State& state) {
-    mrpt::maps::CSimpleMap simplemap;
-    if (!simplemap.loadFromFile(std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/mockup.simplemap")) {
+    ObservationsWithPdf scans;
+    if (!loadMockup(scans, /*lasersOnly=*/true)) {
         state.SkipWithError("rawlogs/mockup.simplemap not found");
         return;
     }
-    std::vector<std::pair<mrpt::obs::CObservation::Ptr, mrpt::poses::CPose3DPDFGaussian>> scans;
-    mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
-        simplemap,
-        [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
-            if (!dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) return;
-            obs.load();
-            scans.emplace_back(
-                std::dynamic_pointer_cast<mrpt::obs::CObservation>(obs.duplicateGetSmartPtr()),
-                pdf);
-        });
     const mrpt::config::CConfigFileMemory ini(
         "[c]\nresolution = 0.015\nbin_height = 0.05\n"
         "[i]\nlaser_agc = LASER:512\nsensor_labels = LASER\nvisibility_constraint = " +
@@ -174,6 +186,35 @@ static void BM_LaserScansMockup(benchmark::State& state) {
         double(scans.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_LaserScansMockup)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
+
+// Every observation of the shipped mock-up (203 laser scans and 21 stereo frames of 320 x 240,
+// with their pose PDFs) into a map configured by ini/mockup.ini: the default run of
+// elevation-mapper, whose report.json gives the same work as multibin's insert_s. One iteration
+// maps everything into a fresh map.
+static void BM_MockupAllObservations(benchmark::State& state) {
+    ObservationsWithPdf observations;
+    if (!loadMockup(observations, /*lasersOnly=*/false)) {
+        state.SkipWithError("rawlogs/mockup.simplemap not found");
+        return;
+    }
+    const mrpt::config::CConfigFile ini(std::string(MULTIBIN_REFERENCE_DATA_DIR) +
+                                        "/../ini/mockup.ini");
+    const std::string section = "MappingApplication_multiBinElevationMap_00_";
+    mrpt::maps::CMultiBinElevationMap::TCreationOptions creation;
+    creation.loadFromConfigFile(ini, section + "creationOpts");
+    mrpt::maps::CMultiBinElevationMap::TInsertionOptions insertion;
+    insertion.loadFromConfigFile(ini, section + "insertOpts");
+    size_t accepted = 0;
+    for (auto _ : state) {
+        mrpt::maps::CMultiBinElevationMap map(creation);
+        map.insertionOptions = insertion;
+        for (const auto& [obs, pdf] : observations) map.insertObservation(*obs, pdf);
+        accepted = map.insertStats().accepted;
+    }
+    state.counters["observations"] = double(observations.size());
+    state.counters["points"] = double(accepted);
+}
+BENCHMARK(BM_MockupAllObservations)->Unit(benchmark::kMillisecond);
 
 // One 640 x 480 stereo frame end to end from its disparity image: halo and near-cluster filters,
 // triangulation with the calibration covariance table (eqs 4-10), propagation, bin update,
