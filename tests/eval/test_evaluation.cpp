@@ -179,4 +179,8 @@ TEST(Evaluation, ACropOnlyMethodDoesNotNarrowTheSharedCells) {
     EXPECT_NEAR(scores.at("full").piShared, 5.0 / 26.0, 1e-5);
     // The crop inside the shared cells: cell 2 only -> 4 / 1.
     EXPECT_NEAR(scores.at("crop").piShared, 4.0, 1e-4);
+    // Its PI: over its crop (cells 2, 3) against the raw map over the same cells,
+    // (4 + 1) / 2 over (1 + 25) / 2; the whole-area PI of `full` is unchanged, (5 / 3) / (51 / 4).
+    EXPECT_NEAR(scores.at("crop").pi, 5.0 / 26.0, 1e-5);
+    EXPECT_NEAR(scores.at("full").pi, (5.0 / 3.0) / (51.0 / 4.0), 1e-5);
 }

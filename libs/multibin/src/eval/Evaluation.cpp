@@ -143,7 +143,10 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
                                         baseName + "', which is not evaluated");
         MethodScore s;
         const SquaredError own = meanSquaredError(m.height_m, truth_m);
-        const SquaredError raw = meanSquaredError(base->second->height_m, truth_m);
+        // A crop-only method's raw map is the raw map over its crop (both over the same area).
+        const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> area =
+            m.coversWholeArea ? truth_m.isFinite().eval() : m.height_m.isFinite().eval();
+        const SquaredError raw = meanSquaredError(base->second->height_m, truth_m, &area);
         s.validCells = own.cells;
         s.rmse_m = std::sqrt(own.mse_m2);
         s.pi = performanceIndex(own, raw);

@@ -65,8 +65,9 @@ struct MethodEstimate {
     std::string baseline;  //!< the raw method that is this method's PI denominator (eq 17)
     double insert_s = 0;   //!< wall time to insert [s]
     double fill_s = 0;     //!< wall time to fill [s]
-    /** false for a method built on a crop only (MRPT's GMRF map): it does not narrow the cells
-     * every method covers (`pi_shared`) to its crop. */
+    /** false for a method built on a crop only (MRPT's GMRF map): its PI divides by the raw
+     * map's error over its crop, and it does not narrow the cells every method covers
+     * (`pi_shared`) to its crop. */
     bool coversWholeArea = true;
 };
 
