@@ -105,10 +105,10 @@ inline void expectConsistent(const std::vector<Eigen::Vector3d>& samples,
                              const Eigen::Vector3d& mean, const Eigen::Matrix3d& P,
                              double tol = 0.1) {
     const Consistency c = consistency(samples, mean, P);
-    std::printf("  MC %zu samples: worst covariance entry off by %.3f sqrt(PiiPjj), mean NEES %.3f "
-                "in [%.3f, %.3f], NEES > 11.34: %.2f %%\n",
-                samples.size(), c.worstEntry, c.meanNees, c.neesLo, c.neesHi,
-                100.0 * c.shareAbove);
+    std::printf(
+        "  MC %zu samples: worst covariance entry off by %.3f sqrt(PiiPjj), mean NEES %.3f "
+        "in [%.3f, %.3f], NEES > 11.34: %.2f %%\n",
+        samples.size(), c.worstEntry, c.meanNees, c.neesLo, c.neesHi, 100.0 * c.shareAbove);
     EXPECT_LT(c.worstEntry, tol) << "empirical\n" << c.empirical << "\npropagated\n" << P;
     EXPECT_GT(c.meanNees, c.neesLo) << "covariance too large";
     EXPECT_LT(c.meanNees, c.neesHi) << "covariance too small";
