@@ -137,6 +137,17 @@ bool loadMockup(ObservationsWithPdf& out, bool lasersOnly) {
         });
     return true;
 }
+
+/** A fresh map with these options fed every observation, in order. */
+mrpt::maps::CMultiBinElevationMap mapObservations(
+    const mrpt::maps::CMultiBinElevationMap::TCreationOptions& creation,
+    const mrpt::maps::CMultiBinElevationMap::TInsertionOptions& insertion,
+    const ObservationsWithPdf& observations) {
+    mrpt::maps::CMultiBinElevationMap map(creation);
+    map.insertionOptions = insertion;
+    for (const auto& [obs, pdf] : observations) map.insertObservation(*obs, pdf);
+    return map;
+}
 }  // namespace
 
 // One 683-beam pitched laser scan end to end: laser model (intensity, mixed pixels, range
@@ -172,9 +183,7 @@ static void BM_LaserScansMockup(benchmark::State& state) {
     state.SetLabel(insertion.visibility.enabled ? "visibility on" : "visibility off");
     size_t accepted = 0, cellsVisited = 0, rays = 0;
     for (auto _ : state) {
-        mrpt::maps::CMultiBinElevationMap map(creation);
-        map.insertionOptions = insertion;
-        for (const auto& [obs, pdf] : scans) map.insertObservation(*obs, pdf);
+        const auto map = mapObservations(creation, insertion, scans);
         accepted = map.insertStats().accepted;
         cellsVisited = map.visibilityStats().cellsVisited;
         rays = map.visibilityStats().raysCast;
@@ -205,12 +214,8 @@ static void BM_MockupAllObservations(benchmark::State& state) {
     mrpt::maps::CMultiBinElevationMap::TInsertionOptions insertion;
     insertion.loadFromConfigFile(ini, section + "insertOpts");
     size_t accepted = 0;
-    for (auto _ : state) {
-        mrpt::maps::CMultiBinElevationMap map(creation);
-        map.insertionOptions = insertion;
-        for (const auto& [obs, pdf] : observations) map.insertObservation(*obs, pdf);
-        accepted = map.insertStats().accepted;
-    }
+    for (auto _ : state)
+        accepted = mapObservations(creation, insertion, observations).insertStats().accepted;
     state.counters["observations"] = double(observations.size());
     state.counters["points"] = double(accepted);
 }
