@@ -64,6 +64,14 @@ inline mrpt::poses::CPose3DPDFGaussian posePdf(double x_m = 0, double y_m = 0) {
     return pdf;
 }
 
+/** Options of a map fixed to x, y in [-1, 1] m (no growth). */
+inline Map::TCreationOptions fixedTwoMetreMap() {
+    Map::TCreationOptions c;
+    c.grow = false;
+    c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
+    return c;
+}
+
 /** A map that already holds a floor seen by one good scan. */
 inline Map mapWithData(const Map::TCreationOptions& c = Map::TCreationOptions()) {
     Map map(c);

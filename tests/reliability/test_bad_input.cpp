@@ -306,9 +306,7 @@ TEST(BadInputPose, NonSymmetricPoseCovarianceIsRejected) {
 }
 
 TEST(BadInputPose, NonPositiveDefinitePointCovarianceIsCounted) {
-    Map::TCreationOptions c;
-    c.grow = false;
-    c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
+    const Map::TCreationOptions c = fixedTwoMetreMap();
     Map map = mapWithData(c);
     const auto before = serialize(map);
     multibin::PointsWithCov pts(3);
@@ -326,9 +324,7 @@ TEST(BadInputPose, NonPositiveDefinitePointCovarianceIsCounted) {
 // Points far outside the map, heights beyond the bin range
 // ---------------------------------------------------------------------------------------------
 TEST(BadInputExtent, PointsFarOutsideAFixedMapAreCounted) {
-    Map::TCreationOptions c;
-    c.grow = false;
-    c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
+    const Map::TCreationOptions c = fixedTwoMetreMap();
     Map map = mapWithData(c);
     const auto before = serialize(map);
     multibin::PointsWithCov pts(4);
@@ -372,9 +368,7 @@ TEST(BadInputExtent, ARobotPoseFarAwayKeepsTheDataAlreadyMapped) {
 // whole length; a sensor 10^9 m from the map (a corrupt sensorPose, a pose jump) meant ~10^11
 // steps per updated cell. The walk now stops where the ray leaves the grid window.
 TEST(BadInputExtent, ASensorFarFromTheMapDoesNotHangTheVisibilityConstraint) {
-    Map::TCreationOptions c;
-    c.grow = false;
-    c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
+    const Map::TCreationOptions c = fixedTwoMetreMap();
     Map map(c);
     multibin::PointsWithCov pts(3);
     for (int i = 0; i < 3; i++) {
@@ -389,9 +383,7 @@ TEST(BadInputExtent, ASensorFarFromTheMapDoesNotHangTheVisibilityConstraint) {
 
 TEST(BadInputExtent, HeightsBeyondTheBinRangeAreCounted) {
     // int16 bin indices with 0.05 m bins cover +-1638 m.
-    Map::TCreationOptions c;
-    c.grow = false;
-    c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
+    const Map::TCreationOptions c = fixedTwoMetreMap();
     Map map = mapWithData(c);
     const auto before = serialize(map);
     multibin::PointsWithCov pts(3);
