@@ -143,18 +143,23 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
                                         baseName + "', which is not evaluated");
         MethodScore s;
         const SquaredError own = meanSquaredError(m.height_m, truth_m);
-        // A crop-only method's raw map is the raw map over its crop (both over the same area).
-        const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> area =
-            m.coversWholeArea ? truth_m.isFinite().eval() : m.height_m.isFinite().eval();
-        const SquaredError raw = meanSquaredError(base->second->height_m, truth_m, &area);
+        // A crop-only method is compared with its raw map over its crop only, for PI and for
+        // the shared cells.
+        using Mask = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
+        Mask crop, sharedInCrop;
+        if (!m.coversWholeArea) {
+            crop = m.height_m.isFinite();
+            sharedInCrop = shared && crop;
+        }
+        const Mask* rawCells = m.coversWholeArea ? nullptr : &crop;
+        const Mask* sharedCells = m.coversWholeArea ? &shared : &sharedInCrop;
+        const SquaredError raw = meanSquaredError(base->second->height_m, truth_m, rawCells);
         s.validCells = own.cells;
         s.rmse_m = std::sqrt(own.mse_m2);
         s.pi = performanceIndex(own, raw);
-        // A crop-only method and its baseline are compared over the shared cells of its crop.
-        const Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> cells =
-            m.coversWholeArea ? shared : (shared && m.height_m.isFinite()).eval();
-        s.piShared = performanceIndex(meanSquaredError(m.height_m, truth_m, &cells),
-                                      meanSquaredError(base->second->height_m, truth_m, &cells));
+        s.piShared =
+            performanceIndex(meanSquaredError(m.height_m, truth_m, sharedCells),
+                             meanSquaredError(base->second->height_m, truth_m, sharedCells));
         s.coverage = truthCells ? double(own.cells) / double(truthCells) : 0.0;
         if (m.sigma_m.size() > 0) {
             size_t inside = 0;
