@@ -15,7 +15,7 @@
 
 #include <fstream>
 #include <stdexcept>
-#include "multibin/ErrorMessage.h"
+#include "multibin/io/ErrorMessage.h"
 
 namespace {
 /** Uncompressed size of a file [bytes]: a gzip file's trailer holds it (mod 4 GiB). */

@@ -33,8 +33,8 @@
 #include "EvaluationRun.h"
 #include "ProgressBar.h"
 #include "RawlogSource.h"
-#include "multibin/ErrorMessage.h"
-#include "multibin/NumberText.h"
+#include "multibin/io/ErrorMessage.h"
+#include "multibin/io/NumberText.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;

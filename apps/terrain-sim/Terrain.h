@@ -1,7 +1,7 @@
 /* Part of the multibin elevation-mapping library: terrain-sim. */
 #pragma once
 
-#include <multibin/EsriAsciiGrid.h>
+#include <multibin/io/EsriAsciiGrid.h>
 
 #include <Eigen/Core>
 #include <cstdint>

@@ -2,7 +2,7 @@
  * over real scanned terrain boards, writing rawlogs with pose PDFs and ground truth. */
 #include "Scenario.h"
 
-#include <multibin/ErrorMessage.h>
+#include <multibin/io/ErrorMessage.h>
 
 #include <cstdio>
 #include <cstdlib>

@@ -13,9 +13,9 @@
 #include <random>
 #include <thread>
 
-#include "multibin/BinGrid.h"
-#include "multibin/PosePropagation.h"
-#include "multibin/VisibilityConstraint.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/VisibilityConstraint.h"
 
 using namespace multibin;
 

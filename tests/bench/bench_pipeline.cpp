@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "multibin/PosePropagation.h"
+#include "multibin/geometry/PosePropagation.h"
 #include "multibin/sensors/StereoDisparity.h"
 
 using namespace multibin;

@@ -13,8 +13,8 @@
 #include <memory>
 #include <random>
 
-#include "multibin/BinGrid.h"
-#include "multibin/PosePropagation.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/geometry/PosePropagation.h"
 
 using namespace multibin;
 

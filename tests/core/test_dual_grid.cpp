@@ -7,7 +7,7 @@
 #include <map>
 #include <random>
 
-#include "multibin/BinGrid.h"
+#include "multibin/map/BinGrid.h"
 
 using namespace multibin;
 using mrpt::maps::CMultiBinElevationMap;

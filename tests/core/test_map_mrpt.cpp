@@ -12,12 +12,12 @@
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 #include <mrpt/random/RandomGenerators.h>
 #include <mrpt/serialization/CArchive.h>
-#include "multibin/StrictConfigSection.h"
+#include "multibin/io/StrictConfigSection.h"
 
 #include <Eigen/Dense>
 #include <random>
 
-#include "multibin/PosePropagation.h"
+#include "multibin/geometry/PosePropagation.h"
 #include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;

@@ -7,7 +7,7 @@
 #include <limits>
 #include <random>
 
-#include "multibin/VisibilityConstraint.h"
+#include "multibin/map/VisibilityConstraint.h"
 #include "test_scenes.h"
 
 using namespace multibin;

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "multibin/RasterExport.h"
+#include "multibin/io/RasterExport.h"
 #include "multibin/eval/Evaluation.h"
 
 using namespace multibin::eval;

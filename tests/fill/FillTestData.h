@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "multibin/EsriAsciiGrid.h"
+#include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/fill/HeightRaster.h"
 
 namespace multibin::filltest {

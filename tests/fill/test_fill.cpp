@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <random>
 
-#include "multibin/StrictConfigSection.h"
+#include "multibin/io/StrictConfigSection.h"
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/GaussianSurface.h"
 #include "multibin/fill/Kriging.h"

@@ -6,7 +6,7 @@
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include "multibin/ErrorMessage.h"
+#include "multibin/io/ErrorMessage.h"
 
 #include <cmath>
 #include <cstdint>

@@ -11,7 +11,7 @@
 #include <random>
 
 #include "mc_check.h"
-#include "multibin/PosePropagation.h"
+#include "multibin/geometry/PosePropagation.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/SensorDispatch.h"
 

@@ -13,7 +13,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "multibin/EsriAsciiGrid.h"
+#include "multibin/io/EsriAsciiGrid.h"
 
 namespace {
 const std::string kRawlogs = MULTIBIN_SOURCE_DIR "/rawlogs/";

@@ -12,7 +12,7 @@
 #include <limits>
 #include <vector>
 
-#include "multibin/PointsWithCovariance.h"
+#include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/StereoDisparity.h"
 #include "multibin/sensors/StereoModel.h"
 

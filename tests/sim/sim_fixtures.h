@@ -1,7 +1,7 @@
 /* Shared helpers of the terrain-sim tests. */
 #pragma once
 
-#include <multibin/EsriAsciiGrid.h>
+#include <multibin/io/EsriAsciiGrid.h>
 
 #include <Eigen/Core>
 

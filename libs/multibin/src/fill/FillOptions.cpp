@@ -6,7 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "multibin/StrictConfigSection.h"
+#include "multibin/io/StrictConfigSection.h"
 
 namespace multibin::fill {
 

@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/PosePropagation.h"
+#include "multibin/geometry/PosePropagation.h"
 
 #include <algorithm>
 #include <cmath>

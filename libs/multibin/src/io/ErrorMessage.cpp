@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/ErrorMessage.h"
+#include "multibin/io/ErrorMessage.h"
 
 #include <sstream>
 

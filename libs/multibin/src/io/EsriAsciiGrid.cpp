@@ -1,7 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/EsriAsciiGrid.h"
+#include "multibin/io/EsriAsciiGrid.h"
 
-#include "multibin/NumberText.h"
+#include "multibin/io/NumberText.h"
 
 #include <cmath>
 #include <cstdio>

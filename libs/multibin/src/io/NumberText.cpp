@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/NumberText.h"
+#include "multibin/io/NumberText.h"
 
 #include <cmath>
 #include <cstdlib>

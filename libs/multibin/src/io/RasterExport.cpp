@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library: raster exports (float TIFF, PLY mesh). */
-#include "multibin/RasterExport.h"
+#include "multibin/io/RasterExport.h"
 
 #include <array>
 #include <cmath>

@@ -1,7 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/StrictConfigSection.h"
+#include "multibin/io/StrictConfigSection.h"
 
-#include "multibin/NumberText.h"
+#include "multibin/io/NumberText.h"
 
 #include <algorithm>
 #include <cctype>

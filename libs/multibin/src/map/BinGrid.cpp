@@ -1,9 +1,9 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/BinGrid.h"
+#include "multibin/map/BinGrid.h"
 
 #include <array>
 
-#include "multibin/PosePropagation.h"
+#include "multibin/geometry/PosePropagation.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "multibin/StrictConfigSection.h"
+#include "multibin/io/StrictConfigSection.h"
 
 using namespace mrpt::maps;
 

@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "multibin/PosePropagation.h"
+#include "multibin/geometry/PosePropagation.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;

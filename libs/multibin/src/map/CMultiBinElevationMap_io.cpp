@@ -9,7 +9,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "multibin/RasterExport.h"
+#include "multibin/io/RasterExport.h"
 
 using namespace mrpt::maps;
 

@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/VisibilityConstraint.h"
+#include "multibin/map/VisibilityConstraint.h"
 
 #include <algorithm>
 #include <cmath>

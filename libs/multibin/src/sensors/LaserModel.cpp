@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "multibin/PosePropagation.h"
+#include "multibin/geometry/PosePropagation.h"
 
 namespace multibin::sensors {
 

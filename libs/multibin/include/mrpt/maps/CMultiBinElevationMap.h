@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "multibin/BinGrid.h"
-#include "multibin/EsriAsciiGrid.h"
-#include "multibin/VisibilityConstraint.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/VisibilityConstraint.h"
 #include "multibin/fill/FillOptions.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/sensors/SensorDispatch.h"

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "multibin/EsriAsciiGrid.h"
+#include "multibin/io/EsriAsciiGrid.h"
 
 namespace multibin::eval {
 

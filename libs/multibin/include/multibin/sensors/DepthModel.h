@@ -4,7 +4,7 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 
-#include "multibin/PointsWithCovariance.h"
+#include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
 
 namespace multibin::sensors {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "multibin/PointsWithCovariance.h"
+#include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
 
 namespace multibin::sensors {

@@ -12,8 +12,8 @@
 #include <memory>
 #include <string>
 
-#include "multibin/BinGrid.h"
-#include "multibin/PointsWithCovariance.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/LaserModel.h"
 #include "multibin/sensors/SensorModelOptions.h"

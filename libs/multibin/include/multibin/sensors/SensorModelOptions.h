@@ -7,7 +7,7 @@
 #include <map>
 #include <string>
 
-#include "multibin/StrictConfigSection.h"
+#include "multibin/io/StrictConfigSection.h"
 #include "multibin/sensors/RangeSigmaCurve.h"
 
 namespace multibin::sensors {

@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "multibin/PointsWithCovariance.h"
+#include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
 #include "multibin/sensors/StereoDisparity.h"
 

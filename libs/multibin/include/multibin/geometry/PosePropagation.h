@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "multibin/PointsWithCovariance.h"
+#include "multibin/geometry/PointsWithCovariance.h"
 
 namespace multibin {
 

@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 
-#include "multibin/BinGrid.h"
+#include "multibin/map/BinGrid.h"
 
 namespace multibin {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "multibin/EsriAsciiGrid.h"
+#include "multibin/io/EsriAsciiGrid.h"
 
 namespace multibin {
 

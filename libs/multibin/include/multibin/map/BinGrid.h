@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "multibin/PointsWithCovariance.h"
+#include "multibin/geometry/PointsWithCovariance.h"
 
 namespace multibin {
 
