@@ -7,7 +7,9 @@
 #include <limits>
 #include <vector>
 
+#include "multibin/geometry/Lattice.h"
 #include "multibin/geometry/PointsWithCovariance.h"
+#include "multibin/map/MapTypes.h"
 
 namespace multibin {
 
@@ -26,51 +28,8 @@ struct Bin {
 };
 static_assert(sizeof(Bin) == 24, "a bin must stay within 24 bytes");
 
-/** Parameters of the per-point bin update (eqs 13-15). */
-struct BinUpdateParams {
-    double binHeight_m = 0.05;               //!< vertical bin size [m]
-    float certaintyIncrement = 1.0f;         //!< `a` of eqs 13-14
-    double maxElevationUncertainty_m = 0.1;  //!< Delta_max: a point counts if 3 sigma_z <= this [m]
-    double varianceFloor_m2 = 0.002 * 0.002;  //!< reported variance never falls below this [m^2]
 
-    /** Eq 13 gate: a height with this variance [m^2] counts only if its 99.7 % interval
-     * (3 sigma) lies within Delta_max. */
-    bool passesEq13(double variance_m2) const {
-        return !(9.0 * variance_m2 > maxElevationUncertainty_m * maxElevationUncertainty_m);
-    }
-};
 
-/** What happened to the points of one insertion. */
-struct InsertStats {
-    size_t accepted = 0;            //!< fused into a bin
-    size_t outOfRange = 0;          //!< sensor reading invalid or outside the accepted range
-    size_t notFinite = 0;           //!< NaN/inf coordinates or covariance
-    size_t badCovariance = 0;       //!< covariance not symmetric positive-definite
-    size_t outsideMap = 0;          //!< (x, y) outside the grid window (after any growth)
-    size_t outsideBinRange = 0;     //!< height beyond the representable bin indices
-    size_t tooUncertain = 0;        //!< eq 13 gate: 3 sigma_z > Delta_max
-    size_t continuityRejected = 0;  //!< eq 14 gate: |h_m - h| > Delta_zmax on a certain bin
-    size_t rejected() const {
-        return outOfRange + notFinite + badCovariance + outsideMap + outsideBinRange +
-               tooUncertain + continuityRejected;
-    }
-    InsertStats& operator+=(const InsertStats& o);
-};
-
-/** Cell window in integer cell indices: cells ix0 .. ix0+nx-1, iy0 .. iy0+ny-1. Cell (ix, iy)
- * covers [ix, ix+1) x [iy, iy+1) * cellSize [m]: the lattice is anchored to the map origin, so
- * moving or growing the window never resamples a cell. */
-struct CellWindow {
-    int ix0 = 0, iy0 = 0;
-    int nx = 0, ny = 0;
-    bool contains(int ix, int iy) const {
-        return ix >= ix0 && iy >= iy0 && ix < ix0 + nx && iy < iy0 + ny;
-    }
-    size_t cellCount() const { return size_t(nx) * size_t(ny); }
-    bool operator==(const CellWindow& o) const {
-        return ix0 == o.ix0 && iy0 == o.iy0 && nx == o.nx && ny == o.ny;
-    }
-};
 
 /** The 2.5D grid of multi-bin cells with the shared insertion core.
  *

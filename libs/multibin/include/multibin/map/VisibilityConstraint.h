@@ -5,29 +5,11 @@
 #include <cstddef>
 
 #include "multibin/map/BinGrid.h"
+#include "multibin/map/MapTypes.h"
 
 namespace multibin {
 
-/** Parameters of the visibility constraint. */
-struct VisibilityParams {
-    bool enabled = true;
-    /** A bin conflicts with a line of sight when it lies above it by more than this plus 3 sigma
-     * of the bin [m]: cell-size relief and the ray's own uncertainty live in this margin. */
-    double margin_m = 0.02;
-    /** The fixed amount of certainty a conflicting bin loses for each new point it contradicts
-     * (each point whose line of sight it blocks, or which lies below it in its own cell): with
-     * the default equal to the certainty increment, a moved object is forgotten as fast as the
-     * new surface is learnt. */
-    float certaintyDecrement = 1.0f;
-};
 
-/** What one application of the constraint did. */
-struct VisibilityStats {
-    size_t raysCast = 0;      //!< one per distinct updated cell
-    size_t cellsVisited = 0;  //!< cells tested along the rays
-    size_t binsRemoved = 0;   //!< stale bins removed
-    size_t binsWeakened = 0;  //!< conflicting bins that lost certainty
-};
 
 /** The visibility constraint, applied after one observation updated `grid` (the cells of its
  * current update cycle), seen from `sensor_m` in the map frame:
