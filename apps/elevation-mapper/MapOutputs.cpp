@@ -8,6 +8,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -202,8 +203,17 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
         steps.emplace_back("elevation.3Dscene", [&] {
             mrpt::opengl::COpenGLScene scene;
             auto obj = mrpt::opengl::CSetOfObjects::Create();
-            map.getVisualizationInto(*obj);
+            multibin::buildTerrainView(map, sel.sceneColouring, *obj);
             scene.insert(obj);
+            // The first view: the whole map from above at an angle.
+            const auto& h = layers.height;
+            auto& camera = scene.getViewport("main")->getCamera();
+            camera.setPointingAt(0.5 * (h.xllcenter_m + h.xMax_m()),
+                                 0.5 * (h.yllcenter_m + h.yMax_m()), 0.0);
+            camera.setZoomDistance(
+                1.2 * std::max({h.xMax_m() - h.xllcenter_m, h.yMax_m() - h.yllcenter_m, 1.0}));
+            camera.setAzimuthDegrees(-60);
+            camera.setElevationDegrees(45);
             folder.write("elevation.3Dscene", gzSerialized(scene));
         });
     if (sel.png) {

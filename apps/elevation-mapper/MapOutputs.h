@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/TerrainView.h"
 
 /** What elevation-mapper writes (--outputs): a comma-separated list of groups. */
 struct OutputSelection {
@@ -20,6 +21,8 @@ struct OutputSelection {
     bool png = true;    //!< elevation_{height,sigma,source}.png: previews with legends
     bool asc = false;   //!< elevation_{height,sigma,certainty,source}.asc: ESRI ASCII rasters
     bool ply = false;   //!< elevation.ply: triangle mesh [m]
+    /** What colours the scene (--scene-colour). */
+    multibin::SceneColouring sceneColouring = multibin::SceneColouring::Height;
 
     static constexpr const char* kDefault = "map,tif,scene,png";
     /** One line per group for --help. */

@@ -45,7 +45,7 @@ namespace {
 struct Arguments {
     std::string config, section = "MappingApplication", rawlog, simplemap,
                         out = "elevation-mapper-out", groundTruth, profile, evalArea,
-                        outputs = OutputSelection::kDefault;
+                        outputs = OutputSelection::kDefault, sceneColour;
     bool withMrf = false, plots = true;
     bool usedDefaults = false;
 };
@@ -74,7 +74,11 @@ void printUsage() {
         << ")\n"
            "  --outputs LIST       comma-separated, or 'all' (default: "
         << d.outputs << ")\n"
-        << OutputSelection::help() << "                       Rasters cover the known cells plus "
+        << OutputSelection::help()
+        << "  --scene-colour NAME  colour of elevation.3Dscene: height, sigma, certainty or\n"
+           "                       source (default: height; sigma if the ini sets\n"
+           "                       color_by_sigma = true)\n"
+           "                       Rasters cover the known cells plus "
         << MapLayers::kMargin_cells
         << " cells. No input is ever\n"
            "                       overwritten; each file is written whole or not at all.\n"
@@ -105,10 +109,10 @@ Arguments parseArguments(int argc, char** argv) {
         return a;
     }
     std::map<std::string, std::string*> flags{
-        {"--config", &a.config},     {"--section", &a.section},          {"-s", &a.section},
-        {"--rawlog", &a.rawlog},     {"--simplemap", &a.simplemap},      {"--out", &a.out},
-        {"--outputs", &a.outputs},   {"--ground-truth", &a.groundTruth}, {"--profile", &a.profile},
-        {"--eval-area", &a.evalArea}};
+        {"--config", &a.config},      {"--section", &a.section},          {"-s", &a.section},
+        {"--rawlog", &a.rawlog},      {"--simplemap", &a.simplemap},      {"--out", &a.out},
+        {"--outputs", &a.outputs},    {"--ground-truth", &a.groundTruth}, {"--profile", &a.profile},
+        {"--eval-area", &a.evalArea}, {"--scene-colour", &a.sceneColour}};
     for (int i = 1; i < argc; i++) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
@@ -203,7 +207,7 @@ const std::vector<std::string> kEvaluationFiles{"report.json", "profile.csv",   
                                                 "fig_pi.png",  "fig_profile.png", "layers.png"};
 
 int run(const Arguments& args) {
-    const OutputSelection selection = OutputSelection::parse(args.outputs);
+    OutputSelection selection = OutputSelection::parse(args.outputs);
     const std::string inputName =
         args.rawlog.empty() ? "simplemap '" + args.simplemap + "'" : "rawlog '" + args.rawlog + "'";
     // Checked before the (long) mapping: no planned output may be one of the inputs.
@@ -226,6 +230,17 @@ int run(const Arguments& args) {
         throw std::runtime_error("config '" + args.config +
                                  "' defines no multiBinElevationMap in [" + args.section +
                                  "] (choose the section with --section)");
+
+    selection.sceneColouring = elevation->insertionOptions.color_by_sigma
+                                   ? multibin::SceneColouring::Sigma
+                                   : multibin::SceneColouring::Height;
+    if (!args.sceneColour.empty()) {
+        try {
+            selection.sceneColouring = multibin::sceneColouringFromName(args.sceneColour);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(std::string("--scene-colour: ") + e.what());
+        }
+    }
 
     std::unique_ptr<EvaluationRun> evaluation;
     if (!args.groundTruth.empty()) {
