@@ -155,11 +155,7 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
     const multibin::CellWindow& w = m_impl->grid.window();
-    multibin::EsriAsciiGrid g;
-    g.cellsize_m = m_impl->grid.cellSize_m();
-    g.xllcenter_m = m_impl->grid.cellCenter_m(w.ix0);
-    g.yllcenter_m = m_impl->grid.cellCenter_m(w.iy0);
-    g.heights_m.setConstant(w.ny, w.nx, NAN);
+    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             const int ix = w.ix0 + c, iy = w.iy0 + r;

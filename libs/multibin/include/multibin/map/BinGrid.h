@@ -28,9 +28,6 @@ struct Bin {
 };
 static_assert(sizeof(Bin) == 24, "a bin must stay within 24 bytes");
 
-
-
-
 /** The 2.5D grid of multi-bin cells with the shared insertion core.
  *
  * Storage is a circular buffer over the cell window (grid_map style): cell (ix, iy) lives in slot
@@ -46,6 +43,8 @@ public:
 
     double cellSize_m() const { return m_cellSize_m; }
     const CellWindow& window() const { return m_window; }
+    /** The grid's cells as the library's one lattice type (cell size and window). */
+    Lattice lattice() const { return Lattice{m_cellSize_m, m_window}; }
     /** Index of the cell containing a coordinate [m]; clamped far outside any window, so
      * absurd coordinates never overflow (NaN gives the upper limit). */
     int cellIndex(double coord_m) const {
