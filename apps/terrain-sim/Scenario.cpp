@@ -4,6 +4,7 @@
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
@@ -105,6 +106,7 @@ ScenarioSummary runScenario(const ScenarioConfig& cfg) {
          << "# frame t_s x_m y_m z_m yaw_rad pitch_rad roll_rad stereo\n";
     path << std::setprecision(9);
     std::vector<BeamTruth> beams;
+    mrpt::poses::CPose2D previousEstimate(frames.front().estimate.mean);
     for (size_t k = 0; k < frames.size(); ++k) {
         const Frame& f = frames[k];
         const auto stamp = syntheticStamp(f.t_s);
@@ -132,7 +134,18 @@ ScenarioSummary runScenario(const ScenarioConfig& cfg) {
             sfMap->insert(st);
             sum.stereoFrames++;
         }
-        mrpt::obs::CActionCollection acts;  // no odometry: the pose comes as ROBOT_POSE
+        // Odometry: the planar (x, y, yaw) increment of the pose estimate since the previous
+        // frame, so that
+        // RawLogViewer and MRPT's odometry-based tools show the path. The mapper takes its poses
+        // from ROBOT_POSE (mean and covariance), which overrides odometry.
+        mrpt::obs::CActionCollection acts;
+        mrpt::obs::CActionRobotMovement2D odo;
+        odo.timestamp = stamp;
+        const mrpt::poses::CPose2D estimate(f.estimate.mean);  // x, y, yaw
+        odo.computeFromOdometry(estimate - previousEstimate,
+                                mrpt::obs::CActionRobotMovement2D::TMotionModelOptions());
+        acts.insert(odo);
+        previousEstimate = estimate;
         rawArch << acts << *sf;
         simplemap.insert(mrpt::poses::CPose3DPDFGaussian::Create(f.estimate), sfMap);
         const auto& p = f.truth;
