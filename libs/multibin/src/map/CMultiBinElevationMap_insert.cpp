@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;
@@ -115,16 +116,18 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                                         obs.sensorLabel + "' has a NaN or infinite component");
     obs.load();  // externally stored observations
 
-    multibin::InsertStats sensorStats;  // rejections before the insertion core
     multibin::sensors::SensorPoints sensed;
     if (!multibin::sensors::observationToSensorPoints(
             obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-            insertionOptions.max_range_m, m_sensorState, sensorStats, sensed))
+            insertionOptions.max_range_m, m_sensorState, sensed))
         return false;  // not an observation this map models
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
     const double continuityBound_m = sensed.continuityBound_m;
-    m_stats += sensorStats;
+    // Rejections before the insertion core: the model's own counts, added up here.
+    m_sensorState.stats += sensed.stats;
+    m_stats.outOfRange += sensed.stats.outOfRange();
+    m_stats.notFinite += sensed.stats.notFinite();
     if (sensorPoints.empty()) return false;
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
