@@ -108,11 +108,10 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
 void EvaluationRun::insertRawPoints(const mrpt::obs::CObservation& obs,
                                     const mrpt::poses::CPose3DPDFGaussian& robotPose) {
     multibin::sensors::SensorPoints sp;
-    multibin::InsertStats ignored;
     const auto& io = m_evaluated.insertionOptions;
     if (!multibin::sensors::observationToSensorPoints(obs, robotPose, m_rawSensorOptions,
                                                       io.min_range_m, io.max_range_m,
-                                                      m_rawSensorState, ignored, sp))
+                                                      m_rawSensorState, sp))
         return;
     const mrpt::poses::CPose3D sensorInMap = robotPose.mean + sp.sensorPose;
     std::vector<mrpt::math::TPoint3D> points(sp.points.size());

@@ -9,6 +9,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/VisibilityConstraint.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;
@@ -117,16 +118,18 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                                         obs.sensorLabel + "' has a NaN or infinite component");
     obs.load();  // externally stored observations
 
-    multibin::InsertStats sensorStats;  // rejections before the insertion core
     multibin::sensors::SensorPoints sensed;
     if (!multibin::sensors::observationToSensorPoints(
             obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-            insertionOptions.max_range_m, m_impl->sensorState, sensorStats, sensed))
+            insertionOptions.max_range_m, m_impl->sensorState, sensed))
         return false;  // not an observation this map models
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
     const double continuityBound_m = sensed.continuityBound_m;
-    m_impl->stats += sensorStats;
+    // Rejections before the insertion core: the model's own counts, added up here.
+    m_impl->sensorState.stats += sensed.stats;
+    m_impl->stats.outOfRange += sensed.stats.outOfRange();
+    m_impl->stats.notFinite += sensed.stats.notFinite();
     if (sensorPoints.empty()) return false;
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);

@@ -10,14 +10,6 @@
 
 namespace multibin::sensors {
 
-DepthStats& DepthStats::operator+=(const DepthStats& o) {
-    points += o.points;
-    notFinite += o.notFinite;
-    outOfRange += o.outOfRange;
-    kept += o.kept;
-    return *this;
-}
-
 SymmetricCov3 depthPointCovariance(const Eigen::Vector3f& p_m, const DepthModelOptions& opts) {
     const double r = p_m.cast<double>().norm();
     const Eigen::Vector3d d = p_m.cast<double>() / r;

@@ -1,12 +1,16 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/SensorModelOptions.h"
 
+#include <mrpt/config/CConfigFileBase.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
+
+#include "multibin/io/StrictConfigSection.h"
 
 namespace multibin::sensors {
 

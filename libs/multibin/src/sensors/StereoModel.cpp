@@ -453,4 +453,40 @@ StereoPixelCounts StereoCovarianceTable::appendPoints(const DisparityImage& disp
     return counts;
 }
 
+void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const StereoModelOptions& opts,
+                    double minRange_m, double maxRange_m,
+                    std::shared_ptr<const StereoCovarianceTable>& table, PointsWithCov& out,
+                    StereoStats& stats) {
+    const StereoGeometry g = StereoGeometry::fromObservation(obs);
+    DisparityImage disp;
+    if (obs.hasImageDisparity) {
+        disp = decodeDisparityImage(obs.imageDisparity);
+    } else {
+        if (!obs.hasImageRight)
+            throw std::invalid_argument(
+                "CObservationStereoImages '" + obs.sensorLabel +
+                "': neither a disparity image nor a right image (hasImageRight = false)");
+        disp = computeDisparitySGBM(obs.imageLeft, obs.imageRight, opts);
+    }
+    if (disp.width != g.width || disp.height != g.height)
+        throw std::invalid_argument("CObservationStereoImages '" + obs.sensorLabel +
+                                    "': image size differs from leftCamera's ncols x nrows");
+    if (opts.haloFilter) stats.halo += removeHalos(disp, opts);
+    if (opts.nearClusterFilter) stats.nearCluster += removeNearClusters(disp, opts);
+
+    if (!table || !table->matches(g, opts)) {
+        table = std::make_shared<const StereoCovarianceTable>(g, opts);
+        stats.tableBuilds++;
+    }
+    stats.pairs++;
+    out.clear();
+    const StereoPixelCounts c =
+        table->appendPoints(disp, opts.subsample, opts.minDepth_m, minRange_m, maxRange_m, out);
+    stats.pixels += c.pixels;
+    stats.noDisparity += c.noDisparity;
+    stats.tooNear += c.tooNear;
+    stats.outOfRange += c.outOfRange;
+    stats.kept += c.kept;
+}
+
 }  // namespace multibin::sensors

@@ -1,14 +1,18 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
-#include <mrpt/config/CConfigFileBase.h>
-
 #include <array>
 #include <map>
 #include <string>
 
-#include "multibin/io/StrictConfigSection.h"
 #include "multibin/sensors/RangeSigmaCurve.h"
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+namespace multibin {
+class StrictConfigSection;
+}
 
 namespace multibin::sensors {
 

@@ -4,10 +4,12 @@
 #include <mrpt/obs/CObservationStereoImages.h>
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
+#include "multibin/sensors/SensorStats.h"
 #include "multibin/sensors/StereoDisparity.h"
 
 namespace multibin::sensors {
@@ -103,5 +105,17 @@ private:
     std::vector<float> m_luu, m_luv, m_lvv;
     std::vector<double> m_rightVar;
 };
+
+/** Points with covariance of a stereo pair in the LEFT camera frame (MRPT camera frame): disparity
+ * from the observation's disparity image if present (see decodeDisparityImage()), else OpenCV
+ * StereoSGBM; halo and near-cluster filters; every `subsample`-th pixel; eqs 4-10 for the
+ * covariance, through `table`: the per-pixel table of this camera that the caller keeps between
+ * pairs, (re)built here when the calibration or the sigmas change. What was done with the pixels
+ * is added to `stats`. Throws std::invalid_argument naming the observation if it has neither a
+ * disparity image nor a right image, or if the image size differs from its calibration. */
+void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const StereoModelOptions& opts,
+                    double minRange_m, double maxRange_m,
+                    std::shared_ptr<const StereoCovarianceTable>& table, PointsWithCov& out,
+                    StereoStats& stats);
 
 }  // namespace multibin::sensors
