@@ -136,7 +136,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
     if (isDualGrid()) {
         recenter(robotPose.mean.x(), robotPose.mean.y());
-    } else if (growthNeeded(sensorPoints, robotPose.mean + sensorPose, propagator)) {
+    } else if (growthNeeded(sensorPoints, propagator)) {
         // Growth is sized by all map-frame points: propagate them first (the rare case).
         PointsWithCov mapPoints;
         propagator.apply(sensorPoints, mapPoints);
@@ -160,7 +160,6 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
 }
 
 bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
-                                         const mrpt::poses::CPose3D& sensorInMap,
                                          const multibin::PosePropagator& propagator) const {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || sensorPoints.empty()) return false;
@@ -174,10 +173,8 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     const double cell = m_impl->grid.cellSize_m(), half = 0.5 * c.max_size_m;
     const double x0 = w.ix0 * cell, x1 = (w.ix0 + w.nx) * cell;
     const double y0 = w.iy0 * cell, y1 = (w.iy0 + w.ny) * cell;
-    const Eigen::Matrix3d R = sensorInMap.getRotationMatrix().asEigen();
-    const double tx = sensorInMap.x(), ty = sensorInMap.y();
-    const double tNorm = std::abs(tx) + std::abs(ty) + std::abs(sensorInMap.z());
     const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
+    const double tNorm = s.cwiseAbs().sum();
     const multibin::BinUpdateParams params = binUpdateParams();
     constexpr size_t kBatch = 256;
     PointWithCov exact[kBatch];
@@ -195,14 +192,11 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
         return grows;
     };
     // Scalar code: about 20 instructions a point, most points leave at the first test.
-    const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2);
-    const double r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2);
     for (const PointWithCov& p : sensorPoints) {
-        const double px = p.point_m.x(), py = p.point_m.y(), pz = p.point_m.z();
-        const double qx = r00 * px + r01 * py + r02 * pz + tx;
-        const double qy = r10 * px + r11 * py + r12 * pz + ty;
-        const double slack =
-            1e-4 + 1e-5 * (std::abs(px) + std::abs(py) + std::abs(pz) + tNorm);  // [m]
+        const Eigen::Vector2d q = propagator.horizontalInMap_m(p.point_m);
+        const double qx = q.x(), qy = q.y();
+        const double slack = 1e-4 + 1e-5 * (std::abs(p.point_m.x()) + std::abs(p.point_m.y()) +
+                                            std::abs(p.point_m.z()) + tNorm);  // [m]
         if (qx - slack >= x0 && qx + slack <= x1 && qy - slack >= y0 && qy + slack <= y1)
             continue;  // clearly inside the window
         if (std::abs(qx - s.x()) > half + slack || std::abs(qy - s.y()) > half + slack)

@@ -9,8 +9,6 @@
 
 namespace multibin {
 
-
-
 /** The visibility constraint, applied after one observation updated `grid` (the cells of its
  * current update cycle), seen from `sensor_m` in the map frame:
  *
