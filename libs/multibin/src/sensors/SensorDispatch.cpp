@@ -4,27 +4,58 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRotatingScan.h>
 #include <mrpt/obs/CObservationStereoImages.h>
+#include <mrpt/obs/CObservationVelodyneScan.h>
 #include <mrpt/system/datetime.h>
 
 #include <cmath>
+#include <initializer_list>
+#include <stdexcept>
+#include <string>
 
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/LaserModel.h"
+#include "multibin/sensors/LidarModel.h"
 #include "multibin/sensors/StereoModel.h"
 
 namespace multibin::sensors {
+
+namespace {
+/** The model chosen for `obs` (its label's entry in sensor_models, else `classDefault`), which must
+ * be one of `allowed`. */
+SensorModelKind chooseModel(const mrpt::obs::CObservation& obs, const SensorModelOptions& opts,
+                            SensorModelKind classDefault,
+                            std::initializer_list<SensorModelKind> allowed) {
+    const SensorModelKind kind = opts.modelFor(obs.sensorLabel, classDefault);
+    for (SensorModelKind k : allowed)
+        if (k == kind) return kind;
+    std::string names;
+    for (SensorModelKind k : allowed)
+        names += std::string(names.empty() ? "" : " or ") + sensorModelName(k);
+    throw std::invalid_argument("CMultiBinElevationMap insertion option 'sensor_models': label '" +
+                                obs.sensorLabel + "' is given the " + sensorModelName(kind) +
+                                " model, but its observation is a " +
+                                obs.GetRuntimeClass()->className + ", which takes " + names);
+}
+}  // namespace
 
 bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
                                const mrpt::poses::CPose3DPDFGaussian& robotPose,
                                const SensorModelOptions& opts, double minRange_m, double maxRange_m,
                                SensorModelState& state, SensorPoints& out) {
+    using K = SensorModelKind;
     out.points.clear();
     out.continuityBound_m = std::numeric_limits<double>::infinity();
     out.stats = {};
     if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
-        laserScanToPoints(*scan, opts.laser, minRange_m, maxRange_m, out.points, out.stats.laser);
         out.sensorPose = scan->sensorPose;
+        if (chooseModel(obs, opts, K::laser, {K::laser, K::lidar}) == K::lidar) {
+            lidarScanToPoints(*scan, opts.lidar, minRange_m, maxRange_m, out.points,
+                              out.stats.lidar);
+            return true;
+        }
+        laserScanToPoints(*scan, opts.laser, minRange_m, maxRange_m, out.points, out.stats.laser);
         if (opts.laser.continuity) {
             const auto prev = state.previousScan.find(scan->sensorLabel);
             const bool timesKnown = prev != state.previousScan.end() &&
@@ -40,19 +71,47 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
         return true;
     }
     if (const auto* stereo = dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs)) {
+        chooseModel(obs, opts, K::stereo, {K::stereo});
         stereoToPoints(*stereo, opts.stereo, minRange_m, maxRange_m,
                        state.stereoTables[stereo->sensorLabel], out.points, out.stats.stereo);
         out.sensorPose = mrpt::poses::CPose3D(stereo->cameraPose);  // left camera on the robot
         return true;
     }
     if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
+        chooseModel(obs, opts, K::depth, {K::depth});
         depthScanToPoints(*depth, opts.depth, minRange_m, maxRange_m, out.points, out.stats.depth);
         out.sensorPose = depth->sensorPose;
         return true;
     }
     if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
-        pointCloudToPoints(*cloud, opts.depth, minRange_m, maxRange_m, out.points, out.stats.depth);
         out.sensorPose = cloud->sensorPose;
+        switch (chooseModel(obs, opts, K::depth, {K::depth, K::lidar, K::stereo})) {
+            case K::lidar:
+                lidarCloudToPoints(*cloud, opts.lidar, minRange_m, maxRange_m, out.points,
+                                   out.stats.lidar);
+                break;
+            case K::stereo:
+                stereoCloudToPoints(*cloud, opts.stereo, minRange_m, maxRange_m, out.points,
+                                    out.stats.stereo);
+                break;
+            default:
+                pointCloudToPoints(*cloud, opts.depth, minRange_m, maxRange_m, out.points,
+                                   out.stats.depth);
+        }
+        return true;
+    }
+    if (const auto* velodyne = dynamic_cast<const mrpt::obs::CObservationVelodyneScan*>(&obs)) {
+        chooseModel(obs, opts, K::lidar, {K::lidar});
+        velodyneScanToPoints(*velodyne, opts.lidar, minRange_m, maxRange_m, out.points,
+                             out.stats.lidar);
+        out.sensorPose = velodyne->sensorPose;
+        return true;
+    }
+    if (const auto* rotating = dynamic_cast<const mrpt::obs::CObservationRotatingScan*>(&obs)) {
+        chooseModel(obs, opts, K::lidar, {K::lidar});
+        rotatingScanToPoints(*rotating, opts.lidar, minRange_m, maxRange_m, out.points,
+                             out.stats.lidar);
+        out.sensorPose = rotating->sensorPose;
         return true;
     }
     return false;

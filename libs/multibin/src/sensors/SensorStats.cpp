@@ -18,6 +18,7 @@ StereoStats& StereoStats::operator+=(const StereoStats& o) {
     pairs += o.pairs;
     tableBuilds += o.tableBuilds;
     pixels += o.pixels;
+    notFinite += o.notFinite;
     noDisparity += o.noDisparity;
     halo += o.halo;
     nearCluster += o.nearCluster;
@@ -35,18 +36,32 @@ DepthStats& DepthStats::operator+=(const DepthStats& o) {
     return *this;
 }
 
+LidarStats& LidarStats::operator+=(const LidarStats& o) {
+    scans += o.scans;
+    returns += o.returns;
+    noReturn += o.noReturn;
+    notDecoded += o.notDecoded;
+    notFinite += o.notFinite;
+    outOfRange += o.outOfRange;
+    kept += o.kept;
+    return *this;
+}
+
 SensorModelStats& SensorModelStats::operator+=(const SensorModelStats& o) {
     laser += o.laser;
     stereo += o.stereo;
     depth += o.depth;
+    lidar += o.lidar;
     return *this;
 }
 
 size_t SensorModelStats::outOfRange() const {
     return laser.noReturn + laser.outOfRange + stereo.tooNear + stereo.outOfRange +
-           depth.outOfRange;
+           depth.outOfRange + lidar.noReturn + lidar.notDecoded + lidar.outOfRange;
 }
 
-size_t SensorModelStats::notFinite() const { return laser.notFinite + depth.notFinite; }
+size_t SensorModelStats::notFinite() const {
+    return laser.notFinite + stereo.notFinite + depth.notFinite + lidar.notFinite;
+}
 
 }  // namespace multibin::sensors

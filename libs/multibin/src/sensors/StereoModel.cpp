@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/StereoModel.h"
 
+#include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/poses/CPose3D.h>
 
 #include <Eigen/Geometry>
@@ -11,6 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <utility>
+
+#include "RayPoint.h"
 
 namespace multibin::sensors {
 
@@ -487,6 +490,21 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
     stats.tooNear += c.tooNear;
     stats.outOfRange += c.outOfRange;
     stats.kept += c.kept;
+}
+
+void stereoCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
+                         const StereoModelOptions& opts, double minRange_m, double maxRange_m,
+                         PointsWithCov& out, StereoStats& stats) {
+    out.clear();
+    stats.pairs++;
+    if (!cloud.pointcloud) return;
+    const double f = opts.cloudFocalLength_px, sm = opts.matchingSigma_px;
+    const double axialPerR2 = std::sqrt(2.0) * sm / (f * opts.cloudBaseline_m);  // [1/m]
+    auto sigmas = [&](double r) { return std::pair{axialPerR2 * r * r, r * sm / f}; };
+    forEachCloudPoint(*cloud.pointcloud, out, [&](const Eigen::Vector3f& p) {
+        stats.pixels++;
+        count(appendRayPoint(p, minRange_m, maxRange_m, sigmas, out), stats);
+    });
 }
 
 }  // namespace multibin::sensors

@@ -52,11 +52,14 @@ struct SensorPoints {
 };
 
 /** The sensor-model step of CMultiBinElevationMap: observation -> sensor-frame points with 3x3
- * covariances. Handles CObservation2DRangeScan (laser model and eq 14 bound from the previous scan
- * of the same label), CObservationStereoImages, CObservation3DRangeScan and
- * CObservationPointCloud (depth model). Invalid, NaN and out-of-range readings are counted in
- * out.stats; the caller adds them up. Returns false for observations that no model handles.
- * `robotPose` is the robot pose PDF of the observation. */
+ * covariances, by the model its label is given in opts.modelByLabel (else its class's default):
+ * CObservation2DRangeScan (laser, with eq 14's bound from the previous scan of the same label;
+ * or lidar), CObservationStereoImages (stereo), CObservation3DRangeScan (depth),
+ * CObservationPointCloud (depth, lidar or stereo), CObservationVelodyneScan and
+ * CObservationRotatingScan (lidar). Invalid, NaN and out-of-range readings are counted in
+ * out.stats; the caller adds them up. Returns false for observations that no model handles;
+ * throws std::invalid_argument naming the key `sensor_models` for a model its observation class
+ * cannot take. `robotPose` is the robot pose PDF of the observation. */
 bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
                                const mrpt::poses::CPose3DPDFGaussian& robotPose,
                                const SensorModelOptions& opts, double minRange_m, double maxRange_m,
