@@ -9,9 +9,7 @@
 
 namespace multibin {
 
-bool cellSurface(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& p,
-                 CellSurface& out) {
-    const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
+bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, CellSurface& out) {
     const Bin* win = grid.winningBin(ix, iy);
     if (!win) return false;
     const double floor_m2 = p.varianceFloor_m2;

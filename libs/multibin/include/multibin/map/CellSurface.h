@@ -21,9 +21,15 @@ struct CellSurface {
     int firstBin = 0, lastBin = 0;  //!< the bin indices merged into the surface
 };
 
-/** The surface of the cell of `grid` containing (x_m, y_m); false if it holds no certain bin. */
-bool cellSurface(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& params,
+/** The surface of cell (ix, iy) of `grid`; false if it holds no certain bin (or lies outside
+ * the window). */
+bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& params,
                  CellSurface& out);
+/** The same for the cell containing (x_m, y_m). */
+inline bool cellSurface(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& params,
+                        CellSurface& out) {
+    return cellSurface(grid, grid.cellIndex(x_m), grid.cellIndex(y_m), params, out);
+}
 
 /** Adds the relief of the cell to its variance [m^2]: the map gives one height per cell, the
  * points sample parts of it, and over a cell of side s on a slope g the heights spread with
