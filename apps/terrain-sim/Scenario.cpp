@@ -68,7 +68,31 @@ std::string mapperIni(const ScenarioConfig& cfg) {
     return o.str();
 }
 
+void applyIndependentNoise(ScenarioConfig& cfg) {
+    for (ErrorShape* e : {&cfg.laser.errors, &cfg.stereo.errors}) {
+        e->tailDof = 4;
+        e->outlierFraction = 0.01;
+        e->outlierSpan = 0.5;
+    }
+    cfg.laser.rangeBias0_m = -0.002;
+    cfg.laser.rangeBiasSlope = 0.01;
+    cfg.laser.mixedProbability = 1.0;
+    cfg.laser.mixedJump_m = 0.015;
+    cfg.laser.pitchError_rad = 0.3 * M_PI / 180.0;
+    cfg.stereo.mixedProbability = 0.5;
+    cfg.stereo.baselineError_m = 0.0003;
+    cfg.stereo.cxError_px = 0.5;
+    cfg.stereo.cyError_px = 0.5;
+}
+
 ScenarioSummary runScenario(const ScenarioConfig& cfg) {
+    cfg.laser.errors.validate("laser");
+    cfg.stereo.errors.validate("stereo");
+    if (!(cfg.laser.mixedProbability >= 0 && cfg.laser.mixedProbability <= 1) ||
+        !(cfg.stereo.mixedProbability >= 0 && cfg.stereo.mixedProbability <= 1))
+        throw std::invalid_argument("mixed-pixel probability must be in [0, 1]");
+    if (!(cfg.laser.mixedJump_m > 0))
+        throw std::invalid_argument("laser mixed-pixel jump must be > 0");
     if (cfg.outPrefix.empty()) throw std::invalid_argument("no output prefix (--out) given");
     if (cfg.terrainFiles.empty()) throw std::invalid_argument("no terrain file (--terrain) given");
     if (cfg.scenario != "mockup" && cfg.scenario != "walk")

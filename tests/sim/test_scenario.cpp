@@ -211,6 +211,14 @@ TEST(TerrainSimCli, BadArgumentsGiveOneLineErrorAndExit1) {
         {"--terrain " + board + " --scenario walk --gt-cell 5 --out " + (d / "g").string(),
          "larger than the terrain"},
         {"--terrain " + board + " --scenario walk --out /nonexistent/dir/x", "cannot write"},
+        {"--terrain " + board + " --scenario walk --noise loud --out x",
+         "not matched or independent"},
+        {"--terrain " + board + " --scenario walk --tail-dof 2 --out x", "--tail-dof"},
+        {"--terrain " + board + " --scenario walk --outliers 1.5 --out x", "--outliers"},
+        {"--terrain " + board + " --scenario walk --laser-range-bias 0.01 --out x",
+         "--laser-range-bias"},
+        {"--terrain " + board + " --scenario walk --stereo-principal-point-error a,1 --out x",
+         "--stereo-principal-point-error"},
     };
     for (const auto& [args, expect] : cases) {
         std::string out;
