@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "multibin/eval/Evaluation.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 /** Builds, side by side and from the same points, the maps that `--ground-truth` compares:
  * - raw_laser, raw_all: the range points simply registered in the grid (eq 17's raw map), from

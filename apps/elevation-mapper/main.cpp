@@ -33,6 +33,7 @@
 #include "EvaluationRun.h"
 #include "ProgressBar.h"
 #include "RawlogSource.h"
+#include "multibin/fill/HeightRaster.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
 

@@ -13,8 +13,9 @@
 #include <memory>
 #include <random>
 
-#include "multibin/map/BinGrid.h"
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin;
 

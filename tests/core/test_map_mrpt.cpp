@@ -18,6 +18,7 @@
 #include <random>
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/BinGrid.h"
 #include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "multibin/io/RasterExport.h"
 #include "multibin/eval/Evaluation.h"
+#include "multibin/io/RasterExport.h"
 
 using namespace multibin::eval;
 

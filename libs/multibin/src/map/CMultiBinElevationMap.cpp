@@ -1,7 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
-#include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 #include <mrpt/rtti/CObject.h>
+#include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
 #include <sstream>
@@ -254,10 +254,46 @@ mrpt::maps::CMetricMap* CMultiBinElevationMap::internal_CreateFromMapDefinition(
 // ---------------------------------------------------------------------------------------------
 // Construction, queries
 // ---------------------------------------------------------------------------------------------
-CMultiBinElevationMap::CMultiBinElevationMap() { setCreationOptions(TCreationOptions()); }
+CMultiBinElevationMap::CMultiBinElevationMap() : m_impl(std::make_unique<Impl>()) {
+    setCreationOptions(TCreationOptions());
+}
 
-CMultiBinElevationMap::CMultiBinElevationMap(const TCreationOptions& creation) {
+CMultiBinElevationMap::CMultiBinElevationMap(const TCreationOptions& creation)
+    : m_impl(std::make_unique<Impl>()) {
     setCreationOptions(creation);
+}
+
+CMultiBinElevationMap::CMultiBinElevationMap(const CMultiBinElevationMap& other)
+    : CMetricMap(other),
+      CHeightGridMap2D_Base(other),
+      creationOptions(other.creationOptions),
+      insertionOptions(other.insertionOptions),
+      m_impl(std::make_unique<Impl>(*other.m_impl)) {}
+
+CMultiBinElevationMap& CMultiBinElevationMap::operator=(const CMultiBinElevationMap& other) {
+    if (this == &other) return *this;
+    CMetricMap::operator=(other);
+    CHeightGridMap2D_Base::operator=(other);
+    creationOptions = other.creationOptions;
+    insertionOptions = other.insertionOptions;
+    *m_impl = *other.m_impl;
+    return *this;
+}
+
+CMultiBinElevationMap::~CMultiBinElevationMap() = default;
+
+const multibin::BinGrid& CMultiBinElevationMap::grid() const { return m_impl->grid; }
+const multibin::BinGrid& CMultiBinElevationMap::localGrid() const { return m_impl->local; }
+bool CMultiBinElevationMap::fillIsStale() const { return m_impl->fillStale; }
+const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const { return m_impl->fill; }
+const multibin::InsertStats& CMultiBinElevationMap::insertStats() const { return m_impl->stats; }
+const multibin::VisibilityStats& CMultiBinElevationMap::visibilityStats() const {
+    return m_impl->visibilityStats;
+}
+size_t CMultiBinElevationMap::poseFallbackCount() const { return m_impl->poseFallbacks; }
+size_t CMultiBinElevationMap::skippedByLabelCount() const { return m_impl->skippedByLabel; }
+const multibin::sensors::SensorModelStats& CMultiBinElevationMap::sensorModelStats() const {
+    return m_impl->sensorState.stats;
 }
 
 void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation) {
@@ -283,21 +319,21 @@ void CMultiBinElevationMap::internal_clear() {
         };
         const int nl = side(c.local_size_m, c.local_resolution_m);
         const int ng = side(c.global_size_m, c.global_resolution_m);
-        m_local.reset(c.local_resolution_m, multibin::CellWindow{-nl / 2, -nl / 2, nl, nl});
-        m_grid.reset(c.global_resolution_m, multibin::CellWindow{-ng / 2, -ng / 2, ng, ng});
+        m_impl->local.reset(c.local_resolution_m, multibin::CellWindow{-nl / 2, -nl / 2, nl, nl});
+        m_impl->grid.reset(c.global_resolution_m, multibin::CellWindow{-ng / 2, -ng / 2, ng, ng});
     } else {
-        m_grid.reset(res, w);
-        m_local.reset(res, multibin::CellWindow{});
+        m_impl->grid.reset(res, w);
+        m_impl->local.reset(res, multibin::CellWindow{});
     }
-    m_stats = {};
-    m_visibilityStats = {};
-    m_poseFallbacks = 0;
-    m_skippedByLabel = 0;
-    m_lastRobotPose.reset();
-    m_sensorState.reset();
-    m_fill = {};
-    m_fillWindow = {};
-    m_fillStale = true;
+    m_impl->stats = {};
+    m_impl->visibilityStats = {};
+    m_impl->poseFallbacks = 0;
+    m_impl->skippedByLabel = 0;
+    m_impl->lastRobotPose.reset();
+    m_impl->sensorState.reset();
+    m_impl->fill = {};
+    m_impl->fillWindow = {};
+    m_impl->fillStale = true;
 }
 
 multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
@@ -392,12 +428,12 @@ bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
     const multibin::BinUpdateParams p = binUpdateParams();
     CellSurface g, l;
-    const bool haveG = cellSurface(m_grid, x_m, y_m, p, g);
-    const bool haveL = isDualGrid() && cellSurface(m_local, x_m, y_m, p, l);
+    const bool haveG = cellSurface(m_impl->grid, x_m, y_m, p, g);
+    const bool haveL = isDualGrid() && cellSurface(m_impl->local, x_m, y_m, p, l);
     if (!haveG && !haveL) return false;
     if (insertionOptions.relief_sigma) {
-        if (haveG) addReliefVariance(m_grid, x_m, y_m, p, g);
-        if (haveL) addReliefVariance(m_local, x_m, y_m, p, l);
+        if (haveG) addReliefVariance(m_impl->grid, x_m, y_m, p, g);
+        if (haveL) addReliefVariance(m_impl->local, x_m, y_m, p, l);
     }
     if (!haveG || !haveL) {
         const CellSurface& c = haveG ? g : l;
@@ -420,24 +456,30 @@ bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
     return true;
 }
 
-bool CMultiBinElevationMap::isEmpty() const { return m_grid.empty() && m_local.empty(); }
+bool CMultiBinElevationMap::isEmpty() const {
+    return m_impl->grid.empty() && m_impl->local.empty();
+}
 
 std::string CMultiBinElevationMap::asString() const {
     std::ostringstream os;
-    os << "CMultiBinElevationMap: " << m_grid.window().nx << " x " << m_grid.window().ny
-       << " cells of " << m_grid.cellSize_m() << " m, x in [" << getXMin() << ", " << getXMax()
-       << "], y in [" << getYMin() << ", " << getYMax() << "] m, " << m_grid.binCount()
-       << " bins of " << creationOptions.bin_height_m << " m";
+    os << "CMultiBinElevationMap: " << m_impl->grid.window().nx << " x " << m_impl->grid.window().ny
+       << " cells of " << m_impl->grid.cellSize_m() << " m, x in [" << getXMin() << ", "
+       << getXMax() << "], y in [" << getYMin() << ", " << getYMax() << "] m, "
+       << m_impl->grid.binCount() << " bins of " << creationOptions.bin_height_m << " m";
     return os.str();
 }
 
-double CMultiBinElevationMap::getXMin() const { return m_grid.window().ix0 * m_grid.cellSize_m(); }
-double CMultiBinElevationMap::getXMax() const {
-    return (m_grid.window().ix0 + m_grid.window().nx) * m_grid.cellSize_m();
+double CMultiBinElevationMap::getXMin() const {
+    return m_impl->grid.window().ix0 * m_impl->grid.cellSize_m();
 }
-double CMultiBinElevationMap::getYMin() const { return m_grid.window().iy0 * m_grid.cellSize_m(); }
+double CMultiBinElevationMap::getXMax() const {
+    return (m_impl->grid.window().ix0 + m_impl->grid.window().nx) * m_impl->grid.cellSize_m();
+}
+double CMultiBinElevationMap::getYMin() const {
+    return m_impl->grid.window().iy0 * m_impl->grid.cellSize_m();
+}
 double CMultiBinElevationMap::getYMax() const {
-    return (m_grid.window().iy0 + m_grid.window().ny) * m_grid.cellSize_m();
+    return (m_impl->grid.window().iy0 + m_impl->grid.window().ny) * m_impl->grid.cellSize_m();
 }
 
 float CMultiBinElevationMap::compute3DMatchingRatio(const mrpt::maps::CMetricMap*,
@@ -471,6 +513,6 @@ bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y
     return insertPoints(pts).accepted == 1;
 }
 
-double CMultiBinElevationMap::dem_get_resolution() const { return m_grid.cellSize_m(); }
-size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_grid.window().nx); }
-size_t CMultiBinElevationMap::dem_get_size_y() const { return size_t(m_grid.window().ny); }
+double CMultiBinElevationMap::dem_get_resolution() const { return m_impl->grid.cellSize_m(); }
+size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_impl->grid.window().nx); }
+size_t CMultiBinElevationMap::dem_get_size_y() const { return size_t(m_impl->grid.window().ny); }

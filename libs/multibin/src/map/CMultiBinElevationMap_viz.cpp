@@ -1,11 +1,13 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: 3D visualization with stock mrpt::opengl classes only, so a saved
  * .3Dscene opens in programs that do not load this library. */
-#include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/opengl/CMesh.h>
 #include <mrpt/opengl/CSetOfObjects.h>
+#include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
+
+#include "multibin/io/EsriAsciiGrid.h"
 
 using namespace mrpt::maps;
 
