@@ -60,20 +60,24 @@ std::string gigabytes(uint64_t bytes) {
     return b;
 }
 
-/** Reads one object under the read budget; a refused allocation becomes an error saying so. */
+/** Reads one object under the read budget; a refused allocation becomes an error saying so
+ * (built after the budget ends: the budget is spent by then). */
 mrpt::serialization::CSerializable::Ptr readBounded(mrpt::serialization::CArchive& arch,
                                                     uint64_t bytesLeft, const std::string& where) {
-    ReadBudget budget(ReadBudget::limitFor(bytesLeft));
-    try {
-        return arch.ReadObject();
-    } catch (const std::exception&) {
-        if (const uint64_t asked = ReadBudget::largestRefused(); asked > 0)
-            throw std::runtime_error(
-                where + " declares more data than the file holds: reading it asked for " +
-                gigabytes(asked) + ", more than 64 MiB + 16 x the " + std::to_string(bytesLeft) +
-                " bytes left");
-        throw;
+    uint64_t asked = 0;
+    {
+        ReadBudget budget(ReadBudget::limitFor(bytesLeft));
+        try {
+            return arch.ReadObject();
+        } catch (const std::exception&) {
+            asked = ReadBudget::largestRefused();
+            if (asked == 0) throw;
+        }
     }
+    throw std::runtime_error(where +
+                             " declares more data than the file holds: reading it asked for " +
+                             gigabytes(asked) + " in all, more than 64 MiB + 16 x the " +
+                             std::to_string(bytesLeft) + " bytes left");
 }
 
 bool finitePose(const mrpt::poses::CPose3D& p) {
@@ -202,21 +206,24 @@ mrpt::maps::CSimpleMap RawlogSource::loadSimplemap(const std::string& path) {
 mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const std::string& name,
                                                    uint64_t sizeBound_bytes) {
     mrpt::maps::CSimpleMap sm;
-    {
+    uint64_t asked = 0;
+    try {
         ReadBudget budget(ReadBudget::limitFor(sizeBound_bytes));
         try {
             auto arch = mrpt::serialization::archiveFrom(in);
             arch >> sm;
-        } catch (const std::exception& e) {
-            if (const uint64_t asked = ReadBudget::largestRefused(); asked > 0)
-                throw std::runtime_error(
-                    name + " declares more data than the file holds: reading it asked for " +
-                    gigabytes(asked) + ", more than 64 MiB + 16 x its " +
-                    std::to_string(sizeBound_bytes) + " bytes");
-            throw std::runtime_error(name +
-                                     " is truncated or corrupt: " + multibin::oneLineMessage(e));
+        } catch (const std::exception&) {
+            asked = ReadBudget::largestRefused();
+            if (asked == 0) throw;
         }
+    } catch (const std::exception& e) {
+        throw std::runtime_error(name + " is truncated or corrupt: " + multibin::oneLineMessage(e));
     }
+    if (asked > 0)
+        throw std::runtime_error(name +
+                                 " declares more data than the file holds: reading it asked for " +
+                                 gigabytes(asked) + " in all, more than 64 MiB + 16 x its " +
+                                 std::to_string(sizeBound_bytes) + " bytes");
     for (size_t i = 0; i < sm.size(); i++) {
         const auto& [posePdf, sf] = sm.get(i);
         const std::string where = name + ": keyframe " + std::to_string(i);

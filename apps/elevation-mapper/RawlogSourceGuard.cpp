@@ -21,13 +21,21 @@
 #endif
 
 namespace {
-thread_local uint64_t t_limit = 0;  // 0: no budget on this thread
+thread_local uint64_t t_limit = 0;      // 0: no budget on this thread
+thread_local uint64_t t_requested = 0;  // sum of the requests since the budget began
 thread_local uint64_t t_largestRefused = 0;
 
-/** Whether a request of n bytes is refused (and records it). */
+/** Whether a request of n bytes is refused (and records it). The sum of all requests is
+ * bounded, frees not subtracted: containers that grow in small blocks (std::deque) are bounded
+ * too, and the sum bounds the peak. */
 inline bool refused(std::size_t n) {
-    if (t_limit == 0 || n <= t_limit) return false;
-    if (n > t_largestRefused) t_largestRefused = n;
+    if (t_limit == 0) return false;
+    if (n <= t_limit && t_requested + n <= t_limit) {
+        t_requested += n;
+        return false;
+    }
+    const uint64_t asked = t_requested + n;
+    if (asked > t_largestRefused) t_largestRefused = asked;
     return true;
 }
 }  // namespace
@@ -38,6 +46,7 @@ uint64_t ReadBudget::limitFor(uint64_t bytesLeft) {
 }
 ReadBudget::ReadBudget(uint64_t limitBytes) : m_previous(t_limit) {
     t_limit = limitBytes == 0 ? 1 : limitBytes;
+    t_requested = 0;
     t_largestRefused = 0;
 }
 ReadBudget::~ReadBudget() { t_limit = m_previous; }
