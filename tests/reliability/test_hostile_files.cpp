@@ -239,10 +239,20 @@ TEST(HostileFiles, FilesDeclaringMoreThanTheyHoldAreRefusedUnderAOneGigabyteLimi
     EXPECT_EQ(runMapper("--rawlog", walk, dir).exitCode, 0);
 }
 
-TEST(HostileFiles, ADirectoryGivenAsTheRawlogIsAOneLineError) {
+TEST(HostileFiles, ADirectoryGivenAsTheRawlogOrTheIniIsAOneLineError) {
     const fs::path dir = scratchDir("hostile_dir");
     fs::create_directories(dir / "a.rawlog");
     expectOneLineError(runMapper("--rawlog", dir / "a.rawlog", dir), dir / "a.rawlog",
                        "is a directory");
+    fs::create_directories(dir / "a.ini");
+    const fs::path err = dir / "stderr.txt";
+    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " +
+                            (dir / "a.ini").string() + " --rawlog " +
+                            (fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog").string() +
+                            " --no-plots --out " + (dir / "out").string() + " > /dev/null 2> " +
+                            err.string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    expectOneLineError({WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(err), 0},
+                       dir / "a.ini", "is a directory");
 }
 #endif
