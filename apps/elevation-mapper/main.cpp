@@ -172,6 +172,8 @@ std::vector<double> parseFourNumbers(const std::string& flag, const std::string&
 int run(const Arguments& args) {
     if (!fs::exists(args.config))
         throw std::runtime_error("config '" + args.config + "' not found");
+    if (fs::is_directory(args.config))
+        throw std::runtime_error("config '" + args.config + "' is a directory, not a file");
     mrpt::config::CConfigFile ini(args.config);
     mrpt::maps::TSetOfMetricMapInitializers inits;
     inits.loadFromConfigFile(ini, kMapsSection);

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/VisibilityConstraint.h"
@@ -25,6 +27,21 @@ bool canGrowTheMap(const PointWithCov& p, const Eigen::Vector3d& sensor_m, doubl
            std::abs(p.point_m.y() - sensor_m.y()) <= half_m && !std::isnan(p.cov_m2.zz) &&
            params.passesEq13(p.cov_m2.zz);
 }
+
+/** Options may be set in code after construction: every insertion entry point checks them
+ * before they reach the grid (a NaN certainty increment makes invalid bins). */
+void validateOptions(const CMultiBinElevationMap& map) {
+    map.creationOptions.validate();
+    map.insertionOptions.validate();
+}
+
+/** t1 - t0 [s] without wrapping: MRPT's timeDifference subtracts int64 ticks, which wraps for
+ * timestamps 2^63 ticks apart. */
+double secondsBetween(mrpt::Clock::time_point t0, mrpt::Clock::time_point t1) {
+    const double ticks =
+        double(t1.time_since_epoch().count()) - double(t0.time_since_epoch().count());
+    return ticks * double(mrpt::Clock::period::num) / double(mrpt::Clock::period::den);
+}
 }  // namespace
 
 bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
@@ -35,6 +52,7 @@ bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
 bool CMultiBinElevationMap::internal_insertObservation(
     const mrpt::obs::CObservation& obs,
     const std::optional<const mrpt::poses::CPose3D>& robotPose) {
+    validateOptions(*this);
     if (const auto* rp = dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs)) {
         // Not inserted: kept as the pose PDF of the observations that follow.
         m_impl->lastRobotPose = rp->pose;
@@ -46,10 +64,9 @@ bool CMultiBinElevationMap::internal_insertObservation(
     if (m_impl->lastRobotPose) {
         const bool timesKnown =
             obs.timestamp != INVALID_TIMESTAMP && m_impl->lastRobotPoseTime != INVALID_TIMESTAMP;
-        const double dt =
-            timesKnown
-                ? std::abs(mrpt::system::timeDifference(m_impl->lastRobotPoseTime, obs.timestamp))
-                : std::numeric_limits<double>::infinity();
+        const double dt = timesKnown
+                              ? std::abs(secondsBetween(m_impl->lastRobotPoseTime, obs.timestamp))
+                              : std::numeric_limits<double>::infinity();
         if (dt <= insertionOptions.robot_pose_max_dt_s) {
             pdf = *m_impl->lastRobotPose;
             haveCov = true;
@@ -80,15 +97,24 @@ void CMultiBinElevationMap::forEachObservationWithPosePdf(
     const std::function<void(const mrpt::obs::CObservation&,
                              const mrpt::poses::CPose3DPDFGaussian&)>& visit,
     const std::function<void(size_t, size_t)>& progress) {
+    // Every keyframe is checked before any is visited: a null pose, sensory frame or observation
+    // (MRPT reads an object of the wrong class as null) is an error, not a silent skip.
     for (size_t i = 0; i < simplemap.size(); i++) {
         const auto& [posePdf, sf] = simplemap.get(i);
-        if (posePdf && sf) {
+        const std::string where = "CMultiBinElevationMap: simplemap keyframe " + std::to_string(i);
+        if (!posePdf) throw std::invalid_argument(where + " has no pose (null)");
+        if (!sf) throw std::invalid_argument(where + " has no sensory frame (null)");
+        for (const auto& obs : *sf)
+            if (!obs) throw std::invalid_argument(where + " holds a null observation");
+    }
+    for (size_t i = 0; i < simplemap.size(); i++) {
+        const auto& [posePdf, sf] = simplemap.get(i);
+        {
             mrpt::poses::CPose3DPDFGaussian pdf;
             const auto [cov, mean] = posePdf->getCovarianceAndMean();
             pdf.mean = mean;
             pdf.cov = cov;
-            for (const auto& obs : *sf)
-                if (obs) visit(*obs, pdf);
+            for (const auto& obs : *sf) visit(*obs, pdf);
         }
         if (progress) progress(i + 1, simplemap.size());
     }
@@ -108,6 +134,7 @@ size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
 
 bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
                                               const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    validateOptions(*this);
     if (!acceptsLabel(obs.sensorLabel)) {
         m_impl->skippedByLabel++;
         return false;
@@ -210,6 +237,7 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    validateOptions(*this);
     return insertIntoGrid(
         isDualGrid() ? m_impl->local : m_impl->grid,
         [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
