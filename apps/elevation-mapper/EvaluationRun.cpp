@@ -16,8 +16,8 @@
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
+using multibin::Lattice;
 using multibin::eval::CellArray;
-using multibin::eval::EvalLattice;
 using multibin::eval::MethodEstimate;
 
 namespace {
@@ -29,13 +29,15 @@ double secondsSince(Clock::time_point t0) {
 
 /** The truth on the map's lattice, cut to `area_m` when given. */
 CellArray loadTruth(const std::string& path, double cellSize_m, const std::vector<double>& area_m,
-                    EvalLattice& lattice) {
+                    Lattice& lattice) {
     if (!fs::exists(path)) throw std::runtime_error("ground truth '" + path + "' not found");
     const CellArray whole = multibin::eval::groundTruthOnLattice(
         multibin::EsriAsciiGrid::load(path), cellSize_m, lattice);
     if (area_m.empty()) return whole;
-    const EvalLattice sub = multibin::eval::subLattice(lattice, area_m);
-    const CellArray cut = whole.block(sub.iy0 - lattice.iy0, sub.ix0 - lattice.ix0, sub.ny, sub.nx);
+    const Lattice sub = multibin::eval::subLattice(lattice, area_m);
+    const CellArray cut =
+        whole.block(sub.window.iy0 - lattice.window.iy0, sub.window.ix0 - lattice.window.ix0,
+                    sub.window.ny, sub.window.nx);
     lattice = sub;
     return cut;
 }
@@ -46,23 +48,20 @@ double evaluatedCellSize_m(const CMultiBinElevationMap& map) {
     return c.dual_grid ? c.global_resolution_m : c.resolution_m;
 }
 
-multibin::EsriAsciiGrid rasterOf(const EvalLattice& L, const CellArray& values) {
-    multibin::EsriAsciiGrid g;
-    g.cellsize_m = L.cellSize_m;
-    g.xllcenter_m = L.cellCenterX_m(0);
-    g.yllcenter_m = L.cellCenterY_m(0);
+multibin::EsriAsciiGrid rasterOf(const Lattice& L, const CellArray& values) {
+    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(L);
     g.heights_m = values.matrix();
     return g;
 }
 
 /** Heights of one of MRPT's DEMs at the lattice's cell centres; NaN where it has none, or outside
  * `within` when given. */
-CellArray sampleDem(const mrpt::maps::CHeightGridMap2D_Base& dem, const EvalLattice& lattice,
-                    const EvalLattice* within = nullptr) {
+CellArray sampleDem(const mrpt::maps::CHeightGridMap2D_Base& dem, const Lattice& lattice,
+                    const Lattice* within = nullptr) {
     CellArray h;
-    h.setConstant(lattice.ny, lattice.nx, NAN);
-    for (int r = 0; r < lattice.ny; r++)
-        for (int c = 0; c < lattice.nx; c++) {
+    h.setConstant(lattice.window.ny, lattice.window.nx, NAN);
+    for (int r = 0; r < lattice.window.ny; r++)
+        for (int c = 0; c < lattice.window.nx; c++) {
             const double x = lattice.cellCenterX_m(c), y = lattice.cellCenterY_m(r);
             int cc, rr;
             double z;
@@ -88,11 +87,11 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
     m_laserOnly.insertionOptions = evaluated.insertionOptions;
     if (options.withMrf) {
         // A centred crop: MRPT's GMRF solve grows as about n^2.6 in cells.
-        const int side = std::min({options.mrfMaxCells, m_lattice.nx, m_lattice.ny});
+        const int side = std::min({options.mrfMaxCells, m_lattice.window.nx, m_lattice.window.ny});
         m_mrfLattice = m_lattice;
-        m_mrfLattice.ix0 = m_lattice.ix0 + (m_lattice.nx - side) / 2;
-        m_mrfLattice.iy0 = m_lattice.iy0 + (m_lattice.ny - side) / 2;
-        m_mrfLattice.nx = m_mrfLattice.ny = side;
+        m_mrfLattice.window.ix0 = m_lattice.window.ix0 + (m_lattice.window.nx - side) / 2;
+        m_mrfLattice.window.iy0 = m_lattice.window.iy0 + (m_lattice.window.ny - side) / 2;
+        m_mrfLattice.window.nx = m_mrfLattice.window.ny = side;
         const auto a = m_mrfLattice.area_m();
         m_mrf = std::make_unique<mrpt::maps::CHeightGridMap2D_MRF>(
             mrpt::maps::CHeightGridMap2D_MRF::mrGMRF_SD, a[0], a[1], a[2], a[3],
@@ -112,11 +111,10 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
 void EvaluationRun::insertRawPoints(const mrpt::obs::CObservation& obs,
                                     const mrpt::poses::CPose3DPDFGaussian& robotPose) {
     multibin::sensors::SensorPoints sp;
-    multibin::InsertStats ignored;
     const auto& io = m_evaluated.insertionOptions;
     if (!multibin::sensors::observationToSensorPoints(obs, robotPose, m_rawSensorOptions,
                                                       io.min_range_m, io.max_range_m,
-                                                      m_rawSensorState, ignored, sp))
+                                                      m_rawSensorState, sp))
         return;
     const mrpt::poses::CPose3D sensorInMap = robotPose.mean + sp.sensorPose;
     std::vector<mrpt::math::TPoint3D> points(sp.points.size());
@@ -168,10 +166,10 @@ MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBin
                                         bool filled) const {
     MethodEstimate m;
     m.name = name;
-    m.height_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
-    m.sigma_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
-    for (int r = 0; r < m_lattice.ny; r++)
-        for (int c = 0; c < m_lattice.nx; c++) {
+    m.height_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
+    m.sigma_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
+    for (int r = 0; r < m_lattice.window.ny; r++)
+        for (int c = 0; c < m_lattice.window.nx; c++) {
             double h, s;
             if (map.getElevation(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), h, s,
                                  filled) != CMultiBinElevationMap::HeightSource::Unknown) {

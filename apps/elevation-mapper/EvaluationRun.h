@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "multibin/eval/Evaluation.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 class OutputFolder;
 
@@ -63,12 +64,12 @@ private:
     Options m_options;
     mrpt::maps::CMultiBinElevationMap& m_evaluated;
     mrpt::maps::CMultiBinElevationMap m_laserOnly;
-    multibin::eval::EvalLattice m_lattice;
+    multibin::Lattice m_lattice;
     multibin::eval::CellArray m_truth;
     multibin::eval::RawPointGrid m_rawLaser, m_rawAll;
     mrpt::maps::CHeightGridMap2D m_heightGrid;
     std::unique_ptr<mrpt::maps::CHeightGridMap2D_MRF> m_mrf;
-    multibin::eval::EvalLattice m_mrfLattice;                  //!< the crop, in the same lattice
+    multibin::Lattice m_mrfLattice;                            //!< the crop, in the same lattice
     multibin::sensors::SensorModelOptions m_rawSensorOptions;  //!< rejection rules off
     multibin::sensors::SensorModelState m_rawSensorState;
     double m_raw_s = 0, m_heightGrid_s = 0, m_mrf_s = 0, m_laserOnly_s = 0;

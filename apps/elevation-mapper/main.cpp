@@ -34,6 +34,7 @@
 #include "ObservationTally.h"
 #include "ProgressBar.h"
 #include "RawlogSource.h"
+#include "multibin/fill/HeightRaster.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
 
@@ -221,6 +222,8 @@ int run(const Arguments& args) {
 
     if (!fs::exists(args.config))
         throw std::runtime_error("config '" + args.config + "' not found");
+    if (fs::is_directory(args.config))
+        throw std::runtime_error("config '" + args.config + "' is a directory, not a file");
     mrpt::config::CConfigFile ini(args.config);
     mrpt::maps::TSetOfMetricMapInitializers inits;
     inits.loadFromConfigFile(ini, args.section);

@@ -2,12 +2,12 @@
  * CMultiBinElevationMap: 3D visualization with stock mrpt::opengl classes only, so a saved
  * .3Dscene opens in programs that do not load this library. */
 #include <mrpt/img/CImage.h>
-#include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/opengl/CColorBar.h>
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/CMesh.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CText.h>
+#include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +18,8 @@
 
 #include "multibin/io/RasterExport.h"
 #include "multibin/map/TerrainView.h"
+
+#include "multibin/io/EsriAsciiGrid.h"
 
 using namespace mrpt::maps;
 
