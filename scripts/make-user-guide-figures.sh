@@ -28,11 +28,12 @@ cp "$work/map/elevation_height.png" "$work/map/elevation_sigma.png" \
 # The mapper's console output, as the guide quotes it (without the absolute output path).
 sed "s|$work/|OUT/|" "$work/map.txt" > "$figures/elevation-mapper-output.txt"
 
-# screenshot OUT.png PROGRAM ARGS...: starts PROGRAM on the virtual display, closes its start-up
-# tip, makes its main window 1280 x 800 and saves the screen.
+# screenshot OUT.png ZOOM PROGRAM ARGS...: starts PROGRAM on the virtual display, closes its
+# start-up tip, makes its main window 1280 x 800, turns the mouse wheel ZOOM notches over the
+# view (SceneViewer3D opens at a fixed distance of 20 m) and saves the screen.
 cat > "$work/screenshot.sh" <<'SHOT'
 set -euo pipefail
-out=$1; shift
+out=$1; zoom=$2; shift 2
 "$@" >/dev/null 2>&1 &
 pid=$!
 title=""
@@ -47,6 +48,9 @@ for tip in $(xdotool search --onlyvisible --name "Tip of the Day" 2>/dev/null ||
   xdotool windowunmap "$tip"
 done
 xdotool windowsize "$title" 1280 800 windowmove "$title" 0 0
+sleep 2
+xdotool mousemove 700 420
+for _ in $(seq "$zoom"); do xdotool click 4; sleep 0.1; done
 sleep 3
 xwd -root -silent | xwdtopnm 2>/dev/null | pnmtopng > "$out"
 kill "$pid" 2>/dev/null || true
@@ -61,9 +65,10 @@ shot() {
   done
   return 1
 }
-shot "$figures/rawlogviewer.png" RawLogViewer rawlogs/mockup.rawlog
-shot "$figures/sceneviewer3d-height.png" SceneViewer3D "$work/map/elevation.3Dscene"
+shot "$figures/rawlogviewer.png" 0 RawLogViewer rawlogs/mockup.rawlog
+shot "$figures/sceneviewer3d-height.png" 20 SceneViewer3D "$work/map/elevation.3Dscene"
 for colour in sigma source; do
-  shot "$figures/sceneviewer3d-$colour.png" SceneViewer3D "$work/scene-$colour/elevation.3Dscene"
+  shot "$figures/sceneviewer3d-$colour.png" 20 SceneViewer3D \
+    "$work/scene-$colour/elevation.3Dscene"
 done
 echo "figures in $figures/"

@@ -162,7 +162,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
 
     // Legend beside the map (+x side), centred on it in y.
     const double legendH = std::max(step, 0.4 * ySpan);
-    const double lx = x1 + 0.5 * step, ly = 0.5 * (y0 + y1) - 0.5 * legendH;
+    const double lx = x1 + 0.2 * step, ly = 0.5 * (y0 + y1) - 0.5 * legendH;
     if (colouring == SceneColouring::Source) {
         double y = ly + legendH;
         for (const RasterCategory& k : heightSourceCategories()) {
@@ -177,7 +177,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
         const std::string format =
             colouring == SceneColouring::Certainty ? "%.0f" : std::string("%.3f m");
         auto bar = mrpt::opengl::CColorBar::Create(cmap, 0.1 * legendH, legendH, 0.f, 1.f, lo, hi,
-                                                   format, float(0.05 * legendH));
+                                                   format, float(0.035 * legendH));
         bar->setName("colour bar");
         bar->setLocation(lx, ly, zHi);
         out.insert(bar);
