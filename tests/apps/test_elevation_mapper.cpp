@@ -316,7 +316,8 @@ TEST(ElevationMapperOutputs, FullDiskLeavesNoTruncatedFile) {
 }
 
 // On a terminal (here a pseudo-terminal made by script(1)) every stage draws its progress line:
-// mapping, filling, writing and the figures; off a terminal nothing of it reaches stderr.
+// mapping, filling, the layers, writing and the figures; off a terminal nothing of it reaches
+// stderr.
 TEST(ElevationMapperCli, ProgressOnATerminalForEveryStage) {
     if (std::system("command -v script >/dev/null 2>&1") != 0)
         GTEST_SKIP() << "script(1) (bsdutils) is not installed";
@@ -332,7 +333,7 @@ TEST(ElevationMapperCli, ProgressOnATerminalForEveryStage) {
                             " 2>&1 < /dev/null";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     const std::string tty = readAll(d / "tty.txt");
-    for (const char* stage : {"mapping [", "filling [", "writing [", "figures ["})
+    for (const char* stage : {"mapping [", "filling [", "layers [", "writing [", "figures ["})
         EXPECT_NE(tty.find(stage), std::string::npos) << stage << " missing from:\n" << tty;
 
     const RunResult plain = runMapper(d, args + " --no-plots");
