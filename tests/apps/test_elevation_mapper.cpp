@@ -335,6 +335,9 @@ TEST(ElevationMapperCli, ProgressOnATerminalForEveryStage) {
     const std::string tty = readAll(d / "tty.txt");
     for (const char* stage : {"mapping [", "filling [", "layers [", "writing [", "figures ["})
         EXPECT_NE(tty.find(stage), std::string::npos) << stage << " missing from:\n" << tty;
+    // The layer panels are drawn from a scratch copy of the rasters: none is left in the output.
+    EXPECT_TRUE(fs::exists(d / "out" / "layers.png"));
+    EXPECT_FALSE(fs::exists(d / "out" / "elevation_height.asc"));
 
     const RunResult plain = runMapper(d, args + " --no-plots");
     EXPECT_EQ(plain.exitCode, 0);
