@@ -15,6 +15,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/BinGrid.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin;
 

@@ -12,6 +12,7 @@
 
 #include "mc_check.h"
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/BinGrid.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/SensorDispatch.h"
 
