@@ -4,6 +4,9 @@
 
 #include <cmath>
 
+#include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/BinGrid.h"
+
 using mrpt::maps::CMultiBinElevationMap;
 
 namespace {
