@@ -207,7 +207,7 @@ TEST(BadInputFiles, SerializedMapOfAnUnknownVersionIsRejected) {
     const auto at = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
     ASSERT_NE(at, bytes.end());
     const size_t versionByte = size_t(at - bytes.begin()) + name.size();
-    ASSERT_EQ(bytes[versionByte], 1u);  // version 1 today
+    ASSERT_EQ(bytes[versionByte], 2u);  // version 2 today (with the payload checksum)
     bytes[versionByte] = 7;
     expectRejected(bytes, "version");
 }
