@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "multibin/io/StrictConfigSection.h"
+#include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
 
@@ -430,113 +431,14 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
     return p;
 }
 
-namespace {
-/** The surface estimate of one cell: its winning bin, fused with the neighbouring bins (index
- * +-1, +-2, ... while contiguous) whose heights agree with it within 3 sigma. A surface whose
- * height lies near a bin boundary spreads its points over two bins, each of which then holds a
- * truncated, biased share; they are one hypothesis, not two. Bins that disagree stay alternative
- * hypotheses. */
-struct CellSurface {
-    double height_m = 0, variance_m2 = 0, certainty = 0;
-    int firstBin = 0, lastBin = 0;  //!< the bin indices merged into the surface
-};
-bool cellSurface(const multibin::BinGrid& grid, double x_m, double y_m,
-                 const multibin::BinUpdateParams& p, CellSurface& out) {
-    const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
-    const multibin::Bin* win = grid.winningBin(ix, iy);
-    if (!win) return false;
-    const double floor_m2 = p.varianceFloor_m2;
-    double info = 1.0 / std::max<double>(win->variance_m2, floor_m2);
-    double weighted_m = info * win->height_m;
-    out.certainty = win->certainty;
-    out.firstBin = out.lastBin = win->index;
-    for (const int dir : {-1, 1}) {
-        for (int n = win->index + dir;; n += dir) {
-            const multibin::Bin* next = nullptr;
-            grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
-                if (b.index == n && b.certainty > 0) next = &b;
-            });
-            if (!next) break;
-            const double v = std::max<double>(next->variance_m2, floor_m2);
-            const double h = weighted_m / info, vNow = 1.0 / info;
-            if ((next->height_m - h) * (next->height_m - h) > 9.0 * (v + vNow)) break;
-            info += 1.0 / v;
-            weighted_m += next->height_m / v;
-            out.certainty += next->certainty;
-            (dir < 0 ? out.firstBin : out.lastBin) = n;
-        }
-    }
-    out.height_m = weighted_m / info;
-    out.variance_m2 = std::max(1.0 / info, floor_m2);
-    return true;
-}
-
-/** Adds the relief of the cell to its variance [m^2]: the map gives one height per cell, the
- * points sample parts of it, and over a cell of side s on a slope g the heights spread with
- * variance (g s)^2 / 12 (uniform over the cell). g comes from the neighbours' surfaces (central
- * differences, one-sided at gaps). Without it sigma is a few mm on 45 degree rock faces where
- * the cell's height is uncertain by a centimetre. */
-void addReliefVariance(const multibin::BinGrid& grid, double x_m, double y_m,
-                       const multibin::BinUpdateParams& p, CellSurface& cell) {
-    const double s = grid.cellSize_m();
-    double slope2 = 0;
-    for (const auto& [dx, dy] : {std::pair<double, double>{s, 0.0}, {0.0, s}}) {
-        CellSurface lo, hi;
-        const bool haveLo = cellSurface(grid, x_m - dx, y_m - dy, p, lo);
-        const bool haveHi = cellSurface(grid, x_m + dx, y_m + dy, p, hi);
-        double g = 0;
-        if (haveLo && haveHi)
-            g = (hi.height_m - lo.height_m) / (2 * s);
-        else if (haveLo)
-            g = (cell.height_m - lo.height_m) / s;
-        else if (haveHi)
-            g = (hi.height_m - cell.height_m) / s;
-        slope2 += g * g;
-    }
-    cell.variance_m2 += slope2 * s * s / 12.0;
-    // Certain bins outside the surface: the cell also holds surfaces at other heights (a step
-    // inside the cell, its top and its foot seen from different places). The truth of the cell,
-    // the mean over its area, lies between them: their spread around the reported height,
-    // weighted by each bin's share of the cell's certainty, is part of the cell's uncertainty.
-    double otherCertainty = 0, otherSpread_m2 = 0;
-    grid.forEachBin(grid.cellIndex(x_m), grid.cellIndex(y_m), [&](const multibin::Bin& b) {
-        if (b.certainty <= 0 || (b.index >= cell.firstBin && b.index <= cell.lastBin)) return;
-        otherCertainty += b.certainty;
-        otherSpread_m2 += b.certainty * (b.height_m - cell.height_m) * (b.height_m - cell.height_m);
-    });
-    if (otherCertainty > 0) cell.variance_m2 += otherSpread_m2 / (otherCertainty + cell.certainty);
-}
-}  // namespace
-
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
-    const multibin::BinUpdateParams p = binUpdateParams();
-    CellSurface g, l;
-    const bool haveG = cellSurface(m_impl->grid, x_m, y_m, p, g);
-    const bool haveL = isDualGrid() && cellSurface(m_impl->local, x_m, y_m, p, l);
-    if (!haveG && !haveL) return false;
-    if (insertionOptions.relief_sigma) {
-        if (haveG) addReliefVariance(m_impl->grid, x_m, y_m, p, g);
-        if (haveL) addReliefVariance(m_impl->local, x_m, y_m, p, l);
-    }
-    if (!haveG || !haveL) {
-        const CellSurface& c = haveG ? g : l;
-        height_m = c.height_m;
-        sigma_m = std::sqrt(c.variance_m2);
-        return true;
-    }
-    // Both grids: their data are disjoint (each observation updates one grid), so agreeing
-    // estimates are fused by inverse variance; disagreeing ones leave the more certain.
-    const double d = l.height_m - g.height_m;
-    if (d * d <= 9.0 * (g.variance_m2 + l.variance_m2)) {
-        const double v = 1.0 / (1.0 / g.variance_m2 + 1.0 / l.variance_m2);
-        height_m = v * (l.height_m / l.variance_m2 + g.height_m / g.variance_m2);
-        sigma_m = std::sqrt(v);
-    } else {
-        const CellSurface& c = l.certainty >= g.certainty ? l : g;
-        height_m = c.height_m;
-        sigma_m = std::sqrt(c.variance_m2);
-    }
+    multibin::CellSurface c;
+    if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,
+                             binUpdateParams(), insertionOptions.relief_sigma, c))
+        return false;
+    height_m = c.height_m;
+    sigma_m = std::sqrt(c.variance_m2);
     return true;
 }
 

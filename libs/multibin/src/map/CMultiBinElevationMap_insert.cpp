@@ -11,6 +11,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/VisibilityConstraint.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;
@@ -144,23 +145,25 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                                         obs.sensorLabel + "' has a NaN or infinite component");
     obs.load();  // externally stored observations
 
-    multibin::InsertStats sensorStats;  // rejections before the insertion core
     multibin::sensors::SensorPoints sensed;
     if (!multibin::sensors::observationToSensorPoints(
             obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-            insertionOptions.max_range_m, m_impl->sensorState, sensorStats, sensed))
+            insertionOptions.max_range_m, m_impl->sensorState, sensed))
         return false;  // not an observation this map models
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
     const double continuityBound_m = sensed.continuityBound_m;
-    m_impl->stats += sensorStats;
+    // Rejections before the insertion core: the model's own counts, added up here.
+    m_impl->sensorState.stats += sensed.stats;
+    m_impl->stats.outOfRange += sensed.stats.outOfRange();
+    m_impl->stats.notFinite += sensed.stats.notFinite();
     if (sensorPoints.empty()) return false;
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
     if (isDualGrid()) {
         recenter(robotPose.mean.x(), robotPose.mean.y());
-    } else if (growthNeeded(sensorPoints, robotPose.mean + sensorPose, propagator)) {
+    } else if (growthNeeded(sensorPoints, propagator)) {
         // Growth is sized by all map-frame points: propagate them first (the rare case).
         PointsWithCov mapPoints;
         propagator.apply(sensorPoints, mapPoints);
@@ -184,7 +187,6 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
 }
 
 bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
-                                         const mrpt::poses::CPose3D& sensorInMap,
                                          const multibin::PosePropagator& propagator) const {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || sensorPoints.empty()) return false;
@@ -198,10 +200,8 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     const double cell = m_impl->grid.cellSize_m(), half = 0.5 * c.max_size_m;
     const double x0 = w.ix0 * cell, x1 = (w.ix0 + w.nx) * cell;
     const double y0 = w.iy0 * cell, y1 = (w.iy0 + w.ny) * cell;
-    const Eigen::Matrix3d R = sensorInMap.getRotationMatrix().asEigen();
-    const double tx = sensorInMap.x(), ty = sensorInMap.y();
-    const double tNorm = std::abs(tx) + std::abs(ty) + std::abs(sensorInMap.z());
     const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
+    const double tNorm = s.cwiseAbs().sum();
     const multibin::BinUpdateParams params = binUpdateParams();
     constexpr size_t kBatch = 256;
     PointWithCov exact[kBatch];
@@ -219,14 +219,11 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
         return grows;
     };
     // Scalar code: about 20 instructions a point, most points leave at the first test.
-    const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2);
-    const double r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2);
     for (const PointWithCov& p : sensorPoints) {
-        const double px = p.point_m.x(), py = p.point_m.y(), pz = p.point_m.z();
-        const double qx = r00 * px + r01 * py + r02 * pz + tx;
-        const double qy = r10 * px + r11 * py + r12 * pz + ty;
-        const double slack =
-            1e-4 + 1e-5 * (std::abs(px) + std::abs(py) + std::abs(pz) + tNorm);  // [m]
+        const Eigen::Vector2d q = propagator.horizontalInMap_m(p.point_m);
+        const double qx = q.x(), qy = q.y();
+        const double slack = 1e-4 + 1e-5 * (std::abs(p.point_m.x()) + std::abs(p.point_m.y()) +
+                                            std::abs(p.point_m.z()) + tNorm);  // [m]
         if (qx - slack >= x0 && qx + slack <= x1 && qy - slack >= y0 && qy + slack <= y1)
             continue;  // clearly inside the window
         if (std::abs(qx - s.x()) > half + slack || std::abs(qy - s.y()) > half + slack)

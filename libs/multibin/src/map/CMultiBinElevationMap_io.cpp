@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "multibin/io/RasterExport.h"
+#include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
 
@@ -207,11 +208,7 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
     const multibin::CellWindow& w = m_impl->grid.window();
-    multibin::EsriAsciiGrid g;
-    g.cellsize_m = m_impl->grid.cellSize_m();
-    g.xllcenter_m = m_impl->grid.cellCenter_m(w.ix0);
-    g.yllcenter_m = m_impl->grid.cellCenter_m(w.iy0);
-    g.heights_m.setConstant(w.ny, w.nx, NAN);
+    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             const int ix = w.ix0 + c, iy = w.iy0 + r;
@@ -232,8 +229,15 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
                     out = float(static_cast<int>(src));
                     break;
                 case RasterLayer::Certainty: {
-                    const multibin::Bin* b = m_impl->grid.winningBin(ix, iy);
-                    out = b ? b->certainty : 0.f;
+                    // The certainty of the surface the height layer reports (0 where filled).
+                    multibin::CellSurface c;
+                    out = src == HeightSource::Measured &&
+                                  multibin::surfaceAt(
+                                      m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
+                                      m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy),
+                                      binUpdateParams(), false, c)
+                              ? float(c.certainty)
+                              : 0.f;
                 } break;
             }
         }
