@@ -382,12 +382,14 @@ const multibin::sensors::SensorModelStats& CMultiBinElevationMap::sensorModelSta
 }
 
 void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     creation.validate();
     creationOptions = creation;
     internal_clear();
 }
 
 void CMultiBinElevationMap::internal_clear() {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     const auto& c = creationOptions;
     multibin::CellWindow w;
     const double res = c.resolution_m;
@@ -433,6 +435,7 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     multibin::CellSurface c;
     if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,
                              binUpdateParams(), insertionOptions.relief_sigma, c))
@@ -443,10 +446,12 @@ bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
 }
 
 bool CMultiBinElevationMap::isEmpty() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     return m_impl->grid.empty() && m_impl->local.empty();
 }
 
 std::string CMultiBinElevationMap::asString() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     std::ostringstream os;
     os << "CMultiBinElevationMap: " << m_impl->grid.window().nx << " x " << m_impl->grid.window().ny
        << " cells of " << m_impl->grid.cellSize_m() << " m, x in [" << getXMin() << ", "
@@ -489,6 +494,7 @@ bool CMultiBinElevationMap::internal_canComputeObservationLikelihood(
 // ---------------------------------------------------------------------------------------------
 bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y, const double z,
                                                   const TPointInsertParams& params) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     creationOptions.validate();
     insertionOptions.validate();
     const double sigma = params.pt_z_std > 0 ? params.pt_z_std : insertionOptions.range_sigma_m;

@@ -52,6 +52,7 @@ bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
 bool CMultiBinElevationMap::internal_insertObservation(
     const mrpt::obs::CObservation& obs,
     const std::optional<const mrpt::poses::CPose3D>& robotPose) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     if (const auto* rp = dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs)) {
         // Not inserted: kept as the pose PDF of the observations that follow.
@@ -134,6 +135,7 @@ size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
 
 bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
                                               const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     if (!acceptsLabel(obs.sensorLabel)) {
         m_impl->skippedByLabel++;
@@ -237,6 +239,7 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     return insertIntoGrid(
         isDualGrid() ? m_impl->local : m_impl->grid,

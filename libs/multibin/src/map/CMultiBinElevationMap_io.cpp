@@ -140,6 +140,7 @@ constexpr size_t kPayloadChunkBytes = size_t(1) << 20;
 }  // namespace
 
 void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     mrpt::io::CMemoryStream mem;
     {
         auto body = mrpt::serialization::archiveFrom(mem);
@@ -162,6 +163,7 @@ void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) cons
 }
 
 void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     auto apply = [this](StoredMap&& m) {
         creationOptions = m.creation;
         insertionOptions = m.insertion;
@@ -207,6 +209,7 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 }
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::CellWindow& w = m_impl->grid.window();
     multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
     for (int r = 0; r < w.ny; r++)
@@ -245,6 +248,7 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
 }
 
 void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::EsriAsciiGrid g = toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height);
     const int rows = g.rows(), cols = g.cols();
     img.resize(std::max(cols, 1), std::max(rows, 1), mrpt::img::CH_RGB);
@@ -273,6 +277,7 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
 
 void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     const std::string& filNamePrefix) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     for (const bool sigma : {false, true}) {
         const std::string layer = sigma ? "_sigma" : "_height";
         mrpt::img::CImage img;
