@@ -5,7 +5,10 @@
 #include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -35,12 +38,17 @@ void validateOptions(const CMultiBinElevationMap& map) {
     map.insertionOptions.validate();
 }
 
-/** t1 - t0 [s] without wrapping: MRPT's timeDifference subtracts int64 ticks, which wraps for
- * timestamps 2^63 ticks apart. */
+/** t1 - t0 [s] as MRPT's timeDifference (whole microseconds), but +-inf where the int64 tick
+ * difference would wrap (timestamps 2^63 ticks apart looked microseconds apart). */
 double secondsBetween(mrpt::Clock::time_point t0, mrpt::Clock::time_point t1) {
-    const double ticks =
-        double(t1.time_since_epoch().count()) - double(t0.time_since_epoch().count());
-    return ticks * double(mrpt::Clock::period::num) / double(mrpt::Clock::period::den);
+    int64_t ticks = 0;
+    if (__builtin_sub_overflow(int64_t(t1.time_since_epoch().count()),
+                               int64_t(t0.time_since_epoch().count()), &ticks))
+        return t1 > t0 ? std::numeric_limits<double>::infinity()
+                       : -std::numeric_limits<double>::infinity();
+    return 1e-6 * double(std::chrono::duration_cast<std::chrono::microseconds>(
+                             mrpt::Clock::duration(ticks))
+                             .count());
 }
 }  // namespace
 
