@@ -3,6 +3,8 @@
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
 #include <cmath>
+#include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/BinGrid.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 
