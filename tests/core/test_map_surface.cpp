@@ -6,6 +6,9 @@
 #include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/map/BinGrid.h"
 
+#include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/BinGrid.h"
+
 using mrpt::maps::CMultiBinElevationMap;
 
 namespace {
