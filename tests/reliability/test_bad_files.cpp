@@ -21,18 +21,6 @@ namespace fs = std::filesystem;
 using namespace reliability;
 
 namespace {
-fs::path scratchDir(const std::string& name) {
-    const fs::path d = fs::path(MULTIBIN_BINARY_DIR) / "test_reliability" / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string readAll(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-
 void writeAll(const fs::path& p, const std::string& bytes) {
     std::ofstream f(p, std::ios::binary);
     f << bytes;

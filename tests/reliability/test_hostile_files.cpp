@@ -32,18 +32,6 @@ using namespace reliability;
 namespace {
 using Bytes = std::string;
 
-fs::path scratchDir(const std::string& name) {
-    const fs::path d = fs::path(MULTIBIN_BINARY_DIR) / "test_reliability" / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string readAll(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-
 template <typename T>
 Bytes bytesOf(const T& obj) {
     mrpt::io::CMemoryStream mem;
