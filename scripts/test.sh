@@ -2,11 +2,13 @@
 # Quick start 2: set up, build, and run the test suite: ctest over the GoogleTest programs in the
 # Release build, then the sanitizer stage (scripts/sanitize.sh: the same tests in a clang
 # ASan + UBSan build, fuzz corpora replayed, a short fuzzing run per target).
-# Arguments go to the first ctest; MULTIBIN_SANITIZE=0 skips the sanitizer stage.
+# Then the ThreadSanitizer stage (scripts/tsan.sh: one writer and two readers on one map).
+# Arguments go to the first ctest; MULTIBIN_SANITIZE=0 skips the sanitizer stages.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 source "$root/scripts/setup.sh"
 ctest --test-dir "$build_dir" --output-on-failure -j "$(nproc)" -LE slow "$@"
 if [ "${MULTIBIN_SANITIZE:-1}" != 0 ]; then
   bash "$root/scripts/sanitize.sh"
+  bash "$root/scripts/tsan.sh"
 fi

@@ -31,8 +31,15 @@ double secondsSince(Clock::time_point t0) {
 CellArray loadTruth(const std::string& path, double cellSize_m, const std::vector<double>& area_m,
                     Lattice& lattice) {
     if (!fs::exists(path)) throw std::runtime_error("ground truth '" + path + "' not found");
-    const CellArray whole = multibin::eval::groundTruthOnLattice(
-        multibin::EsriAsciiGrid::load(path), cellSize_m, lattice);
+    const multibin::EsriAsciiGrid truth = multibin::EsriAsciiGrid::load(path);  // names the file
+    CellArray whole;
+    try {
+        whole = multibin::eval::groundTruthOnLattice(truth, cellSize_m, lattice);
+    } catch (const std::bad_alloc&) {
+        throw std::runtime_error("ground truth '" + path + "': out of memory");
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error("ground truth '" + path + "': " + e.what());
+    }
     if (area_m.empty()) return whole;
     const Lattice sub = multibin::eval::subLattice(lattice, area_m);
     const CellArray cut =

@@ -9,6 +9,10 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -16,6 +20,20 @@
 #include "multibin/map/BinGrid.h"
 
 namespace reliability {
+
+/** An empty scratch directory build/test_reliability/NAME for a test's files. */
+inline std::filesystem::path scratchDir(const std::string& name) {
+    const auto d = std::filesystem::path(MULTIBIN_BINARY_DIR) / "test_reliability" / name;
+    std::filesystem::remove_all(d);
+    std::filesystem::create_directories(d);
+    return d;
+}
+
+/** A file's bytes. */
+inline std::string readAll(const std::filesystem::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
 
 using Map = mrpt::maps::CMultiBinElevationMap;
 

@@ -32,18 +32,6 @@ using namespace reliability;
 namespace {
 using Bytes = std::string;
 
-fs::path scratchDir(const std::string& name) {
-    const fs::path d = fs::path(MULTIBIN_BINARY_DIR) / "test_reliability" / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string readAll(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-
 template <typename T>
 Bytes bytesOf(const T& obj) {
     mrpt::io::CMemoryStream mem;
@@ -254,5 +242,26 @@ TEST(HostileFiles, ADirectoryGivenAsTheRawlogOrTheIniIsAOneLineError) {
     const int status = std::system(cmd.c_str());
     expectOneLineError({WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(err), 0},
                        dir / "a.ini", "is a directory");
+}
+#endif
+
+#ifdef ELEVATION_MAPPER_EXE
+// 2 x 2 truth cells of 150 m: 10 GB on the map's lattice, then "std::bad_alloc" without the file.
+TEST(HostileFiles, AGroundTruthTooLargeForTheMapsLatticeIsAOneLineErrorNamingIt) {
+    const fs::path dir = scratchDir("hostile_truth");
+    const fs::path gt = dir / "huge_gt.asc";
+    write(gt,
+          "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 150\nNODATA_value -9999\n"
+          "0 0\n0 0\n");
+    const fs::path err = dir / "stderr.txt";
+    const std::string cmd =
+        kLimit + ELEVATION_MAPPER_EXE + " --config " +
+        (fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini").string() + " --rawlog " +
+        (fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog").string() + " --ground-truth " +
+        gt.string() + " --no-plots --out " + (dir / "out").string() + " > /dev/null 2> " +
+        err.string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    expectOneLineError({WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(err), 0}, gt,
+                       "cells allowed");
 }
 #endif

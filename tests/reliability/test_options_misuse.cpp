@@ -239,3 +239,33 @@ TEST(OptionsMisuse, NullEntriesOfASimplemapAreErrorsBeforeAnythingIsInserted) {
         EXPECT_EQ(serialize(map), before);
     }
 }
+
+// Keys carry their unit (local_size_m beside local_resolution before): the suffixed names are
+// read and written; the old names stay as aliases, so shipped and users' ini files keep working.
+TEST(OptionsMisuse, OldKeyNamesAreAliasesOfTheUnitSuffixedOnesAndBothIsAnError) {
+    const auto load = [](const std::string& creation, const std::string& insertion) {
+        mrpt::config::CConfigFileMemory ini("[c]\n" + creation + "\n[i]\n" + insertion + "\n");
+        Map::TCreationOptions c;
+        Map::TInsertionOptions o;
+        c.loadFromConfigFile(ini, "c");
+        o.loadFromConfigFile(ini, "i");
+        return std::pair{c, o};
+    };
+    const auto [cOld, iOld] = load("resolution = 0.03\nlocal_resolution = 0.02\nmin_x = -2",
+                                   "range_sigma = 0.02\nrobot_pose_max_dt = 0.2");
+    const auto [cNew, iNew] = load("resolution_m = 0.03\nlocal_resolution_m = 0.02\nmin_x_m = -2",
+                                   "range_sigma_m = 0.02\nrobot_pose_max_dt_s = 0.2");
+    EXPECT_EQ(cOld.resolution_m, 0.03);
+    EXPECT_EQ(cNew.resolution_m, 0.03);
+    EXPECT_EQ(cOld.local_resolution_m, cNew.local_resolution_m);
+    EXPECT_EQ(cOld.min_x, cNew.min_x);
+    EXPECT_EQ(iOld.range_sigma_m, iNew.range_sigma_m);
+    EXPECT_EQ(iOld.robot_pose_max_dt_s, iNew.robot_pose_max_dt_s);
+    expectErrorMentioning([&] { load("resolution = 0.03\nresolution_m = 0.03", ""); },
+                          {"resolution_m", "old name 'resolution'"});
+    // Saved options use the suffixed names.
+    mrpt::config::CConfigFileMemory out;
+    cNew.saveToConfigFile(out, "c");
+    EXPECT_TRUE(out.keyExists("c", "resolution_m"));
+    EXPECT_FALSE(out.keyExists("c", "resolution"));
+}

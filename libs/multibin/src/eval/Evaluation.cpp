@@ -42,6 +42,20 @@ CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m, La
     if (!(cellSize_m > 0)) throw std::invalid_argument("ground truth: cell size must be > 0");
     if (truth.rows() == 0 || truth.cols() == 0)
         throw std::invalid_argument("ground truth: the raster is empty");
+    // Refuse before allocating (16 bytes per cell below): 2 x 2 truth cells of 150 m took 10 GB.
+    // 2.5e7 cells (0.4 GB) hold 100 m x 100 m at 2 cm, beyond any evaluation scenario.
+    const double nx = std::floor(truth.xMax_m() / cellSize_m) -
+                      std::floor(truth.xllcenter_m / cellSize_m) + 1,
+                 ny = std::floor(truth.yMax_m() / cellSize_m) -
+                      std::floor(truth.yllcenter_m / cellSize_m) + 1;
+    constexpr double kMaxCells = 2.5e7;
+    if (!(nx * ny <= kMaxCells)) {
+        std::ostringstream os;
+        os << "ground truth: its extent on the map's " << cellSize_m << " m cells is " << nx
+           << " x " << ny << " cells (" << nx * ny * 16 / 1e9 << " GB), more than the " << kMaxCells
+           << " cells allowed";
+        throw std::invalid_argument(os.str());
+    }
     Lattice& L = latticeOut;
     L.cellSize_m = cellSize_m;
     L.window.ix0 = floorIndex(truth.xllcenter_m, cellSize_m);

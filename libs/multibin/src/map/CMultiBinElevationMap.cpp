@@ -122,19 +122,19 @@ const char* colormapName(mrpt::img::TColormap c) {
 void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
     multibin::StrictConfigSection s(source, section);
-    s.read("resolution", resolution_m);
-    s.read("bin_height", bin_height_m);
+    s.read("resolution_m", "resolution", resolution_m);
+    s.read("bin_height_m", "bin_height", bin_height_m);
     s.read("grow", grow);
     s.read("max_size_m", max_size_m);
-    s.read("min_x", min_x);
-    s.read("max_x", max_x);
-    s.read("min_y", min_y);
-    s.read("max_y", max_y);
+    s.read("min_x_m", "min_x", min_x);
+    s.read("max_x_m", "max_x", max_x);
+    s.read("min_y_m", "min_y", min_y);
+    s.read("max_y_m", "max_y", max_y);
     s.read("dual_grid", dual_grid);
     s.read("local_size_m", local_size_m);
-    s.read("local_resolution", local_resolution_m);
+    s.read("local_resolution_m", "local_resolution", local_resolution_m);
     s.read("global_size_m", global_size_m);
-    s.read("global_resolution", global_resolution_m);
+    s.read("global_resolution_m", "global_resolution", global_resolution_m);
     s.allow(kGenericMapKeys);
     s.finish();
     validateIn(s, *this);
@@ -142,19 +142,19 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
 
 void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                                                const std::string& section) const {
-    c.write(section, "resolution", resolution_m);
-    c.write(section, "bin_height", bin_height_m);
+    c.write(section, "resolution_m", resolution_m);
+    c.write(section, "bin_height_m", bin_height_m);
     c.write(section, "grow", grow);
     c.write(section, "max_size_m", max_size_m);
-    c.write(section, "min_x", min_x);
-    c.write(section, "max_x", max_x);
-    c.write(section, "min_y", min_y);
-    c.write(section, "max_y", max_y);
+    c.write(section, "min_x_m", min_x);
+    c.write(section, "max_x_m", max_x);
+    c.write(section, "min_y_m", min_y);
+    c.write(section, "max_y_m", max_y);
     c.write(section, "dual_grid", dual_grid);
     c.write(section, "local_size_m", local_size_m);
-    c.write(section, "local_resolution", local_resolution_m);
+    c.write(section, "local_resolution_m", local_resolution_m);
     c.write(section, "global_size_m", global_size_m);
-    c.write(section, "global_resolution", global_resolution_m);
+    c.write(section, "global_resolution_m", global_resolution_m);
 }
 
 namespace {
@@ -167,13 +167,15 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
         throw std::invalid_argument("CMultiBinElevationMap creation option '" + key + "': " + what);
     };
     if (!(resolution_m > 0) || !std::isfinite(resolution_m))
-        bad("resolution", "must be a positive cell size [m]");
+        bad("resolution_m", "must be a positive cell size [m]");
     if (!(bin_height_m > 0) || !std::isfinite(bin_height_m))
-        bad("bin_height", "must be a positive bin height [m]");
+        bad("bin_height_m", "must be a positive bin height [m]");
     if (!(max_size_m > 0) || !std::isfinite(max_size_m))
         bad("max_size_m", "must be a positive size [m]");
-    for (const auto& [key, v] :
-         {std::pair{"min_x", min_x}, {"max_x", max_x}, {"min_y", min_y}, {"max_y", max_y}}) {
+    for (const auto& [key, v] : {std::pair{"min_x_m", min_x},
+                                 {"max_x_m", max_x},
+                                 {"min_y_m", min_y},
+                                 {"max_y_m", max_y}}) {
         if (!std::isfinite(v)) bad(key, "must be finite [m]");
         // Cell indices are int: an extent far from the origin would overflow them.
         if (std::abs(v / resolution_m) > kMaxCellIndex) {
@@ -183,11 +185,12 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
             bad(key, os.str());
         }
     }
-    if (max_x < min_x || max_y < min_y) bad("min_x/max_x/min_y/max_y", "max must not be below min");
+    if (max_x < min_x || max_y < min_y)
+        bad("min_x_m/max_x_m/min_y_m/max_y_m", "max must not be below min");
     for (const auto& [key, v] : {std::pair{"local_size_m", local_size_m},
-                                 {"local_resolution", local_resolution_m},
+                                 {"local_resolution_m", local_resolution_m},
                                  {"global_size_m", global_size_m},
-                                 {"global_resolution", global_resolution_m}})
+                                 {"global_resolution_m", global_resolution_m}})
         if (!(v > 0) || !std::isfinite(v)) bad(key, "must be positive [m]");
     if (!grow && (max_x <= min_x || max_y <= min_y))
         bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
@@ -215,13 +218,13 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
     multibin::StrictConfigSection s(source, section);
     s.read("certainty_increment", certainty_increment);
-    s.read("max_elevation_uncertainty", max_elevation_uncertainty_m);
-    s.read("height_sigma_floor", height_sigma_floor_m);
+    s.read("max_elevation_uncertainty_m", "max_elevation_uncertainty", max_elevation_uncertainty_m);
+    s.read("height_sigma_floor_m", "height_sigma_floor", height_sigma_floor_m);
     s.read("default_pose_sigmas", default_pose_sigmas, 6);
-    s.read("robot_pose_max_dt", robot_pose_max_dt_s);
-    s.read("range_sigma", range_sigma_m);
-    s.read("min_range", min_range_m);
-    s.read("max_range", max_range_m);
+    s.read("robot_pose_max_dt_s", "robot_pose_max_dt", robot_pose_max_dt_s);
+    s.read("range_sigma_m", "range_sigma", range_sigma_m);
+    s.read("min_range_m", "min_range", min_range_m);
+    s.read("max_range_m", "max_range", max_range_m);
     s.read("sensor_labels", sensor_labels);
     s.read("global_sensor_labels", global_sensor_labels);
     s.readChoice<mrpt::img::TColormap>("colormap", colormap,
@@ -230,7 +233,7 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
                                         {"grayscale", mrpt::img::cmGRAYSCALE}});
     s.read("color_by_sigma", color_by_sigma);
     s.read("visibility_constraint", visibility.enabled);
-    s.read("visibility_margin", visibility.margin_m);
+    s.read("visibility_margin_m", "visibility_margin", visibility.margin_m);
     s.read("visibility_certainty_decrement", visibility.certaintyDecrement);
     s.read("dem_return_filled", dem_return_filled);
     s.read("relief_sigma", relief_sigma);
@@ -243,17 +246,17 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
 void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                                                 const std::string& section) const {
     c.write(section, "certainty_increment", certainty_increment);
-    c.write(section, "max_elevation_uncertainty", max_elevation_uncertainty_m);
-    c.write(section, "height_sigma_floor", height_sigma_floor_m);
+    c.write(section, "max_elevation_uncertainty_m", max_elevation_uncertainty_m);
+    c.write(section, "height_sigma_floor_m", height_sigma_floor_m);
     std::ostringstream sig;
     sig.precision(17);
     for (size_t i = 0; i < default_pose_sigmas.size(); i++)
         sig << (i ? " " : "") << default_pose_sigmas[i];
     c.write(section, "default_pose_sigmas", sig.str());
-    c.write(section, "robot_pose_max_dt", robot_pose_max_dt_s);
-    c.write(section, "range_sigma", range_sigma_m);
-    c.write(section, "min_range", min_range_m);
-    c.write(section, "max_range", max_range_m);
+    c.write(section, "robot_pose_max_dt_s", robot_pose_max_dt_s);
+    c.write(section, "range_sigma_m", range_sigma_m);
+    c.write(section, "min_range_m", min_range_m);
+    c.write(section, "max_range_m", max_range_m);
     std::string labels;
     for (const auto& l : sensor_labels) labels += (labels.empty() ? "" : ",") + l;
     c.write(section, "sensor_labels", labels);
@@ -264,7 +267,7 @@ void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CC
     c.write(section, "colormap", std::string(colormapName(colormap)));
     c.write(section, "color_by_sigma", color_by_sigma);
     c.write(section, "visibility_constraint", visibility.enabled);
-    c.write(section, "visibility_margin", visibility.margin_m);
+    c.write(section, "visibility_margin_m", visibility.margin_m);
     c.write(section, "visibility_certainty_decrement", visibility.certaintyDecrement);
     c.write(section, "dem_return_filled", dem_return_filled);
     c.write(section, "relief_sigma", relief_sigma);
@@ -281,24 +284,24 @@ void CMultiBinElevationMap::TInsertionOptions::validate() const {
     if (!(certainty_increment > 0) || !finite(certainty_increment))
         bad("certainty_increment", "must be positive and finite");
     if (!(max_elevation_uncertainty_m > 0) || !finite(max_elevation_uncertainty_m))
-        bad("max_elevation_uncertainty", "must be positive and finite [m]");
+        bad("max_elevation_uncertainty_m", "must be positive and finite [m]");
     if (!(height_sigma_floor_m >= 0) || !finite(height_sigma_floor_m))
-        bad("height_sigma_floor", "must be >= 0 and finite [m]");
+        bad("height_sigma_floor_m", "must be >= 0 and finite [m]");
     if (default_pose_sigmas.size() != 6)
         bad("default_pose_sigmas",
             "needs 6 values, has " + std::to_string(default_pose_sigmas.size()));
     for (double v : default_pose_sigmas)
         if (!(v >= 0) || !finite(v)) bad("default_pose_sigmas", "values must be >= 0 and finite");
-    if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt", "must be >= 0 [s]");
+    if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt_s", "must be >= 0 [s]");
     if (!(range_sigma_m > 0) || !finite(range_sigma_m))
-        bad("range_sigma", "must be positive and finite [m]");
+        bad("range_sigma_m", "must be positive and finite [m]");
     if (!(visibility.margin_m >= 0) || !finite(visibility.margin_m))
-        bad("visibility_margin", "must be >= 0 and finite [m]");
+        bad("visibility_margin_m", "must be >= 0 and finite [m]");
     if (!(visibility.certaintyDecrement > 0) || !finite(visibility.certaintyDecrement))
         bad("visibility_certainty_decrement", "must be positive and finite");
     fill.validate();
     if (!(min_range_m >= 0 && max_range_m > min_range_m))
-        bad("min_range/max_range", "need 0 <= min_range < max_range [m]");
+        bad("min_range_m/max_range_m", "need 0 <= min_range_m < max_range_m");
     sensors.validate();
 }
 
@@ -382,12 +385,14 @@ const multibin::sensors::SensorModelStats& CMultiBinElevationMap::sensorModelSta
 }
 
 void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     creation.validate();
     creationOptions = creation;
     internal_clear();
 }
 
 void CMultiBinElevationMap::internal_clear() {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     const auto& c = creationOptions;
     multibin::CellWindow w;
     const double res = c.resolution_m;
@@ -433,6 +438,7 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     multibin::CellSurface c;
     if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,
                              binUpdateParams(), insertionOptions.relief_sigma, c))
@@ -443,10 +449,12 @@ bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
 }
 
 bool CMultiBinElevationMap::isEmpty() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     return m_impl->grid.empty() && m_impl->local.empty();
 }
 
 std::string CMultiBinElevationMap::asString() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     std::ostringstream os;
     os << "CMultiBinElevationMap: " << m_impl->grid.window().nx << " x " << m_impl->grid.window().ny
        << " cells of " << m_impl->grid.cellSize_m() << " m, x in [" << getXMin() << ", "
@@ -489,6 +497,7 @@ bool CMultiBinElevationMap::internal_canComputeObservationLikelihood(
 // ---------------------------------------------------------------------------------------------
 bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y, const double z,
                                                   const TPointInsertParams& params) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     creationOptions.validate();
     insertionOptions.validate();
     const double sigma = params.pt_z_std > 0 ? params.pt_z_std : insertionOptions.range_sigma_m;

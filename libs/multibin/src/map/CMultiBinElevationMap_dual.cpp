@@ -38,6 +38,7 @@ void CMultiBinElevationMap::writeBackLocalCell(int ix, int iy) {
 }
 
 void CMultiBinElevationMap::recenter(double x_m, double y_m) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     if (!std::isfinite(x_m) || !std::isfinite(y_m))
         throw std::invalid_argument("CMultiBinElevationMap::recenter: the position (" +
                                     std::to_string(x_m) + ", " + std::to_string(y_m) +
@@ -57,6 +58,7 @@ void CMultiBinElevationMap::recenter(double x_m, double y_m) {
 }
 
 void CMultiBinElevationMap::flushLocalToGlobal() {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     if (!isDualGrid()) return;
     const multibin::CellWindow w = m_impl->local.window();
     for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)

@@ -13,6 +13,7 @@
 using namespace mrpt::maps;
 
 void CMultiBinElevationMap::dem_update_map() {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     if (!m_impl->fillStale) return;
     const multibin::CellWindow w = m_impl->grid.window();
     multibin::fill::HeightRaster raster(multibin::Lattice{m_impl->grid.cellSize_m(), w});
@@ -32,6 +33,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         double& height_m,
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     if (getHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
     if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
     const int ix = m_impl->grid.cellIndex(x_m), iy = m_impl->grid.cellIndex(y_m);
@@ -47,6 +49,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
 
 bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
                                               double& z_out) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     if (cx >= dem_get_size_x() || cy >= dem_get_size_y()) return false;
     const multibin::CellWindow& w = m_impl->grid.window();
     return dem_get_z(m_impl->grid.cellCenter_m(w.ix0 + int(cx)),
@@ -54,6 +57,7 @@ bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
 }
 
 bool CMultiBinElevationMap::dem_get_z(const double x, const double y, double& z_out) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     double sigma;
     return getElevation(x, y, z_out, sigma, insertionOptions.dem_return_filled) !=
            HeightSource::Unknown;

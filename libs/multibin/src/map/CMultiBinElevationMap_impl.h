@@ -10,6 +10,7 @@
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/geometry/Lattice.h"
 #include "multibin/map/BinGrid.h"
+#include "MapLock.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 namespace mrpt::maps {
@@ -30,6 +31,8 @@ struct CMultiBinElevationMap::Impl {
     multibin::fill::FillResult fill;
     multibin::CellWindow fillWindow;
     bool fillStale = true;
+    /** One writer or concurrent readers: every public entry point takes it (MapLock.h). */
+    multibin::MapLock lock;
 };
 
 }  // namespace mrpt::maps

@@ -5,7 +5,10 @@
 #include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -35,12 +38,17 @@ void validateOptions(const CMultiBinElevationMap& map) {
     map.insertionOptions.validate();
 }
 
-/** t1 - t0 [s] without wrapping: MRPT's timeDifference subtracts int64 ticks, which wraps for
- * timestamps 2^63 ticks apart. */
+/** t1 - t0 [s] as MRPT's timeDifference (whole microseconds), but +-inf where the int64 tick
+ * difference would wrap (timestamps 2^63 ticks apart looked microseconds apart). */
 double secondsBetween(mrpt::Clock::time_point t0, mrpt::Clock::time_point t1) {
-    const double ticks =
-        double(t1.time_since_epoch().count()) - double(t0.time_since_epoch().count());
-    return ticks * double(mrpt::Clock::period::num) / double(mrpt::Clock::period::den);
+    int64_t ticks = 0;
+    if (__builtin_sub_overflow(int64_t(t1.time_since_epoch().count()),
+                               int64_t(t0.time_since_epoch().count()), &ticks))
+        return t1 > t0 ? std::numeric_limits<double>::infinity()
+                       : -std::numeric_limits<double>::infinity();
+    return 1e-6 * double(std::chrono::duration_cast<std::chrono::microseconds>(
+                             mrpt::Clock::duration(ticks))
+                             .count());
 }
 }  // namespace
 
@@ -52,6 +60,7 @@ bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
 bool CMultiBinElevationMap::internal_insertObservation(
     const mrpt::obs::CObservation& obs,
     const std::optional<const mrpt::poses::CPose3D>& robotPose) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     if (const auto* rp = dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs)) {
         // Not inserted: kept as the pose PDF of the observations that follow.
@@ -134,6 +143,7 @@ size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
 
 bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
                                               const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     if (!acceptsLabel(obs.sensorLabel)) {
         m_impl->skippedByLabel++;
@@ -237,6 +247,7 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     return insertIntoGrid(
         isDualGrid() ? m_impl->local : m_impl->grid,

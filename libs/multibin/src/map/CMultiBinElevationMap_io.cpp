@@ -1,13 +1,16 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: serialization, rasters, images and files. */
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/CMemoryStream.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
+#include <mrpt/system/crc.h>
 #include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "multibin/io/RasterExport.h"
 #include "multibin/map/CellSurface.h"
@@ -83,71 +86,122 @@ void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double
         }
     }
 }
+/** What a serialized map holds, read completely (and checked) before the map is touched. */
+struct StoredMap {
+    CMultiBinElevationMap::TCreationOptions creation;
+    CMultiBinElevationMap::TInsertionOptions insertion;
+    multibin::BinGrid grid, local;
+};
+
+/** The version-0/1 body: options text, grid(s), and (version 1) the bin count and tag. */
+StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
+    StoredMap m;
+    // Same layout as MRPT's string (uint32 length, bytes), read with a bound first.
+    uint32_t textBytes = 0;
+    in >> textBytes;
+    if (textBytes > kMaxOptionsTextBytes)
+        corrupt("options text of " + std::to_string(textBytes) + " bytes");
+    std::string iniText(textBytes, '\0');
+    if (textBytes > 0 && in.ReadBuffer(iniText.data(), textBytes) != textBytes)
+        corrupt("options text cut short");
+    mrpt::config::CConfigFileMemory ini(iniText);
+    m.creation.loadFromConfigFile(ini, kCreationSection);
+    m.insertion.loadFromConfigFile(ini, kInsertionSection);
+    multibin::BinGrid &grid = m.grid, &local = m.local;
+    // A window never exceeds what the options allow (growth stops at max_size_m; the margin
+    // covers rounding at the window's edges).
+    const auto& c = m.creation;
+    const double singleSide_m = std::max({c.max_size_m, c.max_x - c.min_x, c.max_y - c.min_y});
+    if (c.dual_grid) {
+        readGrid(in, grid, c.global_resolution_m, c.global_size_m / c.global_resolution_m + 2);
+        readGrid(in, local, c.local_resolution_m, c.local_size_m / c.local_resolution_m + 2);
+    } else {
+        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2);
+    }
+    if (version >= 1) {
+        uint32_t tag = 0;
+        uint64_t bins = 0;
+        in >> bins >> tag;
+        if (tag != kTrailerTag || bins != grid.binCount() + local.binCount())
+            throw std::runtime_error(
+                "CMultiBinElevationMap: corrupt serialized map (truncated: its trailer is "
+                "missing or does not match the bins read)");
+    }
+    return m;
+}
 }  // namespace
 
-uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 1; }
+uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 2; }
+
+namespace {
+/** Version 2 wraps the version-1 body (the payload) as: uint64 payload bytes, the payload, the
+ * CRC-32 of the payload. A flipped bit anywhere in it is an error before anything is parsed. */
+constexpr size_t kPayloadChunkBytes = size_t(1) << 20;
+}  // namespace
 
 void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) const {
-    // Options travel as ini text: readable, and keys can be added without a new version.
-    mrpt::config::CConfigFileMemory ini;
-    creationOptions.saveToConfigFile(ini, kCreationSection);
-    insertionOptions.saveToConfigFile(ini, kInsertionSection);
-    std::string iniText;
-    ini.getContent(iniText);
-    out << iniText;
-
-    writeGrid(out, m_impl->grid);
-    if (creationOptions.dual_grid) writeGrid(out, m_impl->local);
-    out << uint64_t(m_impl->grid.binCount() + m_impl->local.binCount()) << kTrailerTag;
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    mrpt::io::CMemoryStream mem;
+    {
+        auto body = mrpt::serialization::archiveFrom(mem);
+        // Options travel as ini text: readable, and keys can be added without a new version.
+        mrpt::config::CConfigFileMemory ini;
+        creationOptions.saveToConfigFile(ini, kCreationSection);
+        insertionOptions.saveToConfigFile(ini, kInsertionSection);
+        std::string iniText;
+        ini.getContent(iniText);
+        body << iniText;
+        writeGrid(body, m_impl->grid);
+        if (creationOptions.dual_grid) writeGrid(body, m_impl->local);
+        body << uint64_t(m_impl->grid.binCount() + m_impl->local.binCount()) << kTrailerTag;
+    }
+    const auto* payload = static_cast<const uint8_t*>(mem.getRawBufferData());
+    const uint64_t n = mem.getTotalBytesCount();
+    out << n;
+    out.WriteBuffer(payload, n);
+    out << mrpt::system::compute_CRC32(payload, n);
 }
 
 void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
+    auto apply = [this](StoredMap&& m) {
+        creationOptions = m.creation;
+        insertionOptions = m.insertion;
+        internal_clear();
+        m_impl->grid = std::move(m.grid);
+        m_impl->local = std::move(m.local);
+    };
     switch (version) {
         case 0:
-        case 1: {
-            // Same layout as MRPT's string (uint32 length, bytes), read with a bound first.
-            uint32_t textBytes = 0;
-            in >> textBytes;
-            if (textBytes > kMaxOptionsTextBytes)
-                corrupt("options text of " + std::to_string(textBytes) + " bytes");
-            std::string iniText(textBytes, '\0');
-            if (textBytes > 0 && in.ReadBuffer(iniText.data(), textBytes) != textBytes)
-                corrupt("options text cut short");
-            mrpt::config::CConfigFileMemory ini(iniText);
-            TCreationOptions creation;
-            TInsertionOptions insertion;
-            creation.loadFromConfigFile(ini, kCreationSection);
-            insertion.loadFromConfigFile(ini, kInsertionSection);
-
-            // Read everything before touching the map: a corrupt stream leaves it unchanged.
-            multibin::BinGrid grid, local;
-            // A window never exceeds what the options allow (growth stops at max_size_m; the
-            // margin covers rounding at the window's edges).
-            const auto& c = creation;
-            const double singleSide_m =
-                std::max({c.max_size_m, c.max_x - c.min_x, c.max_y - c.min_y});
-            if (c.dual_grid) {
-                readGrid(in, grid, c.global_resolution_m,
-                         c.global_size_m / c.global_resolution_m + 2);
-                readGrid(in, local, c.local_resolution_m,
-                         c.local_size_m / c.local_resolution_m + 2);
-            } else {
-                readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2);
+        case 1:
+            apply(readBody(in, version));
+            break;
+        case 2: {
+            uint64_t n = 0;
+            in >> n;
+            // Read in chunks: the buffer grows only as bytes arrive, whatever length is claimed.
+            std::vector<uint8_t> payload;
+            while (payload.size() < n) {
+                const size_t chunk =
+                    size_t(std::min<uint64_t>(n - payload.size(), kPayloadChunkBytes));
+                const size_t at = payload.size();
+                payload.resize(at + chunk);
+                if (in.ReadBuffer(payload.data() + at, chunk) != chunk)
+                    corrupt("payload cut short: " + std::to_string(n) + " bytes declared");
             }
-            if (version >= 1) {
-                uint32_t tag = 0;
-                uint64_t bins = 0;
-                in >> bins >> tag;
-                if (tag != kTrailerTag || bins != grid.binCount() + local.binCount())
-                    throw std::runtime_error(
-                        "CMultiBinElevationMap: corrupt serialized map (truncated: its trailer "
-                        "is missing or does not match the bins read)");
-            }
-            creationOptions = creation;
-            insertionOptions = insertion;
-            internal_clear();
-            m_impl->grid = std::move(grid);
-            m_impl->local = std::move(local);
+            uint32_t storedCrc = 0;
+            in >> storedCrc;
+            const uint32_t actual = mrpt::system::compute_CRC32(payload.data(), payload.size());
+            if (storedCrc != actual)
+                corrupt("checksum mismatch: the " + std::to_string(n) +
+                        "-byte payload has CRC-32 " + std::to_string(actual) + ", stored " +
+                        std::to_string(storedCrc));
+            mrpt::io::CMemoryStream mem;
+            mem.assignMemoryNotOwn(payload.data(), payload.size());
+            auto body = mrpt::serialization::archiveFrom(mem);
+            StoredMap stored = readBody(body, 1);
+            if (mem.getPosition() != payload.size()) corrupt("bytes after the payload's trailer");
+            apply(std::move(stored));
         } break;
         default:
             MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
@@ -155,6 +209,7 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 }
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::CellWindow& w = m_impl->grid.window();
     multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
     for (int r = 0; r < w.ny; r++)
@@ -193,6 +248,7 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
 }
 
 void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::EsriAsciiGrid g = toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height);
     const int rows = g.rows(), cols = g.cols();
     img.resize(std::max(cols, 1), std::max(rows, 1), mrpt::img::CH_RGB);
@@ -221,6 +277,7 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
 
 void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     const std::string& filNamePrefix) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     // Rasters cover the known cells plus a margin, not the whole grown window.
     const multibin::RasterBox box = multibin::knownBox(toRaster(RasterLayer::Height), 5);
     const auto raster = [&](RasterLayer l) { return multibin::cropRaster(toRaster(l), box); };

@@ -192,6 +192,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
 }  // namespace multibin
 
 void CMultiBinElevationMap::getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
     if (!genericMapParams.enableSaveAs3DObject) return;
     multibin::buildTerrainView(*this,
                                insertionOptions.color_by_sigma ? multibin::SceneColouring::Sigma

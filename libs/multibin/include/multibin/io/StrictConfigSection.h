@@ -42,6 +42,14 @@ public:
     /** Comma- or space-separated words. */
     void read(const std::string& key, std::vector<std::string>& value);
 
+    /** Reads `key`, or `oldName` (its documented alias from before the unit suffix); both
+     * given is an error. */
+    template <typename T>
+    void read(const std::string& key, const std::string& oldName, T& value) {
+        if (has(key) && has(oldName))
+            fail(key, "given twice: as '" + key + "' and as its old name '" + oldName + "'");
+        read(has(oldName) ? oldName : key, value);
+    }
     /** Reads a double and checks lo <= value <= hi (inclusive). */
     void readInRange(const std::string& key, double& value, double lo, double hi);
 

@@ -1,0 +1,77 @@
+/* Threads (issue 16.3): one writer with concurrent readers is safe (doc/reliability.md,
+ * "Threads"). Two threads inserting into one map while a third read corrupted the heap before.
+ * Built alone under ThreadSanitizer by scripts/tsan.sh. */
+#include <gtest/gtest.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <atomic>
+#include <cmath>
+#include <thread>
+#include <vector>
+
+#include "multibin/io/EsriAsciiGrid.h"
+#include "reliability_helpers.h"
+
+using namespace reliability;
+
+namespace {
+/** The writer: `scans` scans along x, the robot moving 2 cm per scan. */
+void write(Map& map, int scans, std::atomic<bool>& done, const std::atomic<int>& started) {
+    while (started < 2) std::this_thread::yield();  // both readers run while it writes
+    for (int i = 0; i < scans; i++) map.insertObservation(*floorScan(200), posePdf(0.02 * i, 0));
+    map.dem_update_map();
+    done = true;
+}
+
+/** A reader: queries until the writer is done; counts the queries and the bad answers. */
+void read(const Map& map, const std::atomic<bool>& done, std::atomic<int>& started,
+          std::atomic<long>& queries, std::atomic<long>& bad) {
+    started++;
+    while (!done) {
+        for (double x = -0.5; x < 1.5; x += 0.1) {
+            double h = 0, s = 0, z = 0;
+            if (map.getHeight(x, 0.3, h, s) && (!std::isfinite(h) || !(s >= 0))) bad++;
+            if (map.getElevation(x, 0.3, h, s, true) != Map::HeightSource::Unknown &&
+                !std::isfinite(h))
+                bad++;
+            if (map.dem_get_z(x, 0.3, z) && !std::isfinite(z)) bad++;
+            queries += 3;
+        }
+        const auto raster = map.toRaster(Map::RasterLayer::Height);
+        if (raster.rows() < 0) bad++;
+        mrpt::io::CMemoryStream mem;
+        auto arch = mrpt::serialization::archiveFrom(mem);
+        arch << map;
+        queries += 2;
+    }
+}
+
+void oneWriterTwoReaders(const Map::TCreationOptions& c) {
+    Map map(c);
+    std::atomic<bool> done{false};
+    std::atomic<int> started{0};
+    std::atomic<long> queries{0}, bad{0};
+    std::thread r1(read, std::cref(map), std::cref(done), std::ref(started), std::ref(queries),
+                   std::ref(bad));
+    std::thread r2(read, std::cref(map), std::cref(done), std::ref(started), std::ref(queries),
+                   std::ref(bad));
+    write(map, 100, done, started);
+    r1.join();
+    r2.join();
+    EXPECT_EQ(bad, 0);
+    EXPECT_GT(queries, 0);
+    double h, s;
+    ASSERT_TRUE(map.getHeight(0.5, 0.3, h, s));
+    EXPECT_NEAR(h, 0.0, 0.02);
+}
+}  // namespace
+
+TEST(Threads, OneWriterAndTwoReadersOfAGrowingMap) { oneWriterTwoReaders(Map::TCreationOptions()); }
+
+TEST(Threads, OneWriterAndTwoReadersOfADualGridThatScrolls) {
+    Map::TCreationOptions c;
+    c.dual_grid = true;
+    c.local_size_m = 1.0;
+    oneWriterTwoReaders(c);
+}
