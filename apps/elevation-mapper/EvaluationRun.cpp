@@ -203,6 +203,7 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
     filled.baseline = "raw_all";
     filled.insert_s = multibin.insert_s;
     filled.fill_s = multibinFill_s;
+    filled.filledFrom = "multibin";  // report.json: within 3 sigma over the filled-only cells
     methods.push_back(filled);
 
     MethodEstimate heightGrid;

@@ -39,6 +39,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
     if (!m_fill.isFilled(k)) return HeightSource::Unknown;
     height_m = m_fill.height_m[k];
     sigma_m = m_fill.sigma_m[k];
+    // FilledHarmonic is a surface fill too (eq 16 plus harmonic rim residuals).
     return m_fill.source[k] == multibin::HeightSource::FilledMedian ? HeightSource::FilledMedian
                                                                      : HeightSource::FilledSurface;
 }
