@@ -442,6 +442,38 @@ int mapper(const std::string& mapPath, const std::string& truthPath) {
                 fill.stats.supportAreas, fill.stats.movingNeighbourhoods,
                 fill.stats.rimCheckHarmonic);
     for (int m : fill.stats.termsChosen) std::printf(" %d", m);
+    std::printf("; m of the rim check's harmonic surfaces:");
+    for (int m : fill.stats.rimCheckTerms) std::printf(" %d", m);
+    std::printf("\n");
+    // Surface-filled cells per chosen m: support areas are filled in gap-label order.
+    HeightRaster measured(fill.lattice);
+    for (size_t k = 0; k < fill.source.size(); k++)
+        if (fill.source[k] == HeightSource::Measured)
+            measured.height_m[k] = 0, measured.sigma_m[k] = 1, measured.certainty[k] = 1;
+    std::vector<int> sizes;
+    const std::vector<int> label = labelGaps(measured, sizes);
+    std::vector<int> surfaceCells(sizes.size(), 0), harmonicCells(sizes.size(), 0);
+    for (size_t k = 0; k < fill.source.size(); k++) {
+        surfaceCells[size_t(label[k])] += fill.source[k] == HeightSource::FilledSurface ||
+                                          fill.source[k] == HeightSource::FilledHarmonic;
+        harmonicCells[size_t(label[k])] += fill.source[k] == HeightSource::FilledHarmonic;
+    }
+    // Cells whose heights came from a surface with m terms, per path (kriging: the best m of
+    // its search; harmonic: the m of the rim check's surface).
+    std::map<int, int> krigingByM, harmonicByM;
+    size_t area = 0, rimCheck = 0;
+    for (size_t g = 0; g < sizes.size(); g++) {
+        if (!surfaceCells[g] || area >= fill.stats.termsChosen.size()) continue;
+        const int m = fill.stats.termsChosen[area++];
+        if (harmonicCells[g] && rimCheck < fill.stats.rimCheckTerms.size())
+            harmonicByM[fill.stats.rimCheckTerms[rimCheck++]] += surfaceCells[g];
+        else
+            krigingByM[m] += surfaceCells[g];
+    }
+    std::printf("surface-filled cells by m: kriging");
+    for (const auto& [m, n] : krigingByM) std::printf(" m = %d: %d", m, n);
+    std::printf("; harmonic (rim check)");
+    for (const auto& [m, n] : harmonicByM) std::printf(" m = %d: %d", m, n);
     std::printf("\n");
     return 0;
 }

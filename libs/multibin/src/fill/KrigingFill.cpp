@@ -182,6 +182,7 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o, const SupportAre
         harmonic.resize(cells.size());
         for (size_t c = 0; c < cells.size(); c++) harmonic[c] = alternative(ci[c], cj[c]) + hg[c];
         out.stats.rimCheckHarmonic++;
+        out.stats.rimCheckTerms.push_back(int(alternative.terms.size()));
     }
     // Each path its own sigma (doc/gap-filling.md, "Sigma of filled cells"): the harmonic
     // heights get the surface path's semivariogram sigma plus the mean squared error the

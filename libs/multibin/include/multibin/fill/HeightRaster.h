@@ -66,6 +66,9 @@ struct FillResult {
         std::vector<int> termsChosen;  //!< AIC-chosen number m of Gaussians, per support area
         int movingNeighbourhoods = 0;  //!< gaps kriged in moving neighbourhoods (tiles)
         int rimCheckHarmonic = 0;      //!< of those, gaps the rim check gave to the harmonic path
+        /** m of the eq 16 surface whose heights those gaps took (AICc on independent residuals;
+         * termsChosen keeps the kriging's m for them), one per rimCheckHarmonic gap */
+        std::vector<int> rimCheckTerms;
     } stats;
 
     int nx() const { return lattice.nx(); }
