@@ -7,11 +7,11 @@
 #include <cstdio>
 #include <random>
 
-#include "multibin/io/StrictConfigSection.h"
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/GaussianSurface.h"
 #include "multibin/fill/Kriging.h"
 #include "multibin/fill/ParticleSwarm.h"
+#include "multibin/io/StrictConfigSection.h"
 
 using multibin::HeightSource;
 using namespace multibin::fill;
