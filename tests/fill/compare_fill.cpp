@@ -411,12 +411,12 @@ int mapper(const std::string& mapPath, const std::string& truthPath) {
     map.insertionOptions.fill = g_base;
     map.dem_update_map();
     const FillResult& fill = map.lastFill();
-    multibin::eval::EvalLattice lattice;
+    multibin::Lattice lattice;
     const auto truth = multibin::eval::groundTruthOnLattice(EsriAsciiGrid::load(truthPath),
                                                             fill.lattice.cellSize_m, lattice);
     std::map<HeightSource, std::vector<Err>> bySource;
-    for (int row = 0; row < lattice.ny; row++)
-        for (int col = 0; col < lattice.nx; col++) {
+    for (int row = 0; row < lattice.ny(); row++)
+        for (int col = 0; col < lattice.nx(); col++) {
             int c, r;
             const float t = truth(row, col);
             if (!std::isfinite(t) ||

@@ -45,13 +45,13 @@ std::map<multibin::HeightSource, Coverage> filledOnlyCoverage(const std::string&
     map.dem_update_map();
     const multibin::fill::FillResult& fill = map.lastFill();
 
-    multibin::eval::EvalLattice lattice;
+    multibin::Lattice lattice;
     const auto truth = multibin::eval::groundTruthOnLattice(
         multibin::EsriAsciiGrid::load(dir + "/rawlogs/" + scenario + "_gt.asc"),
         fill.lattice.cellSize_m, lattice);
     std::map<multibin::HeightSource, Coverage> out;
-    for (int row = 0; row < lattice.ny; row++)
-        for (int col = 0; col < lattice.nx; col++) {
+    for (int row = 0; row < lattice.ny(); row++)
+        for (int col = 0; col < lattice.nx(); col++) {
             int c, r;
             const float t = truth(row, col);
             if (!std::isfinite(t) ||
