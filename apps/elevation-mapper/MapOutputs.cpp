@@ -119,10 +119,14 @@ OutputFolder::OutputFolder(const fs::path& dir,
     : m_dir(dir), m_inputs(std::move(inputs)) {
     if (fs::exists(dir) && !fs::is_directory(dir))
         throw std::invalid_argument("--out '" + dir.string() + "' exists and is not a folder");
+}
+
+void OutputFolder::create() const {
+    // Created at the first file, so a run that fails before writing leaves no empty folder.
     std::error_code ec;
-    fs::create_directories(dir, ec);
+    fs::create_directories(m_dir, ec);
     if (ec)
-        throw std::runtime_error("cannot create the output folder '" + dir.string() +
+        throw std::runtime_error("cannot create the output folder '" + m_dir.string() +
                                  "': " + ec.message());
 }
 
@@ -151,17 +155,20 @@ void OutputFolder::checkNotAnInput(const std::string& name) const {
 
 void OutputFolder::write(const std::string& name, const std::vector<uint8_t>& bytes) const {
     checkNotAnInput(name);
+    create();
     multibin::writeFileAtomically((m_dir / name).string(), bytes);
 }
 
 void OutputFolder::write(const std::string& name, const std::string& text) const {
     checkNotAnInput(name);
+    create();
     multibin::writeFileAtomically((m_dir / name).string(), text);
 }
 
 void OutputFolder::writeWith(const std::string& name,
                              const std::function<bool(const std::string&)>& writer) const {
     checkNotAnInput(name);
+    create();
     multibin::writeFileAtomically((m_dir / name).string(), writer);
 }
 
@@ -232,10 +239,7 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
         });
         multibin::PreviewStyle src;
         src.title = "source of the height";
-        using HS = CMultiBinElevationMap::HeightSource;
-        src.categories = {{int(HS::Measured), "measured"},
-                          {int(HS::FilledMedian), "filled: median"},
-                          {int(HS::FilledSurface), "filled: surface"}};
+        src.categories = multibin::heightSourceCategories();
         steps.emplace_back("elevation_source.png", [&folder, &layers, src] {
             folder.write("elevation_source.png", multibin::encodePreviewPng(layers.source, src));
         });

@@ -38,7 +38,8 @@ struct OutputSelection {
  * truncated file); every error names its file. */
 class OutputFolder {
 public:
-    /** inputs: (what, path), e.g. ("--ground-truth", "gt.asc"). Creates the folder. */
+    /** inputs: (what, path), e.g. ("--ground-truth", "gt.asc"). The folder is created when the
+     * first file is written. */
     OutputFolder(const std::filesystem::path& dir,
                  std::vector<std::pair<std::string, std::string>> inputs);
     const std::filesystem::path& dir() const { return m_dir; }
@@ -52,6 +53,7 @@ public:
                    const std::function<bool(const std::string& path)>& writer) const;
 
 private:
+    void create() const;
     std::filesystem::path m_dir;
     std::vector<std::pair<std::string, std::string>> m_inputs;
 };

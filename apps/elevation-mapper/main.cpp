@@ -306,8 +306,10 @@ int run(const Arguments& args) {
     ProgressBar::runWithProgress("filling", [&] { elevation->dem_update_map(); });  // once
     const double fill_s = std::chrono::duration<double>(Clock::now() - fill0).count();
     std::string table;
+    // Scoring (the MRF solve draws its own line) and the layers of a large window take seconds.
     if (evaluation) table = evaluation->finish(folder, insert_s, fill_s);
-    const MapLayers layers = MapLayers::of(*elevation);
+    MapLayers layers;
+    ProgressBar::runWithProgress("layers", [&] { layers = MapLayers::of(*elevation); });
     const std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
 
     const auto& fs_ = elevation->lastFill().stats;

@@ -73,6 +73,16 @@ void writePatchRawlog(const fs::path& path, int side = 10) {
     writeRawlog(path, {cloud});
 }
 
+/** The ground truth of writePatchRawlog(): the floor at z = -0.3 m around the patch. */
+void writePatchTruth(const fs::path& path) {
+    multibin::EsriAsciiGrid gt;
+    gt.cellsize_m = 0.02;
+    gt.xllcenter_m = 0.9;
+    gt.yllcenter_m = -0.1;
+    gt.heights_m.setConstant(20, 20, -0.3f);
+    gt.save(path.string());
+}
+
 /** An ini with the map in `section`; `creation` adds keys to its creation options. */
 void writeIni(const fs::path& path, const std::string& section = "MappingApplication",
               const std::string& creation = "") {
@@ -266,12 +276,7 @@ TEST(ElevationMapperOutputs, NeverOverwritesAnInput) {
     EXPECT_EQ(readAll(out / "elevation_map.bin"), iniBytes);
 
     // A ground truth where the evaluation writes its truth raster.
-    multibin::EsriAsciiGrid gt;
-    gt.cellsize_m = 0.02;
-    gt.xllcenter_m = 0.9;
-    gt.yllcenter_m = -0.1;
-    gt.heights_m.setConstant(20, 20, -0.3f);
-    gt.save((out / "eval_truth.asc").string());
+    writePatchTruth(out / "eval_truth.asc");
     const std::string gtBytes = readAll(out / "eval_truth.asc");
     r = runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
                          (d / "patch.rawlog").string() + " --ground-truth " +
@@ -308,4 +313,33 @@ TEST(ElevationMapperOutputs, FullDiskLeavesNoTruncatedFile) {
         if (complete.count(name))
             EXPECT_TRUE(readAll(d / "out" / name) == complete[name]) << name << " is not complete";
     }
+}
+
+// On a terminal (here a pseudo-terminal made by script(1)) every stage draws its progress line:
+// mapping, filling, the layers, writing and the figures; off a terminal nothing of it reaches
+// stderr.
+TEST(ElevationMapperCli, ProgressOnATerminalForEveryStage) {
+    if (std::system("command -v script >/dev/null 2>&1") != 0)
+        GTEST_SKIP() << "script(1) (bsdutils) is not installed";
+    const fs::path d = scratchDir("progress");
+    writePatchRawlog(d / "patch.rawlog");
+    writeIni(d / "maps.ini");
+    writePatchTruth(d / "gt.asc");
+    const std::string args = "--config " + (d / "maps.ini").string() + " --rawlog " +
+                             (d / "patch.rawlog").string() + " --ground-truth " +
+                             (d / "gt.asc").string() + " --out " + (d / "out").string();
+    const std::string cmd = "script -qec \"" + std::string(ELEVATION_MAPPER_EXE) + " " + args +
+                            " >/dev/null\" /dev/null > " + (d / "tty.txt").string() +
+                            " 2>&1 < /dev/null";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string tty = readAll(d / "tty.txt");
+    for (const char* stage : {"mapping [", "filling [", "layers [", "writing [", "figures ["})
+        EXPECT_NE(tty.find(stage), std::string::npos) << stage << " missing from:\n" << tty;
+    // The layer panels are drawn from a scratch copy of the rasters: none is left in the output.
+    EXPECT_TRUE(fs::exists(d / "out" / "layers.png"));
+    EXPECT_FALSE(fs::exists(d / "out" / "elevation_height.asc"));
+
+    const RunResult plain = runMapper(d, args + " --no-plots");
+    EXPECT_EQ(plain.exitCode, 0);
+    EXPECT_EQ(plain.err, "");
 }

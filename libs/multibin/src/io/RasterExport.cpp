@@ -120,16 +120,15 @@ std::string meshPlyText(const EsriAsciiGrid& raster) {
     return out.str();
 }
 
-namespace {
-
-/** 1, 2 or 5 times a power of ten, near `rough`. */
 double niceStep(double rough) {
-    if (!(rough > 0)) return 1;
+    if (!(rough > 0) || !std::isfinite(rough)) return 1;
     const double p = std::pow(10.0, std::floor(std::log10(rough)));
     for (const double m : {1.0, 2.0, 5.0})
         if (m * p >= rough) return m * p;
     return 10 * p;
 }
+
+namespace {
 
 std::string formatted(const char* format, double v) {
     if (std::abs(v) < 1e-9) v = 0;  // no "-0"
@@ -154,13 +153,6 @@ void text(cv::Mat& img, const std::string& s, cv::Point at, double size = 0.4) {
 int textWidth(const std::string& s, double size = 0.4) {
     int base = 0;
     return cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, size, 1, &base).width;
-}
-
-/** Categorical colours (BGR), the tab10 palette's first entries. */
-cv::Vec3b categoryColour(size_t i) {
-    static const cv::Vec3b palette[] = {{180, 119, 31}, {14, 127, 255},  {44, 160, 44},
-                                        {40, 39, 214},  {189, 103, 148}, {75, 86, 140}};
-    return palette[i % (sizeof palette / sizeof palette[0])];
 }
 
 }  // namespace
@@ -194,8 +186,8 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     auto colourOf = [&](float v) -> cv::Vec3b {
         if (!std::isfinite(v)) return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
         if (categorical) {
-            for (size_t i = 0; i < style.categories.size(); i++)
-                if (int(std::lround(v)) == style.categories[i].first) return categoryColour(i);
+            for (const RasterCategory& k : style.categories)
+                if (int(std::lround(v)) == k.value) return {k.rgb[2], k.rgb[1], k.rgb[0]};
             return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
         }
         const int k = std::clamp(int((v - lo) / span * 255.f + 0.5f), 0, 255);
@@ -246,11 +238,11 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     if (categorical) {
         for (size_t i = 0; i < style.categories.size(); i++) {
             const int y = T + int(i) * 24;
-            const cv::Vec3b c = categoryColour(i);
-            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, cv::Scalar(c[0], c[1], c[2]),
+            const RasterCategory& k = style.categories[i];
+            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, cv::Scalar(k.rgb[2], k.rgb[1], k.rgb[0]),
                           cv::FILLED);
             cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, kBlack);
-            text(img, style.categories[i].second, {bx + 24, y + 13});
+            text(img, k.name, {bx + 24, y + 13});
             legendBottom = y + 24;
         }
     } else {

@@ -221,6 +221,9 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
 
 void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     const std::string& filNamePrefix) const {
+    // Rasters cover the known cells plus a margin, not the whole grown window.
+    const multibin::RasterBox box = multibin::knownBox(toRaster(RasterLayer::Height), 5);
+    const auto raster = [&](RasterLayer l) { return multibin::cropRaster(toRaster(l), box); };
     for (const bool sigma : {false, true}) {
         const std::string layer = sigma ? "_sigma" : "_height";
         mrpt::img::CImage img;
@@ -228,12 +231,12 @@ void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
         if (!img.saveToFile(filNamePrefix + layer + ".png"))
             throw std::runtime_error("CMultiBinElevationMap: cannot write " + filNamePrefix +
                                      layer + ".png");
-        toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height)
+        raster(sigma ? RasterLayer::Sigma : RasterLayer::Height)
             .save(filNamePrefix + layer + ".asc");
     }
-    toRaster(RasterLayer::Certainty).save(filNamePrefix + "_certainty.asc");
-    toRaster(RasterLayer::Source).save(filNamePrefix + "_source.asc");
-    const multibin::EsriAsciiGrid heights = toRaster(RasterLayer::Height);
+    raster(RasterLayer::Certainty).save(filNamePrefix + "_certainty.asc");
+    raster(RasterLayer::Source).save(filNamePrefix + "_source.asc");
+    const multibin::EsriAsciiGrid heights = raster(RasterLayer::Height);
     if (heights.rows() > 0 && heights.cols() > 0) {
         multibin::saveFloatTiff(heights, filNamePrefix + "_height.tif");
         multibin::saveMeshPly(heights, filNamePrefix + ".ply");

@@ -29,16 +29,6 @@ namespace {
 using Layer = CMultiBinElevationMap::RasterLayer;
 using HS = CMultiBinElevationMap::HeightSource;
 
-struct Category {
-    HS source;
-    const char* name;
-    mrpt::img::TColor colour;
-};
-// The colours of elevation_source.png and layers.png (tab10 blue, orange, green).
-const Category kCategories[] = {{HS::Measured, "measured", {31, 119, 180}},
-                                {HS::FilledMedian, "filled: median", {255, 127, 14}},
-                                {HS::FilledSurface, "filled: surface", {44, 160, 44}}};
-
 Layer layerOf(SceneColouring c) {
     switch (c) {
         case SceneColouring::Sigma:
@@ -52,15 +42,16 @@ Layer layerOf(SceneColouring c) {
     }
 }
 
-/** 1, 2 or 5 times a power of ten, near `rough`. */
-double niceStep(double rough) {
-    const double p = std::pow(10.0, std::floor(std::log10(rough)));
-    for (const double m : {1.0, 2.0, 5.0})
-        if (m * p >= rough) return m * p;
-    return 10 * p;
-}
-
 }  // namespace
+
+const std::vector<RasterCategory>& heightSourceCategories() {
+    // tab10's blue, orange and green: distinct, and none is the grey of unknown cells.
+    static const std::vector<RasterCategory> categories{
+        {int(HS::Measured), "measured", {31, 119, 180}},
+        {int(HS::FilledMedian), "filled: median", {255, 127, 14}},
+        {int(HS::FilledSurface), "filled: surface", {44, 160, 44}}};
+    return categories;
+}
 
 SceneColouring sceneColouringFromName(const std::string& name) {
     for (const SceneColouring c : {SceneColouring::Height, SceneColouring::Sigma,
@@ -130,8 +121,9 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
             mrpt::img::TColor colour(128, 128, 128);
             if (known && std::isfinite(v)) {
                 if (colouring == SceneColouring::Source) {
-                    for (const Category& k : kCategories)
-                        if (int(std::lround(v)) == int(k.source)) colour = k.colour;
+                    for (const RasterCategory& k : heightSourceCategories())
+                        if (int(std::lround(v)) == k.value)
+                            colour = mrpt::img::TColor(k.rgb[0], k.rgb[1], k.rgb[2]);
                 } else {
                     float R, G, B;
                     mrpt::img::colormap(cmap, (v - lo) / span, R, G, B);
@@ -170,13 +162,13 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
 
     // Legend beside the map (+x side), centred on it in y.
     const double legendH = std::max(step, 0.4 * ySpan);
-    const double lx = x1 + 0.5 * step, ly = 0.5 * (y0 + y1) - 0.5 * legendH;
+    const double lx = x1 + 0.2 * step, ly = 0.5 * (y0 + y1) - 0.5 * legendH;
     if (colouring == SceneColouring::Source) {
         double y = ly + legendH;
-        for (const Category& k : kCategories) {
+        for (const RasterCategory& k : heightSourceCategories()) {
             auto t = mrpt::opengl::CText::Create(k.name);
             t->setLocation(lx, y, zHi);
-            t->setColor_u8(k.colour);
+            t->setColor_u8(mrpt::img::TColor(k.rgb[0], k.rgb[1], k.rgb[2]));
             out.insert(t);
             y -= 0.1 * legendH;
         }
@@ -185,7 +177,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
         const std::string format =
             colouring == SceneColouring::Certainty ? "%.0f" : std::string("%.3f m");
         auto bar = mrpt::opengl::CColorBar::Create(cmap, 0.1 * legendH, legendH, 0.f, 1.f, lo, hi,
-                                                   format, float(0.05 * legendH));
+                                                   format, float(0.035 * legendH));
         bar->setName("colour bar");
         bar->setLocation(lx, ly, zHi);
         out.insert(bar);

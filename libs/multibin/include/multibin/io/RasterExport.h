@@ -36,15 +36,26 @@ std::string worldFileText(const EsriAsciiGrid& raster);
  * known). */
 std::string meshPlyText(const EsriAsciiGrid& raster);
 
+/** 1, 2 or 5 times a power of ten, the smallest at or above `rough` (> 0): tick and grid
+ * spacings [m]. */
+double niceStep(double rough);
+
+/** A category of a categorical layer: its value, name and colour (R, G, B). */
+struct RasterCategory {
+    int value;
+    std::string name;
+    uint8_t rgb[3];
+};
+
 /** How encodePreviewPng() draws a layer. */
 struct PreviewStyle {
     std::string title;  //!< e.g. "height [m]"
     /** Continuous layers: OpenCV colormap (cv::COLORMAP_*), bar labelled with `valueFormat`. */
     int colormap = 16;  // cv::COLORMAP_VIRIDIS
     std::string valueFormat = "%.3f";
-    /** Categorical layers: the value of each category and its name; a legend of swatches replaces
-     * the colour bar. Samples with other values are drawn as unknown. */
-    std::vector<std::pair<int, std::string>> categories;
+    /** Categorical layers: a legend of swatches replaces the colour bar. Samples with other
+     * values are drawn as unknown. */
+    std::vector<RasterCategory> categories;
 };
 
 /** A PNG preview of a raster layer: north up, x and y axes with ticks in metres, a scale bar, a

@@ -4,6 +4,9 @@
 #include <mrpt/opengl/CSetOfObjects.h>
 
 #include <string>
+#include <vector>
+
+#include "multibin/io/RasterExport.h"
 
 namespace mrpt::maps {
 class CMultiBinElevationMap;
@@ -18,6 +21,11 @@ enum class SceneColouring {
     Certainty,  //!< the winning bin's certainty c [-]
     Source      //!< measured, median-filled, surface-filled (fixed categorical colours)
 };
+
+/** The categories of the source layer (CMultiBinElevationMap::HeightSource: measured, filled by
+ * the weighted median, filled by the Gaussian surface) with the colours every view of it uses
+ * (the 3D view, elevation_source.png; plot_report.py repeats them for matplotlib). */
+const std::vector<RasterCategory>& heightSourceCategories();
 
 /** Parses "height", "sigma", "certainty" or "source"; throws std::invalid_argument naming the
  * text otherwise. */
