@@ -211,6 +211,7 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     filled.baseline = "raw_all";
     filled.insert_s = multibin.insert_s;
     filled.fill_s = multibinFill_s;
+    filled.filledFrom = "multibin";  // report.json: within 3 sigma over the filled-only cells
     methods.push_back(filled);
 
     MethodEstimate heightGrid;

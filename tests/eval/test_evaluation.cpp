@@ -56,6 +56,25 @@ TEST(Evaluation, Within3SigmaCountsCellsInsideTheBand) {
     EXPECT_NEAR(*scores.at("m").within3Sigma, 2.0 / 3.0, 1e-12);
 }
 
+TEST(Evaluation, Within3SigmaOverFilledOnlyCellsLeavesTheMeasuredOnesOut) {
+    const CellArray truth = array2x2(0, 0, 0, 0);
+    // Cells 0 and 1 measured (in the twin), 2 and 3 filled: of those, cell 2 misses its band.
+    MethodEstimate measured{"measured", array2x2(0.029f, -0.031f, NAN, NAN), {}, "measured", 0, 0};
+    MethodEstimate filled{"filled",
+                          array2x2(0.029f, -0.031f, 0.05f, 0.01f),
+                          array2x2(0.01f, 0.01f, 0.01f, 0.01f),
+                          "measured",
+                          0,
+                          0};
+    filled.filledFrom = "measured";
+    const auto scores = scoreMethods(truth, {measured, filled});
+    ASSERT_TRUE(scores.at("filled").within3SigmaFilledOnly.has_value());
+    EXPECT_EQ(scores.at("filled").filledOnlyCells, 2u);
+    EXPECT_NEAR(*scores.at("filled").within3SigmaFilledOnly, 0.5, 1e-12);
+    EXPECT_NEAR(*scores.at("filled").within3Sigma, 0.5, 1e-12);
+    EXPECT_FALSE(scores.at("measured").within3SigmaFilledOnly.has_value());
+}
+
 TEST(Evaluation, UnknownBaselineIsRefused) {
     const CellArray truth = array2x2(0, 0, 0, 0);
     EXPECT_THROW(scoreMethods(truth, {{"m", truth, {}, "nope", 0, 0}}), std::invalid_argument);

@@ -4,13 +4,19 @@
  *   tests/fill/compare_fill coverage       sigma coverage on held-out gaps (other placements)
  *   tests/fill/compare_fill accuracy       RMSE: Gaussian vs median vs cv::inpaint
  *   tests/fill/compare_fill accuracy-mrf   the same plus MRPT's CHeightGridMap2D_MRF (minutes)
+ *   tests/fill/compare_fill mapper MAP.bin GT.asc
+ *                                          sigma coverage of the filled-only cells of a map
+ *                                          written by elevation-mapper, per fill path
  * `seed=N` picks the accuracy placements (3, the reported ones, by default; 1 and 2 are the ones
  * used to choose settings).
  * Further arguments `fill_key=value` (ini keys of FillOptions) change the options every mode
  * starts from, e.g. `compare_fill accuracy fill_extrapolation_margin=1.0`.
  * Every figure of doc/gap-filling.md comes from these commands. */
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/CHeightGridMap2D_MRF.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
 #include <chrono>
@@ -21,8 +27,10 @@
 #include <string>
 
 #include "FillTestData.h"
+#include "multibin/eval/Evaluation.h"
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/Kriging.h"
+#include "multibin/io/EsriAsciiGrid.h"
 
 using namespace multibin;
 using namespace multibin::fill;
@@ -81,7 +89,11 @@ void collect(const FillResult& res, const std::vector<Board>& boards, int board,
     for (int iy = 0; iy < res.ny(); iy++)
         for (int ix = 0; ix < res.nx(); ix++) {
             const size_t k = res.index(ix, iy);
-            if (res.source[k] != kind) continue;
+            // Gaussian: every cell filled from an eq 16 fit (kriging or harmonic rim residuals).
+            const bool match =
+                res.source[k] == kind || (kind == HeightSource::FilledSurface &&
+                                          res.source[k] == HeightSource::FilledHarmonic);
+            if (!match) continue;
             const double t = boards[size_t(board)].at(kCropOffset + ix, kCropOffset + iy);
             out.push_back({res.height_m[k] - t, res.sigma_m[k]});
         }
@@ -109,11 +121,16 @@ double calibrateGain(const std::vector<Err>& g0, const std::vector<Err>& g1, dou
     return hi;
 }
 
+/** How often each m was chosen (the best m of each support area) in the last coverage run. */
+std::map<int, int> g_termsChosen;
+
 void runCalibrationSet(const std::vector<Board>& boards, const FillOptions& opt, unsigned seed,
                        std::map<int, std::vector<Err>>& gauss,
                        std::map<int, std::vector<Err>>& med) {
+    g_termsChosen.clear();
     for (const auto& c : makeGapCases(int(boards.size()), kLargeSizes, 4, 4, seed)) {
         const auto res = fillGaps(caseRaster(boards, c), opt);
+        for (int m : res.stats.termsChosen) g_termsChosen[m]++;
         collect(res, boards, c.board, HeightSource::FilledSurface, gauss[c.size]);
     }
     for (int s : kSmallSizes)
@@ -136,15 +153,19 @@ unsigned g_accuracySeed = 3;
 int calibrate(const std::vector<Board>& boards) {
     FillOptions o0 = g_base, o1 = g_base;
     o0.sigmaFloor_m = o1.sigmaFloor_m = 0;
-    o0.medianSigmaGain = o0.gaussianSigmaGain = 0;
-    o1.medianSigmaGain = o1.gaussianSigmaGain = 1;
+    o0.medianSigmaGain = o0.gaussianSigmaGain = o0.harmonicSigmaGain = 0;
+    o1.medianSigmaGain = o1.gaussianSigmaGain = o1.harmonicSigmaGain = 1;
     std::map<int, std::vector<Err>> g0, m0, g1, m1;
     runCalibrationSet(boards, o0, 1, g0, m0);
     runCalibrationSet(boards, o1, 1, g1, m1);
     const FillOptions def = g_base;
     std::printf("calibration set (seed 1): %zu Gaussian cells, %zu median cells\n",
                 flatten(g0).size(), flatten(m0).size());
-    std::printf("fill_gaussian_sigma_gain = %.3f\n",
+    // The square gaps go to the kriging by default, to the surface path (eq 16 plus harmonic
+    // rim residuals) with fill_residual_model=harmonic: the gain of the path that ran.
+    std::printf("%s = %.3f\n",
+                def.residualModel == ResidualModel::Kriging ? "fill_gaussian_sigma_gain"
+                                                            : "fill_harmonic_sigma_gain",
                 calibrateGain(flatten(g0), flatten(g1), def.sigmaFloor_m));
     std::printf("fill_median_sigma_gain = %.3f\n",
                 calibrateGain(flatten(m0), flatten(m1), def.sigmaFloor_m));
@@ -168,6 +189,9 @@ int coverage(const std::vector<Board>& boards) {
         for (const auto& [s, e] : gauss) coverageRow("Gaussian", s, e);
         coverageRow("median, all", 0, flatten(med));
         coverageRow("Gaussian, all", 0, flatten(gauss));
+        std::printf("\nm chosen (support areas):");
+        for (const auto& [m, n] : g_termsChosen) std::printf(" m = %d: %d", m, n);
+        std::printf("\n");
     }
     return 0;
 }
@@ -375,13 +399,94 @@ int accuracy(const std::vector<Board>& boards, bool withMrf) {
     return 0;
 }
 
+/** The filled-only cells of a map written by elevation-mapper (refilled with the options of
+ * this run), per fill path, against the truth averaged on the map's cells as the evaluation
+ * does. */
+int mapper(const std::string& mapPath, const std::string& truthPath) {
+    mrpt::maps::CMultiBinElevationMap map;
+    {
+        mrpt::io::CFileGZInputStream f(mapPath);
+        mrpt::serialization::archiveFrom(f) >> map;
+    }
+    map.insertionOptions.fill = g_base;
+    map.dem_update_map();
+    const FillResult& fill = map.lastFill();
+    multibin::Lattice lattice;
+    const auto truth = multibin::eval::groundTruthOnLattice(EsriAsciiGrid::load(truthPath),
+                                                            fill.lattice.cellSize_m, lattice);
+    std::map<HeightSource, std::vector<Err>> bySource;
+    for (int row = 0; row < lattice.ny(); row++)
+        for (int col = 0; col < lattice.nx(); col++) {
+            int c, r;
+            const float t = truth(row, col);
+            if (!std::isfinite(t) ||
+                !fill.lattice.cellOf(lattice.cellCenterX_m(col), lattice.cellCenterY_m(row), c, r))
+                continue;
+            const size_t k = fill.index(c, r);
+            if (fill.isFilled(k))
+                bySource[fill.source[k]].push_back({fill.height_m[k] - t, fill.sigma_m[k]});
+        }
+    std::printf(
+        "| filled by | - | cells | within 1 sigma [%%] | within 2 sigma [%%] | within 3 sigma [%%] "
+        "| RMSE [mm] | mean sigma [mm] |\n|---|---|---|---|---|---|---|---|\n");
+    std::vector<Err> all;
+    for (const auto& [src, e] : bySource) {
+        coverageRow(src == HeightSource::FilledMedian    ? "median"
+                    : src == HeightSource::FilledSurface ? "kriging (eq 16 trend)"
+                                                         : "harmonic (eq 16 + rim residuals)",
+                    0, e);
+        all.insert(all.end(), e.begin(), e.end());
+    }
+    coverageRow("filled only, all", 0, all);
+    std::printf("support areas %d, moving neighbourhoods %d, rim check -> harmonic %d, m:",
+                fill.stats.supportAreas, fill.stats.movingNeighbourhoods,
+                fill.stats.rimCheckHarmonic);
+    for (int m : fill.stats.termsChosen) std::printf(" %d", m);
+    std::printf("; m of the rim check's harmonic surfaces:");
+    for (int m : fill.stats.rimCheckTerms) std::printf(" %d", m);
+    std::printf("\n");
+    // Surface-filled cells per chosen m: support areas are filled in gap-label order.
+    HeightRaster measured(fill.lattice);
+    for (size_t k = 0; k < fill.source.size(); k++)
+        if (fill.source[k] == HeightSource::Measured)
+            measured.height_m[k] = 0, measured.sigma_m[k] = 1, measured.certainty[k] = 1;
+    std::vector<int> sizes;
+    const std::vector<int> label = labelGaps(measured, sizes);
+    std::vector<int> surfaceCells(sizes.size(), 0), harmonicCells(sizes.size(), 0);
+    for (size_t k = 0; k < fill.source.size(); k++) {
+        surfaceCells[size_t(label[k])] += fill.source[k] == HeightSource::FilledSurface ||
+                                          fill.source[k] == HeightSource::FilledHarmonic;
+        harmonicCells[size_t(label[k])] += fill.source[k] == HeightSource::FilledHarmonic;
+    }
+    // Cells whose heights came from a surface with m terms, per path (kriging: the best m of
+    // its search; harmonic: the m of the rim check's surface).
+    std::map<int, int> krigingByM, harmonicByM;
+    size_t area = 0, rimCheck = 0;
+    for (size_t g = 0; g < sizes.size(); g++) {
+        if (!surfaceCells[g] || area >= fill.stats.termsChosen.size()) continue;
+        const int m = fill.stats.termsChosen[area++];
+        if (harmonicCells[g] && rimCheck < fill.stats.rimCheckTerms.size())
+            harmonicByM[fill.stats.rimCheckTerms[rimCheck++]] += surfaceCells[g];
+        else
+            krigingByM[m] += surfaceCells[g];
+    }
+    std::printf("surface-filled cells by m: kriging");
+    for (const auto& [m, n] : krigingByM) std::printf(" m = %d: %d", m, n);
+    std::printf("; harmonic (rim check)");
+    for (const auto& [m, n] : harmonicByM) std::printf(" m = %d: %d", m, n);
+    std::printf("\n");
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     const std::string mode = argc > 1 ? argv[1] : "";
     try {
         mrpt::config::CConfigFileMemory ini;
-        for (int a = 2; a < argc; a++) {
+        const bool onMap = mode == "mapper";
+        if (onMap && argc < 4) throw std::invalid_argument("mapper needs MAP.bin GT.asc");
+        for (int a = onMap ? 4 : 2; a < argc; a++) {
             const std::string kv = argv[a];
             const auto eq = kv.find('=');
             if (eq == std::string::npos)
@@ -393,6 +498,7 @@ int main(int argc, char** argv) {
             ini.write("fill", kv.substr(0, eq), kv.substr(eq + 1));
         }
         g_base.loadFromConfigFile(ini, "fill");
+        if (onMap) return mapper(argv[2], argv[3]);
         const auto boards = loadBoards();
         if (mode == "calibrate") return calibrate(boards);
         if (mode == "coverage") return coverage(boards);
@@ -404,6 +510,7 @@ int main(int argc, char** argv) {
     }
     std::fprintf(
         stderr,
-        "usage: compare_fill calibrate|coverage|accuracy|accuracy-mrf [fill_key=value ...]\n");
+        "usage: compare_fill calibrate|coverage|accuracy|accuracy-mrf [fill_key=value ...]\n"
+        "       compare_fill mapper MAP.bin GT.asc [fill_key=value ...]\n");
     return 2;
 }

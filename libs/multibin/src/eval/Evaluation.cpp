@@ -170,14 +170,28 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
                              meanSquaredError(base->second->height_m, truth_m, sharedCells));
         s.coverage = truthCells ? double(own.cells) / double(truthCells) : 0.0;
         if (m.sigma_m.size() > 0) {
-            size_t inside = 0;
-            for (Eigen::Index r = 0; r < truth_m.rows(); r++)
-                for (Eigen::Index c = 0; c < truth_m.cols(); c++) {
-                    const float h = m.height_m(r, c), t = truth_m(r, c);
-                    if (!std::isfinite(h) || !std::isfinite(t)) continue;
-                    if (std::abs(h - t) <= 3.f * m.sigma_m(r, c)) inside++;
-                }
-            s.within3Sigma = own.cells ? double(inside) / double(own.cells) : 0.0;
+            // Share of the cells (of `only`, if given) where h and the truth are finite whose
+            // error is within 3 sigma; `cells` receives their count.
+            auto within3Sigma = [&](const Mask* only, size_t& cells) {
+                size_t inside = 0;
+                cells = 0;
+                for (Eigen::Index r = 0; r < truth_m.rows(); r++)
+                    for (Eigen::Index c = 0; c < truth_m.cols(); c++) {
+                        const float h = m.height_m(r, c), t = truth_m(r, c);
+                        if (!std::isfinite(h) || !std::isfinite(t) || (only && !(*only)(r, c)))
+                            continue;
+                        cells++;
+                        if (std::abs(h - t) <= 3.f * m.sigma_m(r, c)) inside++;
+                    }
+                return cells ? double(inside) / double(cells) : 0.0;
+            };
+            size_t cells = 0;
+            s.within3Sigma = within3Sigma(nullptr, cells);
+            const auto twin = byName.find(m.filledFrom);
+            if (!m.filledFrom.empty() && twin != byName.end()) {
+                const Mask filledOnly = !twin->second->height_m.isFinite();
+                s.within3SigmaFilledOnly = within3Sigma(&filledOnly, s.filledOnlyCells);
+            }
         }
         s.insert_s = m.insert_s;
         s.fill_s = m.fill_s;
@@ -221,6 +235,10 @@ std::string reportJson(const std::map<std::string, MethodScore>& scores,
                          {"insert_s", number(s.insert_s)},
                          {"fill_s", number(s.fill_s)},
                          {"valid_cells", s.validCells}};
+        if (s.within3SigmaFilledOnly) {
+            methods[name]["within_3sigma_filled_only"] = number(*s.within3SigmaFilledOnly);
+            methods[name]["filled_only_cells"] = s.filledOnlyCells;
+        }
     }
     nlohmann::ordered_json report = {
         {"methods", methods}, {"cell_size_m", lattice.cellSize_m}, {"area_m", lattice.area_m()}};

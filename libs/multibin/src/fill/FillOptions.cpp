@@ -69,6 +69,7 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("fill_sigma_model", o.sigmaModel, kSigmaModels);
     visit("fill_median_sigma_gain", o.medianSigmaGain);
     visit("fill_gaussian_sigma_gain", o.gaussianSigmaGain);
+    visit("fill_harmonic_sigma_gain", o.harmonicSigmaGain);
     visit("fill_sigma_floor", o.sigmaFloor_m);
 }
 
@@ -155,6 +156,8 @@ void FillOptions::validate() const {
         bad("fill_median_sigma_gain", "must be >= 0");
     if (!(gaussianSigmaGain >= 0) || !std::isfinite(gaussianSigmaGain))
         bad("fill_gaussian_sigma_gain", "must be >= 0");
+    if (!(harmonicSigmaGain >= 0) || !std::isfinite(harmonicSigmaGain))
+        bad("fill_harmonic_sigma_gain", "must be >= 0");
     if (!(sigmaFloor_m >= 0) || !std::isfinite(sigmaFloor_m))
         bad("fill_sigma_floor", "must be >= 0 [m]");
 }

@@ -45,8 +45,8 @@ std::vector<Gap> collectGaps(const HeightRaster& r, const std::vector<int>& labe
     auto S = [&](int x, int y) -> int& { return sat[size_t(y) * size_t(nx + 1) + size_t(x)]; };
     for (int iy = 0; iy < ny; iy++)
         for (int ix = 0; ix < nx; ix++)
-            S(ix + 1, iy + 1) = int(r.isMeasured(r.index(ix, iy))) + S(ix, iy + 1) +
-                                S(ix + 1, iy) - S(ix, iy);
+            S(ix + 1, iy + 1) =
+                int(r.isMeasured(r.index(ix, iy))) + S(ix, iy + 1) + S(ix + 1, iy) - S(ix, iy);
     auto knownInWindow = [&](int ix, int iy) {
         const int xa = std::max(ix - half, 0), xb = std::min(ix + half + 1, nx);
         const int ya = std::max(iy - half, 0), yb = std::min(iy + half + 1, ny);

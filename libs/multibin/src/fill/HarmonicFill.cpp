@@ -119,17 +119,11 @@ std::vector<double> biharmonicResiduals(const HeightRaster& r, const GaussianSur
     return out;
 }
 
-void fillByHarmonic(const HeightRaster& r, const FillOptions& o, const SupportArea& a,
-                    const GaussianSurface& g, FillResult& out) {
+std::vector<double> surfacePathSigma(const HeightRaster& r, const FillOptions& o,
+                                     const SupportArea& a, const GaussianSurface& g, double gain) {
     const auto& cells = a.cells;
     const auto& samples = a.samples;
-    const int side = a.side, sx = a.sx, sy = a.sy;
-    // The surface never leaves the heights of its data by more than extrapolationMargin times
-    // their range: far from the rim the model extrapolates, and the data say little there.
-    const double hLo = a.heightLo_m, hHi = a.heightHi_m, slack = a.slack_m(o);
-    out.stats.supportAreas++;
-    out.stats.termsChosen.push_back(int(g.terms.size()));
-
+    const int side = a.side;
     // Distance of each gap cell to the nearest training point [cells].
     std::vector<double> dist(cells.size(), std::numeric_limits<double>::infinity());
     double maxDist = 1;
@@ -141,36 +135,49 @@ void fillByHarmonic(const HeightRaster& r, const FillOptions& o, const SupportAr
         dist[c] = std::sqrt(double(best));
         maxDist = std::max(maxDist, dist[c]);
     }
-    const int maxLag = std::min(int(std::ceil(maxDist)) + 1, std::max(side - 1, 1));
-    std::vector<double> gamma;
-    double meanSigma = 0;
-    if (o.sigmaModel == FillSigmaModel::Calibrated)
-        gamma = semivariogram(r, sx, sy, side, side, maxLag);
-    else {
+    std::vector<double> sigma(cells.size());
+    if (o.sigmaModel == FillSigmaModel::Paper) {
+        double meanSigma = 0;
         for (const auto& s : samples) meanSigma += s.sigma_m;
         meanSigma /= double(samples.size());
+        std::fill(sigma.begin(), sigma.end(), meanSigma);
+        return sigma;
     }
+    const int maxLag = std::min(int(std::ceil(maxDist)) + 1, std::max(side - 1, 1));
+    const std::vector<double> gamma = semivariogram(r, a.sx, a.sy, side, side, maxLag);
+    for (size_t c = 0; c < cells.size(); c++) {
+        // Interpolated semivariogram at the distance to the data (flat beyond maxLag).
+        const double d = std::min(dist[c], double(maxLag));
+        const int l = std::min(int(d), maxLag - 1);
+        const double t = d - l;
+        const double gam = (1 - t) * gamma[size_t(l)] + t * gamma[size_t(l) + 1];
+        sigma[c] = std::sqrt(g.rmsResidual_m * g.rmsResidual_m + gain * gain * 2.0 * gam);
+        sigma[c] = std::max(sigma[c], o.sigmaFloor_m);
+    }
+    return sigma;
+}
+
+void fillByHarmonic(const HeightRaster& r, const FillOptions& o, const SupportArea& a,
+                    const GaussianSurface& g, FillResult& out) {
+    const auto& cells = a.cells;
+    // The surface never leaves the heights of its data by more than extrapolationMargin times
+    // their range: far from the rim the model extrapolates, and the data say little there.
+    const double hLo = a.heightLo_m, hHi = a.heightHi_m, slack = a.slack_m(o);
+    out.stats.supportAreas++;
+    out.stats.termsChosen.push_back(int(g.terms.size()));
+    const std::vector<double> sigma = surfacePathSigma(r, o, a, g, o.harmonicSigmaGain);
     const std::vector<double> resid = !o.residualCorrection ? std::vector<double>(cells.size(), 0.0)
                                       : o.residualModel == ResidualModel::Biharmonic
                                           ? biharmonicResiduals(r, g, cells, a)
                                           : harmonicResiduals(r, g, cells, a);
+    const HeightSource source =
+        o.residualCorrection ? HeightSource::FilledHarmonic : HeightSource::FilledSurface;
     for (size_t c = 0; c < cells.size(); c++) {
         const double h = std::clamp(g(a.i(c), a.j(c)) + resid[c], hLo - slack, hHi + slack);
-        double sigma = meanSigma;
-        if (o.sigmaModel == FillSigmaModel::Calibrated) {
-            // Interpolated semivariogram at the distance to the data (flat beyond maxLag).
-            const double d = std::min(dist[c], double(maxLag));
-            const int l = std::min(int(d), maxLag - 1);
-            const double t = d - l;
-            const double gam = (1 - t) * gamma[size_t(l)] + t * gamma[size_t(l) + 1];
-            sigma = std::sqrt(g.rmsResidual_m * g.rmsResidual_m +
-                              o.gaussianSigmaGain * o.gaussianSigmaGain * 2.0 * gam);
-            sigma = std::max(sigma, o.sigmaFloor_m);
-        }
         const size_t k = size_t(cells[c]);
         out.height_m[k] = float(h);
-        out.sigma_m[k] = float(sigma);
-        out.source[k] = HeightSource::FilledSurface;
+        out.sigma_m[k] = float(sigma[c]);
+        out.source[k] = source;
     }
 }
 

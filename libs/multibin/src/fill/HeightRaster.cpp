@@ -76,7 +76,7 @@ FillResult initResult(const HeightRaster& r, std::vector<char>& measured) {
 
 void countSources(FillResult& out) {
     auto& s = out.stats;
-    s.measured = s.median = s.gaussian = s.unfilled = 0;
+    s.measured = s.median = s.gaussian = s.harmonic = s.unfilled = 0;
     for (auto src : out.source) switch (src) {
             case HeightSource::Measured:
                 s.measured++;
@@ -86,6 +86,9 @@ void countSources(FillResult& out) {
                 break;
             case HeightSource::FilledSurface:
                 s.gaussian++;
+                break;
+            case HeightSource::FilledHarmonic:
+                s.gaussian++, s.harmonic++;
                 break;
             default:
                 s.unfilled++;

@@ -70,30 +70,49 @@ void krigeByTiles(const std::vector<double>& ci, const std::vector<double>& cj,
     }
 }
 
-/** The rim check: true if the rim-check surface plus harmonic rim residuals predicts the area's
- * two hidden rings of measured cells better (sum of squared errors) than the kriging of `best`
- * from the cells beyond them. */
-bool harmonicPredictsRimBetter(const HeightRaster& r, const FillOptions& o, const SupportArea& a,
-                               const GaussianSurface& alternative, const KrigingModel& best,
-                               double prior) {
+/** The best model kriged at the area's rim cells (the two rings of measured cells around the
+ * gap) from the measured cells beyond them, tile by tile: the gap's own held-out check. */
+KrigingModel krigeRim(const FillOptions& o, const SupportArea& a, const KrigingModel& best,
+                      double prior) {
     std::vector<KrigingModel> one(1);
     one[0].shapes = best.shapes, one[0].cov = best.cov;
     std::vector<double> ri, rj;
-    std::vector<int> both = a.cells;
-    for (const auto& s : a.rim) {
-        ri.push_back(s.i), rj.push_back(s.j);
-        both.push_back(a.rasterIndex(s.i, s.j));
-    }
+    for (const auto& s : a.rim) ri.push_back(s.i), rj.push_back(s.j);
     krigeByTiles(ri, rj, a.beyondRim, o.krigingMaxPoints, prior, one, {1.0});
+    return std::move(one[0]);
+}
+
+/** The rim check: true if the rim-check surface plus harmonic rim residuals predicts the area's
+ * two hidden rings of measured cells better (sum of squared errors) than `rim`, the kriging of
+ * the best model from the cells beyond them. `harmonicMs_m2` receives the mean squared error of
+ * the harmonic prediction there [m^2]. */
+bool harmonicPredictsRimBetter(const HeightRaster& r, const SupportArea& a,
+                               const GaussianSurface& alternative, const KrigingModel& rim,
+                               double& harmonicMs_m2) {
+    std::vector<int> both = a.cells;
+    for (const auto& s : a.rim) both.push_back(a.rasterIndex(s.i, s.j));
     const auto hr = harmonicResiduals(r, alternative, both, a);
     double ek = 0, eh = 0;
     for (size_t k = 0; k < a.rim.size(); k++) {
         const auto& v = a.rim[k];
         const double dh = v.h_m - (alternative(v.i, v.j) + hr[a.cells.size() + k]);
-        const double dk = v.h_m - one[0].mean_m[k];
+        const double dk = v.h_m - rim.mean_m[k];
         eh += dh * dh, ek += dk * dk;
     }
+    harmonicMs_m2 = eh / double(a.rim.size());
     return eh < ek;
+}
+
+/** Mean of (h - mean)^2 / variance of the kriging `rim` over the area's rim cells: about 1 when
+ * the kriging variance describes its own held-out errors, larger where the gap hides what the
+ * smooth residual field does not expect (a step, a face). */
+double rimStandardisedError(const SupportArea& a, const KrigingModel& rim) {
+    double sum = 0;
+    for (size_t k = 0; k < a.rim.size(); k++) {
+        const double e = a.rim[k].h_m - rim.mean_m[k];
+        sum += e * e / std::max(rim.var_m2[k], 1e-12);
+    }
+    return sum / double(a.rim.size());
 }
 
 }  // namespace
@@ -107,9 +126,9 @@ KrigingPlan planKriging(const FillOptions& o, const SupportArea& a) {
     // One neighbourhood for the whole gap only if it holds the two rings of measured cells
     // around it; otherwise (a long shadow, a sprawling gap) part of the gap would be
     // extrapolated from one side of its rim: krige each tile from its own nearest points.
-    plan.moving = o.krigingNeighbourhood == KrigingNeighbourhood::Moving ||
-                  (o.krigingNeighbourhood == KrigingNeighbourhood::Auto &&
-                   a.rim.size() > plan.near.size());
+    plan.moving =
+        o.krigingNeighbourhood == KrigingNeighbourhood::Moving ||
+        (o.krigingNeighbourhood == KrigingNeighbourhood::Auto && a.rim.size() > plan.near.size());
     // A gap too long or sprawling for one neighbourhood: the rim check against eq 16 by AIC
     // with harmonic rim residuals.
     if (plan.moving && o.movingRimCheck)
@@ -141,14 +160,38 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o, const SupportAre
     out.stats.termsChosen.push_back(best.m);
     const double hLo = a.heightLo_m, hHi = a.heightHi_m, slack = a.slack_m(o);
     std::vector<double> harmonic;  // the gap's heights by harmonic residuals, if they won
-    if (plan.rimCheckSurface && a.rim.size() >= 4 && a.beyondRim.size() >= 12 &&
-        harmonicPredictsRimBetter(r, o, a, *plan.rimCheckSurface, best, set.amplitudePrior)) {
+    const bool rimHeldOut = a.rim.size() >= 4 && a.beyondRim.size() >= 12;
+    KrigingModel rim;  // the best model kriged on the hidden rim from beyond it
+    if (plan.rimCheckSurface && rimHeldOut) rim = krigeRim(o, a, best, set.amplitudePrior);
+    // The kriging variance, scaled up by the kriging's standardised error on the gap's own
+    // hidden rim where that exceeds 1: a step or face in the gap that the fitted covariance does
+    // not expect shows there first.
+    double varianceScale = 1, harmonicRimMs_m2 = 0;
+    if (o.sigmaModel == FillSigmaModel::Calibrated && rimHeldOut) {
+        try {
+            if (rim.mean_m.empty()) rim = krigeRim(o, a, best, set.amplitudePrior);
+            varianceScale = std::max(1.0, rimStandardisedError(a, rim));
+        } catch (const std::runtime_error&) {
+            // Not seen (K holds every sample's sensor variance): keep the plain kriging variance.
+        }
+    }
+    if (plan.rimCheckSurface && rimHeldOut &&
+        harmonicPredictsRimBetter(r, a, *plan.rimCheckSurface, rim, harmonicRimMs_m2)) {
         const GaussianSurface& alternative = *plan.rimCheckSurface;
         const auto hg = harmonicResiduals(r, alternative, cells, a);
         harmonic.resize(cells.size());
-        for (size_t c = 0; c < cells.size(); c++)
-            harmonic[c] = alternative(ci[c], cj[c]) + hg[c];
+        for (size_t c = 0; c < cells.size(); c++) harmonic[c] = alternative(ci[c], cj[c]) + hg[c];
         out.stats.rimCheckHarmonic++;
+        out.stats.rimCheckTerms.push_back(int(alternative.terms.size()));
+    }
+    // Each path its own sigma (doc/gap-filling.md, "Sigma of filled cells"): the harmonic
+    // heights get the surface path's semivariogram sigma plus the mean squared error the
+    // harmonic prediction made on the gap's hidden rim.
+    std::vector<double> harmonicSigma;
+    if (!harmonic.empty()) {
+        harmonicSigma = surfacePathSigma(r, o, a, *plan.rimCheckSurface, o.harmonicSigmaGain);
+        if (o.sigmaModel == FillSigmaModel::Calibrated)
+            for (double& s : harmonicSigma) s = std::sqrt(s * s + harmonicRimMs_m2);
     }
     for (size_t c = 0; c < cells.size(); c++) {
         double mean = 0, var = 0;
@@ -161,12 +204,14 @@ void fillByKriging(const HeightRaster& r, const FillOptions& o, const SupportAre
         }
         double sigma = meanSigma;
         if (o.sigmaModel == FillSigmaModel::Calibrated)
-            sigma = std::max(o.gaussianSigmaGain * std::sqrt(var), o.sigmaFloor_m);
+            sigma = std::max(o.gaussianSigmaGain * std::sqrt(var * varianceScale), o.sigmaFloor_m);
+        if (!harmonic.empty()) sigma = harmonicSigma[c];
         const size_t k = size_t(cells[c]);
         if (!harmonic.empty()) mean = harmonic[c];
         out.height_m[k] = float(std::clamp(mean, hLo - slack, hHi + slack));
         out.sigma_m[k] = float(sigma);
-        out.source[k] = HeightSource::FilledSurface;
+        out.source[k] =
+            harmonic.empty() ? HeightSource::FilledSurface : HeightSource::FilledHarmonic;
     }
 }
 

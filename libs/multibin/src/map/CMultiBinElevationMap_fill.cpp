@@ -42,6 +42,8 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
     if (!m_impl->fill.isFilled(k)) return HeightSource::Unknown;
     height_m = m_impl->fill.height_m[k];
     sigma_m = m_impl->fill.sigma_m[k];
+    // FilledHarmonic is a surface fill too (eq 16 plus harmonic rim residuals): one value of
+    // the source layer for both surface paths.
     return m_impl->fill.source[k] == multibin::HeightSource::FilledMedian
                ? HeightSource::FilledMedian
                : HeightSource::FilledSurface;

@@ -51,6 +51,9 @@ struct MethodEstimate {
      * map's error over its crop, and it does not narrow the cells every method covers
      * (`pi_shared`) to its crop. */
     bool coversWholeArea = true;
+    /** Optional: the method whose valid cells are this one's measured cells (a filled map's
+     * unfilled twin); its other valid cells, the filled-only ones, are scored apart. */
+    std::string filledFrom;
 };
 
 /** Mean squared error over the cells where both the estimate and the truth are finite (and the
@@ -76,6 +79,10 @@ struct MethodScore {
     double coverage = 0;  //!< share of truth cells with an estimate
     std::optional<double> within3Sigma;  //!< share of valid cells with |h - h_t| <= 3 sigma
     size_t validCells = 0;
+    /** The same share over the filled-only cells (valid here, not in MethodEstimate::filledFrom),
+     * and their count; set only for a method with filledFrom and a sigma. */
+    std::optional<double> within3SigmaFilledOnly;
+    size_t filledOnlyCells = 0;
     double insert_s = 0, fill_s = 0;
 };
 
@@ -96,8 +103,9 @@ AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
                      const Lattice& area);
 
 /** report.json: {"methods": {name: {rmse_m, pi, pi_shared, coverage, within_3sigma, insert_s,
- * fill_s, valid_cells}}, "cell_size_m", "area_m": [xmin, xmax, ymin, ymax]}; methods in `order`.
- * Each sub-area adds {"<name>": {"area_m": [...], "rmse_m": {method: x}, "cells": {method: n}}}.
+ * fill_s, valid_cells[, within_3sigma_filled_only, filled_only_cells]}}, "cell_size_m", "area_m":
+ * [xmin, xmax, ymin, ymax]}; methods in `order`. Each sub-area adds {"<name>": {"area_m": [...],
+ * "rmse_m": {method: x}, "cells": {method: n}}}.
  */
 std::string reportJson(const std::map<std::string, MethodScore>& scores,
                        const std::vector<std::string>& order, const Lattice& lattice,

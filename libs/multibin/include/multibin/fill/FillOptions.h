@@ -36,11 +36,15 @@ enum class CovarianceFamily {
 
 /** How a filled cell gets its sigma. */
 enum class FillSigmaModel {
-    /** Calibrated on held-out cells (default; see doc/gap-filling.md). Median cells:
-     * sigma^2 = sigma_nb^2 + (median_sigma_gain * s)^2, s the weighted RMS spread of the window's
-     * heights about the median. Gaussian cells: sigma^2 = rms_res^2 + gaussian_sigma_gain^2 *
-     * 2 gamma(d), gamma the semivariogram of the support area's known heights, d the distance
-     * to the nearest known cell. Both floored at sigma_floor_m. */
+    /** Calibrated on held-out cells, one sigma per fill path (default; see doc/gap-filling.md).
+     * Median cells: sigma^2 = sigma_nb^2 + (median_sigma_gain * s)^2, s the weighted RMS spread
+     * of the window's heights about the median. Kriging cells: sigma = gaussian_sigma_gain *
+     * sqrt(v f), v the kriging variance, f >= 1 the kriging's mean standardised squared error
+     * on the gap's hidden rim (1 if that is below 1). Harmonic cells (eq 16 plus rim
+     * residuals): sigma^2 = rms_res^2 + harmonic_sigma_gain^2 * 2 gamma(d), gamma the
+     * semivariogram of the support area's known heights, d the distance to the nearest known
+     * cell, plus (rim check) the mean squared error of the harmonic prediction of the hidden
+     * rim. All floored at sigma_floor_m. */
     Calibrated,
     /** The paper's rule: the weighted average of the neighbours' sigma (same skeleton as the
      * median); Gaussian cells get the mean sigma of their training points. Too small for the
@@ -133,10 +137,13 @@ struct FillOptions {
 
     // --- Sigma of filled cells ---
     FillSigmaModel sigmaModel =
-        FillSigmaModel::Calibrated;   //!< [fill_sigma_model] calibrated|paper
-    double medianSigmaGain = 0.77;    //!< [fill_median_sigma_gain] calibrated gain [-]
-    double gaussianSigmaGain = 1.33;  //!< [fill_gaussian_sigma_gain] calibrated gain [-]
-    double sigmaFloor_m = 0.002;      //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
+        FillSigmaModel::Calibrated;  //!< [fill_sigma_model] calibrated|paper
+    double medianSigmaGain = 0.77;   //!< [fill_median_sigma_gain] calibrated gain [-]
+    /** [fill_gaussian_sigma_gain] calibrated gain of the kriging sigma [-] */
+    double gaussianSigmaGain = 1.16;
+    /** [fill_harmonic_sigma_gain] calibrated gain of the harmonic (surface path) sigma [-] */
+    double harmonicSigmaGain = 0.76;
+    double sigmaFloor_m = 0.002;  //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
 
     /** The Gaussian-fit settings these options imply. */
     GaussianFitOptions gaussianFitOptions() const;

@@ -26,13 +26,22 @@ std::vector<double> harmonicResiduals(const HeightRaster& raster, const Gaussian
 std::vector<double> biharmonicResiduals(const HeightRaster& raster, const GaussianSurface& g,
                                         const std::vector<int>& cells, const SupportArea& area);
 
+/** Sigma of the surface path at each gap cell of `area` [m]: sigma^2 = rms_res^2 + gain^2
+ * 2 gamma(d), rms_res the weighted RMS residual of g on the training points, gamma the
+ * semivariogram of the area's measured heights, d the distance to the nearest training point
+ * (FillSigmaModel::Calibrated; floored at sigmaFloor_m), or the training points' mean sigma
+ * (Paper). */
+std::vector<double> surfacePathSigma(const HeightRaster& raster, const FillOptions& options,
+                                     const SupportArea& area, const GaussianSurface& g,
+                                     double gain);
+
 /** The surface path (ResidualModel::Harmonic / Biharmonic, the fallback of the kriging, and
  * eq 16 alone without residual correction): the gap of `area` gets g plus its rim residuals
  * (harmonic or biharmonic per options.residualModel; none if !residualCorrection), clamped to
  * the training heights widened by the extrapolation margin, with sigma from the semivariogram
  * of the area's heights at the distance to the data (FillSigmaModel::Calibrated) or the
  * training points' mean sigma (Paper). */
-void fillByHarmonic(const HeightRaster& raster, const FillOptions& options,
-                    const SupportArea& area, const GaussianSurface& g, FillResult& out);
+void fillByHarmonic(const HeightRaster& raster, const FillOptions& options, const SupportArea& area,
+                    const GaussianSurface& g, FillResult& out);
 
 }  // namespace multibin::fill

@@ -58,19 +58,26 @@ struct FillResult {
 
     /** Statistics of one run (for logs, tests and tuning). */
     struct Stats {
-        int measured = 0, median = 0, gaussian = 0, unfilled = 0;  //!< cell counts
+        /** Cell counts; `gaussian` counts every cell filled from a support area's eq 16 fit
+         * (FilledSurface and FilledHarmonic), `harmonic` those of them FilledHarmonic. */
+        int measured = 0, median = 0, gaussian = 0, harmonic = 0, unfilled = 0;
         int gapComponents = 0;         //!< connected gaps found (4-connected never-observed cells)
         int supportAreas = 0;          //!< gaps filled by a Gaussian surface
         std::vector<int> termsChosen;  //!< AIC-chosen number m of Gaussians, per support area
         int movingNeighbourhoods = 0;  //!< gaps kriged in moving neighbourhoods (tiles)
         int rimCheckHarmonic = 0;      //!< of those, gaps the rim check gave to the harmonic path
+        /** m of the eq 16 surface whose heights those gaps took (AICc on independent residuals;
+         * termsChosen keeps the kriging's m for them), one per rimCheckHarmonic gap */
+        std::vector<int> rimCheckTerms;
     } stats;
 
     int nx() const { return lattice.nx(); }
     int ny() const { return lattice.ny(); }
     size_t index(int ix, int iy) const { return lattice.index(ix, iy); }
     bool isFilled(size_t k) const {
-        return source[k] == HeightSource::FilledMedian || source[k] == HeightSource::FilledSurface;
+        return source[k] == HeightSource::FilledMedian ||
+               source[k] == HeightSource::FilledSurface ||
+               source[k] == HeightSource::FilledHarmonic;
     }
 };
 

@@ -30,10 +30,10 @@ struct SupportArea {
     /** The training points: the measured cells of the area, at most maxTrainingPoints of them,
      * nearest the gap first (see keepNearestToGap). */
     std::vector<TrainingPoint> training;
-    std::vector<SurfaceSample> samples;    //!< the training points' samples
-    std::vector<SurfaceSample> all;        //!< every measured cell of the area
-    std::vector<SurfaceSample> rim;        //!< of those, the ones within 2 cells of the gap
-    std::vector<SurfaceSample> beyondRim;  //!< the others
+    std::vector<SurfaceSample> samples;     //!< the training points' samples
+    std::vector<SurfaceSample> all;         //!< every measured cell of the area
+    std::vector<SurfaceSample> rim;         //!< of those, the ones within 2 cells of the gap
+    std::vector<SurfaceSample> beyondRim;   //!< the others
     double heightLo_m = 0, heightHi_m = 0;  //!< range of the training heights [m]
 
     /** Column and row of gap cell `c` (an index into `cells`) [support-area cells]. */

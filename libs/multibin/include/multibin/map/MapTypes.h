@@ -66,6 +66,9 @@ enum class HeightSource : std::uint8_t {
     Measured = 1,       //!< observed: the cell's surface from its bins
     FilledMedian = 2,   //!< never observed; weighted median of the neighbours
     FilledSurface = 3,  //!< never observed; Gaussian surface (eq 16) / kriging of its support area
+    /** never observed; eq 16 plus harmonic (or biharmonic) rim residuals: the rim check's choice
+     * for a long shadow, or the surface path (its own sigma, doc/gap-filling.md) */
+    FilledHarmonic = 4,
 };
 
 }  // namespace multibin
