@@ -23,23 +23,24 @@ struct SymmetricCov3 {
     }
 };
 
-/** Whether `c` is a covariance: finite and positive semi-definite, all principal minors >= 0
- * to within single-precision rounding. Zero and rank-deficient covariances pass (an exact pose,
- * a range-only sensor: the point is exactly known along some directions); indefinite ones (a
- * negative variance, |correlation| > 1) do not. */
+/** Whether `c`, not positive-definite, is still positive semi-definite: all principal minors
+ * >= 0 to within single-precision rounding (see isCovariance). */
+#if defined(__GNUC__)
+__attribute__((cold))  // exact poses only: kept out of the insertion loop's hot code
+#endif
+bool isSingularCovariance(const SymmetricCov3& c);
+
+/** Whether `c` is a covariance: finite and positive semi-definite. Zero and rank-deficient
+ * covariances pass (an exact pose, a range-only sensor: the point is exactly known along some
+ * directions); indefinite ones (a negative variance, |correlation| > 1) and NaN do not. */
 inline bool isCovariance(const SymmetricCov3& c) {
-    // Rounding: float entries carry a relative error of 6e-8, so a singular covariance can show
-    // minors of -1e-7 of their scale; 1e-5 leaves room. The absolute terms cover entries that
-    // rounded to zero (variances below (1e-12 m)^2 are exact for any purpose).
-    constexpr double kRel = 1e-5, kAbs2 = 1e-48, kAbs3 = 1e-72;
+    // Positive-definite by Sylvester's criterion (leading minors), in double: the common case.
     const double xx = c.xx, xy = c.xy, xz = c.xz, yy = c.yy, yz = c.yz, zz = c.zz;
-    if (!(xx >= 0 && yy >= 0 && zz >= 0)) return false;  // also NaN
-    const double mxy = xx * yy - xy * xy, mxz = xx * zz - xz * xz, myz = yy * zz - yz * yz;
-    if (!(mxy >= -kRel * xx * yy - kAbs2 && mxz >= -kRel * xx * zz - kAbs2 &&
-          myz >= -kRel * yy * zz - kAbs2))
-        return false;
-    const double det = xx * myz - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
-    return det >= -kRel * xx * yy * zz - kAbs3;
+    const double m2 = xx * yy - xy * xy;
+    const double m3 =
+        xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+    if (__builtin_expect(xx > 0 && m2 > 0 && m3 > 0, 1)) return true;
+    return isSingularCovariance(c);
 }
 
 /** One 3D point [m] with its full covariance [m^2]. */
