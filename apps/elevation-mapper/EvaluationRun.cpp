@@ -1,6 +1,9 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #include "EvaluationRun.h"
 
+#include "MapOutputs.h"
+#include "ProgressBar.h"
+
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 
@@ -8,13 +11,13 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
+using multibin::Lattice;
 using multibin::eval::CellArray;
-using multibin::eval::EvalLattice;
 using multibin::eval::MethodEstimate;
 
 namespace {
@@ -26,13 +29,15 @@ double secondsSince(Clock::time_point t0) {
 
 /** The truth on the map's lattice, cut to `area_m` when given. */
 CellArray loadTruth(const std::string& path, double cellSize_m, const std::vector<double>& area_m,
-                    EvalLattice& lattice) {
+                    Lattice& lattice) {
     if (!fs::exists(path)) throw std::runtime_error("ground truth '" + path + "' not found");
     const CellArray whole = multibin::eval::groundTruthOnLattice(
         multibin::EsriAsciiGrid::load(path), cellSize_m, lattice);
     if (area_m.empty()) return whole;
-    const EvalLattice sub = multibin::eval::subLattice(lattice, area_m);
-    const CellArray cut = whole.block(sub.iy0 - lattice.iy0, sub.ix0 - lattice.ix0, sub.ny, sub.nx);
+    const Lattice sub = multibin::eval::subLattice(lattice, area_m);
+    const CellArray cut =
+        whole.block(sub.window.iy0 - lattice.window.iy0, sub.window.ix0 - lattice.window.ix0,
+                    sub.window.ny, sub.window.nx);
     lattice = sub;
     return cut;
 }
@@ -43,23 +48,20 @@ double evaluatedCellSize_m(const CMultiBinElevationMap& map) {
     return c.dual_grid ? c.global_resolution_m : c.resolution_m;
 }
 
-multibin::EsriAsciiGrid rasterOf(const EvalLattice& L, const CellArray& values) {
-    multibin::EsriAsciiGrid g;
-    g.cellsize_m = L.cellSize_m;
-    g.xllcenter_m = L.cellCenterX_m(0);
-    g.yllcenter_m = L.cellCenterY_m(0);
+multibin::EsriAsciiGrid rasterOf(const Lattice& L, const CellArray& values) {
+    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(L);
     g.heights_m = values.matrix();
     return g;
 }
 
 /** Heights of one of MRPT's DEMs at the lattice's cell centres; NaN where it has none, or outside
  * `within` when given. */
-CellArray sampleDem(const mrpt::maps::CHeightGridMap2D_Base& dem, const EvalLattice& lattice,
-                    const EvalLattice* within = nullptr) {
+CellArray sampleDem(const mrpt::maps::CHeightGridMap2D_Base& dem, const Lattice& lattice,
+                    const Lattice* within = nullptr) {
     CellArray h;
-    h.setConstant(lattice.ny, lattice.nx, NAN);
-    for (int r = 0; r < lattice.ny; r++)
-        for (int c = 0; c < lattice.nx; c++) {
+    h.setConstant(lattice.window.ny, lattice.window.nx, NAN);
+    for (int r = 0; r < lattice.window.ny; r++)
+        for (int c = 0; c < lattice.window.nx; c++) {
             const double x = lattice.cellCenterX_m(c), y = lattice.cellCenterY_m(r);
             int cc, rr;
             double z;
@@ -85,11 +87,11 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
     m_laserOnly.insertionOptions = evaluated.insertionOptions;
     if (options.withMrf) {
         // A centred crop: MRPT's GMRF solve grows as about n^2.6 in cells.
-        const int side = std::min({options.mrfMaxCells, m_lattice.nx, m_lattice.ny});
+        const int side = std::min({options.mrfMaxCells, m_lattice.window.nx, m_lattice.window.ny});
         m_mrfLattice = m_lattice;
-        m_mrfLattice.ix0 = m_lattice.ix0 + (m_lattice.nx - side) / 2;
-        m_mrfLattice.iy0 = m_lattice.iy0 + (m_lattice.ny - side) / 2;
-        m_mrfLattice.nx = m_mrfLattice.ny = side;
+        m_mrfLattice.window.ix0 = m_lattice.window.ix0 + (m_lattice.window.nx - side) / 2;
+        m_mrfLattice.window.iy0 = m_lattice.window.iy0 + (m_lattice.window.ny - side) / 2;
+        m_mrfLattice.window.nx = m_mrfLattice.window.ny = side;
         const auto a = m_mrfLattice.area_m();
         m_mrf = std::make_unique<mrpt::maps::CHeightGridMap2D_MRF>(
             mrpt::maps::CHeightGridMap2D_MRF::mrGMRF_SD, a[0], a[1], a[2], a[3],
@@ -109,11 +111,10 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
 void EvaluationRun::insertRawPoints(const mrpt::obs::CObservation& obs,
                                     const mrpt::poses::CPose3DPDFGaussian& robotPose) {
     multibin::sensors::SensorPoints sp;
-    multibin::InsertStats ignored;
     const auto& io = m_evaluated.insertionOptions;
     if (!multibin::sensors::observationToSensorPoints(obs, robotPose, m_rawSensorOptions,
                                                       io.min_range_m, io.max_range_m,
-                                                      m_rawSensorState, ignored, sp))
+                                                      m_rawSensorState, sp))
         return;
     const mrpt::poses::CPose3D sensorInMap = robotPose.mean + sp.sensorPose;
     std::vector<mrpt::math::TPoint3D> points(sp.points.size());
@@ -165,10 +166,10 @@ MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBin
                                         bool filled) const {
     MethodEstimate m;
     m.name = name;
-    m.height_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
-    m.sigma_m.setConstant(m_lattice.ny, m_lattice.nx, NAN);
-    for (int r = 0; r < m_lattice.ny; r++)
-        for (int c = 0; c < m_lattice.nx; c++) {
+    m.height_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
+    m.sigma_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
+    for (int r = 0; r < m_lattice.window.ny; r++)
+        for (int c = 0; c < m_lattice.window.nx; c++) {
             double h, s;
             if (map.getElevation(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), h, s,
                                  filled) != CMultiBinElevationMap::HeightSource::Unknown) {
@@ -179,7 +180,7 @@ MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBin
     return m;
 }
 
-std::string EvaluationRun::finish(const std::string& outDir, double multibinInsert_s,
+std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert_s,
                                   double multibinFill_s) {
     m_laserOnly.flushLocalToGlobal();
 
@@ -214,7 +215,8 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
 
     if (m_mrf) {
         const auto t0 = Clock::now();
-        m_mrf->dem_update_map();  // one GMRF solve over the crop
+        // One GMRF solve over the crop (a minute or more).
+        ProgressBar::runWithProgress("MRF solve", [&] { m_mrf->dem_update_map(); });
         MethodEstimate mrf;
         mrf.name = "mrpt_height_grid_mrf";
         mrf.baseline = "raw_all";
@@ -233,21 +235,21 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
         areas.push_back(
             multibin::eval::scoreArea("mrf_crop", m_truth, methods, m_lattice, m_mrfLattice));
 
-    const fs::path out = outDir;
-    {
-        std::ofstream f(out / "report.json");
-        f << multibin::eval::reportJson(scores, order, m_lattice, areas);
-        if (!f) throw std::runtime_error("cannot write '" + (out / "report.json").string() + "'");
-    }
-    rasterOf(m_lattice, m_truth).save((out / "eval_truth.asc").string());
-    for (const auto& m : methods)
-        rasterOf(m_lattice, m.height_m).save((out / ("eval_" + m.name + ".asc")).string());
-    writeProfile((out / "profile.csv").string(), m_truth, methods);
+    out.write("report.json", multibin::eval::reportJson(scores, order, m_lattice, areas));
+    auto saveRaster = [&](const std::string& name, const CellArray& values) {
+        out.writeWith(name, [&](const std::string& path) {
+            rasterOf(m_lattice, values).save(path);
+            return true;
+        });
+    };
+    saveRaster("eval_truth.asc", m_truth);
+    for (const auto& m : methods) saveRaster("eval_" + m.name + ".asc", m.height_m);
+    out.write("profile.csv", profileCsv(m_truth, methods));
     return multibin::eval::reportTable(scores, order, areas);
 }
 
-void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth,
-                                 const std::vector<MethodEstimate>& methods) const {
+std::string EvaluationRun::profileCsv(const CellArray& truth,
+                                      const std::vector<MethodEstimate>& methods) const {
     std::vector<double> line = m_options.profile_m;
     if (line.empty()) {
         const auto a = m_lattice.area_m();
@@ -264,7 +266,7 @@ void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth
     const MethodEstimate* filled = find("multibin_filled");
     const MethodEstimate* raw = find("raw_all");
 
-    std::ofstream f(path);
+    std::ostringstream f;
     f << "s_m,x_m,y_m,truth_m,multibin_m,multibin_sigma_m,filled_m,filled_sigma_m,raw_m\n";
     const double dx = line[2] - line[0], dy = line[3] - line[1];
     const double length_m = std::hypot(dx, dy);
@@ -283,5 +285,5 @@ void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth
           << value(filled->height_m, r, c) << ',' << value(filled->sigma_m, r, c) << ','
           << value(raw->height_m, r, c) << '\n';
     }
-    if (!f) throw std::runtime_error("cannot write '" + path + "'");
+    return f.str();
 }

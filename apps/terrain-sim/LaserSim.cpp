@@ -15,6 +15,12 @@ LaserSim::LaserSim(const LaserConfig& cfg, const Terrain& terrain, const Surface
     for (auto& b : bias_) b = u(rng);
 }
 
+mrpt::poses::CPose3D LaserConfig::truePose() const {
+    if (pitchError_rad == 0.0) return pose;
+    return mrpt::poses::CPose3D(pose.x(), pose.y(), pose.z(), pose.yaw(),
+                                pose.pitch() + pitchError_rad, pose.roll());
+}
+
 Eigen::Vector3d LaserSim::beamDirection(int k) const {
     const double a = -0.5 * cfg_.aperture_rad + k * cfg_.aperture_rad / (cfg_.beams - 1);
     return {std::cos(a), std::sin(a), 0.0};
@@ -24,7 +30,7 @@ mrpt::obs::CObservation2DRangeScan::Ptr LaserSim::scan(const mrpt::poses::CPose3
                                                        mrpt::Clock::time_point stamp,
                                                        std::mt19937_64& rng,
                                                        std::vector<BeamTruth>* truthOut) const {
-    const mrpt::poses::CPose3D sensor = robot + cfg_.pose;
+    const mrpt::poses::CPose3D sensor = robot + cfg_.truePose();
     const Eigen::Matrix3d R = sensor.getRotationMatrix().asEigen();
     const Eigen::Vector3d o(sensor.x(), sensor.y(), sensor.z());
     const int n = cfg_.beams;
@@ -47,8 +53,17 @@ mrpt::obs::CObservation2DRangeScan::Ptr LaserSim::scan(const mrpt::poses::CPose3
             t.dropout = true;
             continue;
         }
-        double r = t.trueRange_m + bias_[t.surface] + cfg_.sigma(t.trueRange_m) * z;
-        if (t.restored < cfg_.darkRestored) {
+        const double rt = t.trueRange_m;
+        // Optional errors draw from the stream only when on, so matched runs keep their bytes.
+        double r = rt + bias_[t.surface] + cfg_.sigma(rt) * z * cfg_.errors.tailFactor(rng);
+        if (cfg_.rangeBias0_m != 0.0 || cfg_.rangeBiasSlope != 0.0)
+            r += cfg_.rangeBias0_m + cfg_.rangeBiasSlope * rt;
+        double factor = 1.0;
+        if (cfg_.errors.drawOutlier(rng, factor)) {
+            r = rt * factor;
+            t.outlier = true;
+        }
+        if (t.restored < cfg_.darkRestored && !t.outlier) {
             t.dark = true;
             r += cfg_.darkBias_m + cfg_.darkExtraSigma_m * gauss(rng);
         }

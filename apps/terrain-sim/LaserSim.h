@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library: terrain-sim. */
 #pragma once
 
+#include "SensorErrors.h"
 #include "SurfaceTexture.h"
 #include "Terrain.h"
 
@@ -34,6 +35,15 @@ struct LaserConfig {
     double darkBias_m = 0.02;         //!< extra range bias of unreliable (dark) returns [m]
     double mixedJump_m = 0.03;        //!< neighbour range jump that marks a depth edge [m]
     double mixedProbability = 0.5;    //!< chance that the far beam at an edge is a mixed pixel
+    // Errors the library's laser model does not describe (off by default, doc/terrain-sim.md).
+    ErrorShape errors;            //!< heavy tails and gross outliers of the range
+    double rangeBias0_m = 0.0;    //!< extra range bias b0 + b1 r, the same on every surface [m]
+    double rangeBiasSlope = 0.0;  //!< b1 [m/m]
+    double pitchError_rad = 0.0;  //!< true mounting pitch minus the written `pose` pitch [rad]
+
+    /** The pose the beams are really cast from: `pose` with the mounting pitch error. The scan
+     * keeps `pose` as its sensorPose, so the map is not told. */
+    mrpt::poses::CPose3D truePose() const;
 };
 
 /** What really happened to one beam (for tests and statistics). */
@@ -44,6 +54,7 @@ struct BeamTruth {
     bool dropout = false;    //!< no return because the surface is too dark
     bool dark = false;       //!< returned, but Ires < darkRestored
     bool mixed = false;      //!< mixed pixel: a range between foreground and background
+    bool outlier = false;    //!< gross error: true range times U(1 - span, 1 + span)
 };
 
 /** Simulates scans of the URG-04LX over a terrain. */

@@ -4,6 +4,7 @@
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
@@ -67,7 +68,31 @@ std::string mapperIni(const ScenarioConfig& cfg) {
     return o.str();
 }
 
+void applyIndependentNoise(ScenarioConfig& cfg) {
+    for (ErrorShape* e : {&cfg.laser.errors, &cfg.stereo.errors}) {
+        e->tailDof = 4;
+        e->outlierFraction = 0.01;
+        e->outlierSpan = 0.5;
+    }
+    cfg.laser.rangeBias0_m = -0.002;
+    cfg.laser.rangeBiasSlope = 0.01;
+    cfg.laser.mixedProbability = 1.0;
+    cfg.laser.mixedJump_m = 0.015;
+    cfg.laser.pitchError_rad = 0.3 * M_PI / 180.0;
+    cfg.stereo.mixedProbability = 0.5;
+    cfg.stereo.baselineError_m = 0.0003;
+    cfg.stereo.cxError_px = 0.5;
+    cfg.stereo.cyError_px = 0.5;
+}
+
 ScenarioSummary runScenario(const ScenarioConfig& cfg) {
+    cfg.laser.errors.validate("laser");
+    cfg.stereo.errors.validate("stereo");
+    if (!(cfg.laser.mixedProbability >= 0 && cfg.laser.mixedProbability <= 1) ||
+        !(cfg.stereo.mixedProbability >= 0 && cfg.stereo.mixedProbability <= 1))
+        throw std::invalid_argument("mixed-pixel probability must be in [0, 1]");
+    if (!(cfg.laser.mixedJump_m > 0))
+        throw std::invalid_argument("laser mixed-pixel jump must be > 0");
     if (cfg.outPrefix.empty()) throw std::invalid_argument("no output prefix (--out) given");
     if (cfg.terrainFiles.empty()) throw std::invalid_argument("no terrain file (--terrain) given");
     if (cfg.scenario != "mockup" && cfg.scenario != "walk")
@@ -105,6 +130,7 @@ ScenarioSummary runScenario(const ScenarioConfig& cfg) {
          << "# frame t_s x_m y_m z_m yaw_rad pitch_rad roll_rad stereo\n";
     path << std::setprecision(9);
     std::vector<BeamTruth> beams;
+    mrpt::poses::CPose2D previousEstimate(frames.front().estimate.mean);
     for (size_t k = 0; k < frames.size(); ++k) {
         const Frame& f = frames[k];
         const auto stamp = syntheticStamp(f.t_s);
@@ -132,7 +158,18 @@ ScenarioSummary runScenario(const ScenarioConfig& cfg) {
             sfMap->insert(st);
             sum.stereoFrames++;
         }
-        mrpt::obs::CActionCollection acts;  // no odometry: the pose comes as ROBOT_POSE
+        // Odometry: the planar (x, y, yaw) increment of the pose estimate since the previous
+        // frame, so that
+        // RawLogViewer and MRPT's odometry-based tools show the path. The mapper takes its poses
+        // from ROBOT_POSE (mean and covariance), which overrides odometry.
+        mrpt::obs::CActionCollection acts;
+        mrpt::obs::CActionRobotMovement2D odo;
+        odo.timestamp = stamp;
+        const mrpt::poses::CPose2D estimate(f.estimate.mean);  // x, y, yaw
+        odo.computeFromOdometry(estimate - previousEstimate,
+                                mrpt::obs::CActionRobotMovement2D::TMotionModelOptions());
+        acts.insert(odo);
+        previousEstimate = estimate;
         rawArch << acts << *sf;
         simplemap.insert(mrpt::poses::CPose3DPDFGaussian::Create(f.estimate), sfMap);
         const auto& p = f.truth;

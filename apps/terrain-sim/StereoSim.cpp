@@ -31,7 +31,9 @@ double StereoSim::shade(const Eigen::Vector3d& p, const Eigen::Vector3d& n) cons
 
 void StereoSim::renderView(const mrpt::poses::CPose3D& cam, cv::Mat& grey, cv::Mat& zcam) const {
     const int W = cfg_.width_px, H = cfg_.height_px;
-    const double f = cfg_.fx_px(), cx = cfg_.cx_px(), cy = cfg_.cy_px();
+    // The true principal point (the observation keeps the nominal one).
+    const double f = cfg_.fx_px(), cx = cfg_.cx_px() + cfg_.cxError_px,
+                 cy = cfg_.cy_px() + cfg_.cyError_px;
     grey.create(H, W, CV_64F);
     zcam.create(H, W, CV_64F);
     const Eigen::Matrix3d R = cam.getRotationMatrix().asEigen();
@@ -55,7 +57,8 @@ void StereoSim::renderView(const mrpt::poses::CPose3D& cam, cv::Mat& grey, cv::M
 
 StereoRender StereoSim::render(const mrpt::poses::CPose3D& robot, std::mt19937_64& rng) const {
     const mrpt::poses::CPose3D left = robot + cfg_.leftPose();
-    const mrpt::poses::CPose3D right = left + mrpt::poses::CPose3D(cfg_.baseline_m, 0, 0, 0, 0, 0);
+    const double trueBaseline_m = cfg_.baseline_m + cfg_.baselineError_m;
+    const mrpt::poses::CPose3D right = left + mrpt::poses::CPose3D(trueBaseline_m, 0, 0, 0, 0, 0);
     cv::Mat gl, zl, gr, zr;
     renderView(left, gl, zl);
     renderView(right, gr, zr);
@@ -72,7 +75,7 @@ StereoRender StereoSim::render(const mrpt::poses::CPose3D& robot, std::mt19937_6
             out.left.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(std::lround(a));
             out.right.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(std::lround(b));
         }
-    const double fB = cfg_.fx_px() * cfg_.baseline_m;
+    const double fB = cfg_.fx_px() * trueBaseline_m;
     out.trueDisparity.create(H, W, CV_32F);
     for (int v = 0; v < H; ++v)
         for (int u = 0; u < W; ++u) {
@@ -95,17 +98,43 @@ StereoRender StereoSim::render(const mrpt::poses::CPose3D& robot, std::mt19937_6
             textureless.at<uint8_t>(v, u) = std::sqrt(var) < cfg_.texturelessStd_grey;
         }
     cv::Mat d(H, W, CV_64F, cv::Scalar(0));
+    out.matchKind = cv::Mat(H, W, CV_8U, cv::Scalar(StereoRender::kNone));
     const cv::Mat& dt = out.trueDisparity;
     for (int v = 0; v < H; ++v)
         for (int u = 0; u < W; ++u) {
-            const double noise = cfg_.matchingSigma_px * gauss(rng);
+            // Optional errors draw from the stream only when on, so matched runs keep their bytes.
+            const double noise = cfg_.matchingSigma_px * gauss(rng) * cfg_.errors.tailFactor(rng);
             const double d0 = dt.at<float>(v, u);
             if (d0 <= 0 || textureless.at<uint8_t>(v, u)) continue;
             double dmax = d0;
             for (int k = std::max(0, u - cfg_.haloWidth_px);
                  k <= std::min(W - 1, u + cfg_.haloWidth_px); ++k)
                 dmax = std::max(dmax, double(dt.at<float>(v, k)));
-            d.at<double>(v, u) = (dmax - d0 > cfg_.haloJump_px ? dmax : d0) + noise;
+            const bool halo = dmax - d0 > cfg_.haloJump_px;
+            d.at<double>(v, u) = (halo ? dmax : d0) + noise;
+            auto& kind = out.matchKind.at<uint8_t>(v, u);
+            kind = halo ? StereoRender::kHalo : StereoRender::kNoise;
+            if (cfg_.mixedProbability > 0) {
+                // The 4-neighbour with the largest true-disparity jump, if it makes an edge.
+                double dn = d0;
+                const int nb[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+                for (const auto& o : nb) {
+                    const int uu = u + o[0], vv = v + o[1];
+                    if (uu < 0 || uu >= W || vv < 0 || vv >= H) continue;
+                    const double x = dt.at<float>(vv, uu);
+                    if (x > 0 && std::abs(x - d0) > std::abs(dn - d0)) dn = x;
+                }
+                const double pick = uni(rng), w = uni(rng);
+                if (std::abs(dn - d0) > cfg_.haloJump_px && pick < cfg_.mixedProbability) {
+                    d.at<double>(v, u) = d0 + w * (dn - d0) + noise;
+                    kind = StereoRender::kMixed;
+                }
+            }
+            double factor = 1.0;
+            if (cfg_.errors.drawOutlier(rng, factor)) {
+                d.at<double>(v, u) = d0 * factor;
+                kind = StereoRender::kOutlier;
+            }
         }
     for (int b = 0; b < cfg_.blobsPerFrame; ++b) {
         const int uc = static_cast<int>(uni(rng) * W),
@@ -116,8 +145,10 @@ StereoRender StereoSim::render(const mrpt::poses::CPose3D& robot, std::mt19937_6
         for (int v = std::max(0, int(vc - radius)); v <= std::min(H - 1, int(vc + radius)); ++v)
             for (int u = std::max(0, int(uc - radius)); u <= std::min(W - 1, int(uc + radius)); ++u)
                 if ((u - uc) * (u - uc) + (v - vc) * (v - vc) <= radius * radius &&
-                    textureless.at<uint8_t>(v, u))
+                    textureless.at<uint8_t>(v, u)) {
                     d.at<double>(v, u) = db;
+                    out.matchKind.at<uint8_t>(v, u) = StereoRender::kBlob;
+                }
     }
     out.disparity16.create(H, W, CV_16U);
     for (int v = 0; v < H; ++v)

@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library: terrain-sim. */
 #pragma once
 
+#include "SensorErrors.h"
 #include "SurfaceTexture.h"
 #include "Terrain.h"
 
@@ -34,6 +35,15 @@ struct StereoConfig {
      * fx fy cx cy k1 k2 p1 p2 k3 [px px px px - - - - -], extrinsics rx ry rz tx ty tz [rad, m]. */
     std::array<double, 9> intrinsicsSigma{0.4, 0.4, 0.3, 0.3, 0.002, 0.004, 0.0002, 0.0002, 0.005};
     std::array<double, 6> extrinsicsSigma{0.0005, 0.0005, 0.0003, 0.0002, 0.0001, 0.0002};
+    // Errors the library's stereo model does not describe (off by default, doc/terrain-sim.md).
+    ErrorShape errors;  //!< heavy tails and gross outliers of the matching (disparity image)
+    /** Chance that a pixel at a depth edge (a 4-neighbour more than haloJump_px away in true
+     * disparity) matches a blend of both sides: d + w (d_neighbour - d), w ~ U(0, 1). */
+    double mixedProbability = 0.0;
+    /** Calibration errors: the pair is rendered with the true values (nominal + error), the
+     * observation and the ini keep the nominal ones, so the map is not told. */
+    double baselineError_m = 0.0;
+    double cxError_px = 0.0, cyError_px = 0.0;
 
     double fx_px() const { return 0.5 * width_px / std::tan(0.5 * hfov_rad); }
     double cx_px() const { return 0.5 * (width_px - 1); }
@@ -47,6 +57,9 @@ struct StereoRender {
     cv::Mat left, right;    //!< CV_8U grey
     cv::Mat trueDisparity;  //!< CV_32F, left image, fx * B / z_cam [px]; 0 where no surface
     cv::Mat disparity16;    //!< CV_16U, disparity * 16, 0 = invalid (artefacts included)
+    /** CV_8U, left image: what the matcher did at each pixel (one of the kinds below). */
+    cv::Mat matchKind;
+    enum Kind : uint8_t { kNone = 0, kNoise = 1, kHalo = 2, kMixed = 3, kOutlier = 4, kBlob = 5 };
 };
 
 class StereoSim {

@@ -28,6 +28,20 @@ const char* kUsage =
     "  --speed MPS          walk: forward speed [m/s] (default 0.1)\n"
     "  --dark-patches N     black discs on the boards (default 6)\n"
     "  --max-frames N       stop after N frames (default: the whole trajectory)\n"
+    "Sensor errors the library's models do not describe (doc/terrain-sim.md; default: none,\n"
+    "the noise drawn from the models' own sigmas with exact calibration):\n"
+    "  --noise matched|independent  independent: all of the below at their stated values\n"
+    "                       (doc/independent-evaluation.md); the options below override it\n"
+    "  --tail-dof N         Student-t noise with N > 2 dof at the same sigma, laser and stereo\n"
+    "                       (0: Gaussian)\n"
+    "  --outliers F         share of laser ranges and stereo disparities replaced by the true\n"
+    "                       value times U(0.5, 1.5)\n"
+    "  --laser-range-bias B0,B1        extra range bias B0 + B1 r [m, m/m]\n"
+    "  --laser-mixed P[,JUMP]          mixed-pixel chance at depth edges over JUMP m (0.5, 0.03)\n"
+    "  --laser-pitch-error DEG         true mounting pitch minus the written one\n"
+    "  --stereo-mixed P                chance that a pixel at a depth edge blends both sides\n"
+    "  --stereo-baseline-error M       true baseline minus the written one [m]\n"
+    "  --stereo-principal-point-error DU,DV  true cx, cy minus the written ones [px]\n"
     "  --help               this text\n";
 
 double parseDouble(const std::string& opt, const std::string& v) {
@@ -57,6 +71,20 @@ long parseInt(const std::string& opt, const std::string& v, long lo) {
     return n;
 }
 
+/** "A,B" (or "A" when `secondOptional`, leaving b as it is) as two numbers. */
+void parseNumbers(const std::string& opt, const std::string& v, double& a, double& b,
+                  bool secondOptional = false) {
+    const auto comma = v.find(',');
+    if (comma == std::string::npos) {
+        if (!secondOptional)
+            throw std::invalid_argument(opt + ": '" + v + "' is not of the form A,B");
+        a = parseDouble(opt, v);
+        return;
+    }
+    a = parseDouble(opt, v.substr(0, comma));
+    b = parseDouble(opt, v.substr(comma + 1));
+}
+
 void parsePair(const std::string& opt, const std::string& v, int& a, int& b) {
     const auto x = v.find('x');
     if (x == std::string::npos)
@@ -71,6 +99,15 @@ int main(int argc, char** argv) {
     try {
         terrain_sim::ScenarioConfig cfg;
         bool haveScenario = false;
+        // The noise preset first, so that the single-error options override it in any order.
+        for (int i = 1; i + 1 < argc; ++i) {
+            if (std::string(argv[i]) != "--noise") continue;
+            const std::string v = argv[i + 1];
+            if (v == "independent")
+                terrain_sim::applyIndependentNoise(cfg);
+            else if (v != "matched")
+                throw std::invalid_argument("--noise: '" + v + "' is not matched or independent");
+        }
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
             if (a == "--help" || a == "-h") {
@@ -127,6 +164,38 @@ int main(int argc, char** argv) {
                 cfg.darkPatches = static_cast<int>(parseInt(a, v, 0));
             } else if (a == "--max-frames") {
                 cfg.trajectory.maxFrames = static_cast<int>(parseInt(a, v, 1));
+            } else if (a == "--noise") {
+                // applied above
+            } else if (a == "--tail-dof") {
+                const int dof = static_cast<int>(parseInt(a, v, 0));
+                if (dof == 1 || dof == 2)
+                    throw std::invalid_argument("--tail-dof must be 0 or > 2");
+                cfg.laser.errors.tailDof = cfg.stereo.errors.tailDof = dof;
+            } else if (a == "--outliers") {
+                const double f = parseDouble(a, v);
+                if (!(f >= 0 && f <= 1))
+                    throw std::invalid_argument("--outliers must be in [0, 1]");
+                cfg.laser.errors.outlierFraction = cfg.stereo.errors.outlierFraction = f;
+            } else if (a == "--laser-range-bias") {
+                parseNumbers(a, v, cfg.laser.rangeBias0_m, cfg.laser.rangeBiasSlope);
+            } else if (a == "--laser-mixed") {
+                parseNumbers(a, v, cfg.laser.mixedProbability, cfg.laser.mixedJump_m, true);
+                if (!(cfg.laser.mixedProbability >= 0 && cfg.laser.mixedProbability <= 1) ||
+                    !(cfg.laser.mixedJump_m > 0))
+                    throw std::invalid_argument("--laser-mixed: P in [0, 1], JUMP > 0");
+            } else if (a == "--laser-pitch-error") {
+                cfg.laser.pitchError_rad = parseDouble(a, v) * M_PI / 180.0;
+            } else if (a == "--stereo-mixed") {
+                cfg.stereo.mixedProbability = parseDouble(a, v);
+                if (!(cfg.stereo.mixedProbability >= 0 && cfg.stereo.mixedProbability <= 1))
+                    throw std::invalid_argument("--stereo-mixed must be in [0, 1]");
+            } else if (a == "--stereo-baseline-error") {
+                cfg.stereo.baselineError_m = parseDouble(a, v);
+                if (!(cfg.stereo.baseline_m + cfg.stereo.baselineError_m > 0))
+                    throw std::invalid_argument(
+                        "--stereo-baseline-error: the true baseline must be > 0");
+            } else if (a == "--stereo-principal-point-error") {
+                parseNumbers(a, v, cfg.stereo.cxError_px, cfg.stereo.cyError_px);
             } else {
                 throw std::invalid_argument("unknown option '" + a + "' (see --help)");
             }

@@ -13,8 +13,8 @@
 #include <random>
 #include <thread>
 
-#include "multibin/map/BinGrid.h"
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/BinGrid.h"
 #include "multibin/map/VisibilityConstraint.h"
 
 using namespace multibin;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/BinGrid.h"
 #include "multibin/sensors/StereoDisparity.h"
 
 using namespace multibin;

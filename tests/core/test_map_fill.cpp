@@ -1,6 +1,7 @@
 /* The map's gap filling: lazy (dem_update_map only), measured vs filled, dem_return_filled. */
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
+#include "multibin/io/EsriAsciiGrid.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 using Source = CMultiBinElevationMap::HeightSource;

@@ -8,10 +8,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "multibin/io/RasterExport.h"
 #include "multibin/eval/Evaluation.h"
+#include "multibin/io/RasterExport.h"
 
 using namespace multibin::eval;
+using multibin::Lattice;
 
 namespace {
 CellArray array2x2(float a, float b, float c, float d) {
@@ -70,12 +71,12 @@ TEST(Evaluation, GroundTruthCellIsTheMeanOfItsSamples) {
     gt.heights_m.resize(4, 4);
     for (int r = 0; r < 4; r++)
         for (int c = 0; c < 4; c++) gt.heights_m(r, c) = 0.001f * float(c);
-    EvalLattice L;
+    Lattice L;
     const CellArray truth = groundTruthOnLattice(gt, 0.02, L);
-    EXPECT_EQ(L.ix0, 0);
-    EXPECT_EQ(L.iy0, 0);
-    ASSERT_EQ(L.nx, 2);
-    ASSERT_EQ(L.ny, 2);
+    EXPECT_EQ(L.window.ix0, 0);
+    EXPECT_EQ(L.window.iy0, 0);
+    ASSERT_EQ(L.window.nx, 2);
+    ASSERT_EQ(L.window.ny, 2);
     EXPECT_NEAR(truth(0, 0), 0.0005, 1e-7);  // mean of columns 0 and 1
     EXPECT_NEAR(truth(1, 1), 0.0025, 1e-7);  // mean of columns 2 and 3
 
@@ -97,9 +98,9 @@ TEST(Evaluation, ReportJsonHasTheDocumentedFields) {
         {"multibin", array2x2(0.11f, 0.2f, 0.3f, NAN), array2x2(0.01f, 0.01f, 0.01f, 0), "raw_all",
          1.5, 0.25}};
     const auto scores = scoreMethods(truth, methods);
-    EvalLattice L;
+    Lattice L;
     L.cellSize_m = 0.02;
-    L.nx = L.ny = 2;
+    L.window.nx = L.window.ny = 2;
     const std::string json = reportJson(scores, {"raw_all", "multibin"}, L);
     const auto doc = mrpt::containers::yaml::FromText(json);
     const auto& mb = doc["methods"]["multibin"];
@@ -130,12 +131,12 @@ TEST(Exports, PlyMeshHasOneVertexPerKnownCellAndTwoTrianglesPerKnownQuad) {
 
 TEST(Evaluation, AreaScoresCountOnlyTheCellsOfTheSubArea) {
     const CellArray truth = array2x2(0, 0, 0, 0);
-    EvalLattice L;
+    Lattice L;
     L.cellSize_m = 1;
-    L.nx = L.ny = 2;
-    EvalLattice crop = L;
-    crop.ix0 = 1;  // the right column: cells (r, 1)
-    crop.nx = 1;
+    L.window.nx = L.window.ny = 2;
+    Lattice crop = L;
+    crop.window.ix0 = 1;  // the right column: cells (r, 1)
+    crop.window.nx = 1;
     const std::vector<MethodEstimate> methods{
         {"m", array2x2(0.5f, 0.1f, 0.5f, 0.2f), {}, "m", 0, 0}};
     const AreaScores a = scoreArea("crop", truth, methods, L, crop);
@@ -147,17 +148,17 @@ TEST(Evaluation, AreaScoresCountOnlyTheCellsOfTheSubArea) {
 // Cells of 0.1 m, lattice cells ix -5..14 (x in [-0.5, 1.5)), iy 0..9. An area whose edges fall
 // just past cell centres keeps exactly the cells whose centres lie inside it.
 TEST(Evaluation, SubLatticeKeepsTheCellsWhoseCentresLieInTheArea) {
-    EvalLattice L;
+    Lattice L;
     L.cellSize_m = 0.1;
-    L.ix0 = -5;
-    L.nx = 20;
-    L.iy0 = 0;
-    L.ny = 10;
-    const EvalLattice s = subLattice(L, {0.0, 0.34, 0.24, 2.0});
-    EXPECT_EQ(s.ix0, 0);  // centre 0.05 is the first >= 0.0
-    EXPECT_EQ(s.nx, 3);   // centres 0.05, 0.15, 0.25 (0.35 > 0.34)
-    EXPECT_EQ(s.iy0, 2);  // centre 0.25 is the first >= 0.24
-    EXPECT_EQ(s.ny, 8);   // up to the lattice's last row (iy 9), the area goes beyond it
+    L.window.ix0 = -5;
+    L.window.nx = 20;
+    L.window.iy0 = 0;
+    L.window.ny = 10;
+    const Lattice s = subLattice(L, {0.0, 0.34, 0.24, 2.0});
+    EXPECT_EQ(s.window.ix0, 0);  // centre 0.05 is the first >= 0.0
+    EXPECT_EQ(s.window.nx, 3);   // centres 0.05, 0.15, 0.25 (0.35 > 0.34)
+    EXPECT_EQ(s.window.iy0, 2);  // centre 0.25 is the first >= 0.24
+    EXPECT_EQ(s.window.ny, 8);   // up to the lattice's last row (iy 9), the area goes beyond it
     EXPECT_DOUBLE_EQ(s.cellSize_m, 0.1);
     EXPECT_THROW(subLattice(L, {2.0, 3.0, 0.0, 1.0}), std::invalid_argument);  // outside
     EXPECT_THROW(subLattice(L, {1.0, 0.0, 0.0, 1.0}), std::invalid_argument);  // xmin > xmax

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/fill/HeightRaster.h"
+#include "multibin/io/EsriAsciiGrid.h"
 
 namespace multibin::filltest {
 

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <string>
 #include <vector>
+#include "multibin/map/BinGrid.h"
 
 namespace fuzz {
 

@@ -7,6 +7,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include "fuzz_common.h"
+#include "multibin/io/EsriAsciiGrid.h"
 
 namespace {
 /** A small map with data, the state every input is read over. */

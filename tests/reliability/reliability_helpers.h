@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "../core/test_scenes.h"
+#include "multibin/map/BinGrid.h"
 
 namespace reliability {
 

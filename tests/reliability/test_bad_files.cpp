@@ -14,6 +14,7 @@
 #include <iterator>
 #include <sstream>
 
+#include "multibin/map/BinGrid.h"
 #include "reliability_helpers.h"
 
 namespace fs = std::filesystem;

@@ -13,6 +13,8 @@
 #include <limits>
 #include <string>
 
+#include "multibin/map/BinGrid.h"
+#include "multibin/sensors/SensorDispatch.h"
 #include "multibin/sensors/StereoDisparity.h"
 #include "reliability_helpers.h"
 

@@ -14,6 +14,7 @@
 #include <cstdio>
 
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 namespace {
 const std::string kRawlogs = MULTIBIN_SOURCE_DIR "/rawlogs/";

@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/math/wrap2pi.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/obs/CRawlog.h>
+#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -207,6 +211,14 @@ TEST(TerrainSimCli, BadArgumentsGiveOneLineErrorAndExit1) {
         {"--terrain " + board + " --scenario walk --gt-cell 5 --out " + (d / "g").string(),
          "larger than the terrain"},
         {"--terrain " + board + " --scenario walk --out /nonexistent/dir/x", "cannot write"},
+        {"--terrain " + board + " --scenario walk --noise loud --out x",
+         "not matched or independent"},
+        {"--terrain " + board + " --scenario walk --tail-dof 2 --out x", "--tail-dof"},
+        {"--terrain " + board + " --scenario walk --outliers 1.5 --out x", "--outliers"},
+        {"--terrain " + board + " --scenario walk --laser-range-bias 0.01 --out x",
+         "--laser-range-bias"},
+        {"--terrain " + board + " --scenario walk --stereo-principal-point-error a,1 --out x",
+         "--stereo-principal-point-error"},
     };
     for (const auto& [args, expect] : cases) {
         std::string out;
@@ -255,6 +267,51 @@ TEST_P(ShippedScenario, StockRawlogEditReadsIt) {
     EXPECT_EQ(rc, 0) << out;
     ASSERT_TRUE(fs::exists(list)) << out;
     EXPECT_EQ(fs::file_size(list), 0u) << "images are inline: no external image files listed";
+}
+
+// The rawlog carries odometry (a planar increment per frame) so that RawLogViewer and MRPT's
+// odometry-based tools show the path: the odometry accumulated over the actions must follow the
+// ROBOT_POSE estimates in x, y and yaw (a rawlog without actions leaves it at the origin).
+TEST_P(ShippedScenario, OdometryActionsFollowThePoseEstimates) {
+    mrpt::io::CFileGZInputStream in(prefix() + ".rawlog");
+    auto arch = mrpt::serialization::archiveFrom(in);
+    mrpt::poses::CPose2D odometry, firstEstimate;
+    size_t actions = 0, compared = 0;
+    bool haveFirst = false;
+    double worstXY_m = 0, worstYaw_rad = 0;
+    for (;;) {
+        mrpt::serialization::CSerializable::Ptr obj;
+        try {
+            obj = arch.ReadObject();
+        } catch (const mrpt::serialization::CExceptionEOF&) {
+            break;
+        }
+        if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj)) {
+            auto move = acts->getBestMovementEstimation();
+            ASSERT_TRUE(move) << "action collection " << actions << " holds no odometry";
+            odometry = odometry + move->poseChange->getMeanVal();
+            actions++;
+        } else if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
+            auto rp = sf->getObservationByClass<mrpt::obs::CObservationRobotPose>();
+            ASSERT_TRUE(rp);
+            const mrpt::poses::CPose2D estimate(rp->pose.mean);
+            if (!haveFirst) {
+                firstEstimate = estimate;  // odometry starts at the first frame's pose
+                haveFirst = true;
+            }
+            const mrpt::poses::CPose2D expected = estimate - firstEstimate;
+            worstXY_m = std::max(worstXY_m, expected.distanceTo(odometry));
+            worstYaw_rad = std::max(
+                worstYaw_rad, std::abs(mrpt::math::wrapToPi(expected.phi() - odometry.phi())));
+            compared++;
+        }
+    }
+    EXPECT_EQ(actions, compared);
+    EXPECT_GT(compared, 100u);
+    // Planar increments of the planar projection compose back to it (float rounding only).
+    EXPECT_LT(worstXY_m, 1e-4);
+    EXPECT_LT(worstYaw_rad, 1e-4);
+    EXPECT_GT(odometry.norm(), 1.0) << "the robot walks more than a metre";
 }
 
 INSTANTIATE_TEST_SUITE_P(Rawlogs, ShippedScenario, ::testing::Values("mockup", "walk"));

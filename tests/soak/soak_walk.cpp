@@ -39,6 +39,7 @@
 #include "SurfaceTexture.h"
 #include "Terrain.h"
 #include "Trajectory.h"
+#include "multibin/map/BinGrid.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;

@@ -19,44 +19,38 @@ int floorIndex(double coord_m, double cellSize_m) {
 }
 }  // namespace
 
-bool EvalLattice::cellOf(double x_m, double y_m, int& col, int& row) const {
-    if (!std::isfinite(x_m) || !std::isfinite(y_m)) return false;
-    col = floorIndex(x_m, cellSize_m) - ix0;
-    row = floorIndex(y_m, cellSize_m) - iy0;
-    return col >= 0 && row >= 0 && col < nx && row < ny;
-}
-
-EvalLattice subLattice(const EvalLattice& lattice, const std::vector<double>& area_m) {
+Lattice subLattice(const Lattice& lattice, const std::vector<double>& area_m) {
     if (area_m.size() != 4 || !(area_m[0] < area_m[1]) || !(area_m[2] < area_m[3]))
         throw std::invalid_argument("evaluation area: expected xmin < xmax, ymin < ymax [m]");
     // Cell k's centre (k + 0.5) s lies in [lo, hi] for ceil(lo/s - 0.5) <= k <= floor(hi/s - 0.5).
     const double s = lattice.cellSize_m;
     const auto first = [s](double lo) { return int(std::ceil(lo / s - 0.5)); };
     const auto last = [s](double hi) { return int(std::floor(hi / s - 0.5)); };
-    EvalLattice sub = lattice;
-    sub.ix0 = std::max(lattice.ix0, first(area_m[0]));
-    sub.iy0 = std::max(lattice.iy0, first(area_m[2]));
-    sub.nx = std::min(lattice.ix0 + lattice.nx - 1, last(area_m[1])) - sub.ix0 + 1;
-    sub.ny = std::min(lattice.iy0 + lattice.ny - 1, last(area_m[3])) - sub.iy0 + 1;
-    if (sub.nx <= 0 || sub.ny <= 0)
+    Lattice sub = lattice;
+    sub.window.ix0 = std::max(lattice.window.ix0, first(area_m[0]));
+    sub.window.iy0 = std::max(lattice.window.iy0, first(area_m[2]));
+    sub.window.nx =
+        std::min(lattice.window.ix0 + lattice.window.nx - 1, last(area_m[1])) - sub.window.ix0 + 1;
+    sub.window.ny =
+        std::min(lattice.window.iy0 + lattice.window.ny - 1, last(area_m[3])) - sub.window.iy0 + 1;
+    if (sub.window.nx <= 0 || sub.window.ny <= 0)
         throw std::invalid_argument("evaluation area: no cell of the ground truth lies inside it");
     return sub;
 }
 
-CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m,
-                               EvalLattice& latticeOut) {
+CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m, Lattice& latticeOut) {
     if (!(cellSize_m > 0)) throw std::invalid_argument("ground truth: cell size must be > 0");
     if (truth.rows() == 0 || truth.cols() == 0)
         throw std::invalid_argument("ground truth: the raster is empty");
-    EvalLattice& L = latticeOut;
+    Lattice& L = latticeOut;
     L.cellSize_m = cellSize_m;
-    L.ix0 = floorIndex(truth.xllcenter_m, cellSize_m);
-    L.iy0 = floorIndex(truth.yllcenter_m, cellSize_m);
-    L.nx = floorIndex(truth.xMax_m(), cellSize_m) - L.ix0 + 1;
-    L.ny = floorIndex(truth.yMax_m(), cellSize_m) - L.iy0 + 1;
+    L.window.ix0 = floorIndex(truth.xllcenter_m, cellSize_m);
+    L.window.iy0 = floorIndex(truth.yllcenter_m, cellSize_m);
+    L.window.nx = floorIndex(truth.xMax_m(), cellSize_m) - L.window.ix0 + 1;
+    L.window.ny = floorIndex(truth.yMax_m(), cellSize_m) - L.window.iy0 + 1;
 
-    Eigen::ArrayXXd sum = Eigen::ArrayXXd::Zero(L.ny, L.nx);
-    Eigen::ArrayXXi count = Eigen::ArrayXXi::Zero(L.ny, L.nx);
+    Eigen::ArrayXXd sum = Eigen::ArrayXXd::Zero(L.window.ny, L.window.nx);
+    Eigen::ArrayXXi count = Eigen::ArrayXXi::Zero(L.window.ny, L.window.nx);
     for (int r = 0; r < truth.rows(); r++)
         for (int c = 0; c < truth.cols(); c++) {
             const float h = truth.heights_m(r, c);
@@ -68,17 +62,17 @@ CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m,
             sum(row, col) += h;
             count(row, col)++;
         }
-    CellArray out(L.ny, L.nx);
-    for (int r = 0; r < L.ny; r++)
-        for (int c = 0; c < L.nx; c++)
+    CellArray out(L.window.ny, L.window.nx);
+    for (int r = 0; r < L.window.ny; r++)
+        for (int c = 0; c < L.window.nx; c++)
             out(r, c) = count(r, c) > 0 ? float(sum(r, c) / count(r, c)) : kNaN;
     return out;
 }
 
-RawPointGrid::RawPointGrid(const EvalLattice& lattice)
+RawPointGrid::RawPointGrid(const Lattice& lattice)
     : m_lattice(lattice),
-      m_sum_m(Eigen::ArrayXXd::Zero(lattice.ny, lattice.nx)),
-      m_count(Eigen::ArrayXXi::Zero(lattice.ny, lattice.nx)) {}
+      m_sum_m(Eigen::ArrayXXd::Zero(lattice.window.ny, lattice.window.nx)),
+      m_count(Eigen::ArrayXXi::Zero(lattice.window.ny, lattice.window.nx)) {}
 
 void RawPointGrid::addPoint(double x_m, double y_m, double z_m) {
     int col, row;
@@ -88,9 +82,9 @@ void RawPointGrid::addPoint(double x_m, double y_m, double z_m) {
 }
 
 CellArray RawPointGrid::heights_m() const {
-    CellArray out(m_lattice.ny, m_lattice.nx);
-    for (int r = 0; r < m_lattice.ny; r++)
-        for (int c = 0; c < m_lattice.nx; c++)
+    CellArray out(m_lattice.window.ny, m_lattice.window.nx);
+    for (int r = 0; r < m_lattice.window.ny; r++)
+        for (int c = 0; c < m_lattice.window.nx; c++)
             out(r, c) = m_count(r, c) > 0 ? float(m_sum_m(r, c) / m_count(r, c)) : kNaN;
     return out;
 }
@@ -179,14 +173,14 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
 }
 
 AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
-                     const std::vector<MethodEstimate>& methods, const EvalLattice& lattice,
-                     const EvalLattice& area) {
-    Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> mask(lattice.ny, lattice.nx);
-    for (int r = 0; r < lattice.ny; r++)
-        for (int c = 0; c < lattice.nx; c++) {
-            const int ix = lattice.ix0 + c, iy = lattice.iy0 + r;
-            mask(r, c) = ix >= area.ix0 && ix < area.ix0 + area.nx && iy >= area.iy0 &&
-                         iy < area.iy0 + area.ny;
+                     const std::vector<MethodEstimate>& methods, const Lattice& lattice,
+                     const Lattice& area) {
+    Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> mask(lattice.window.ny, lattice.window.nx);
+    for (int r = 0; r < lattice.window.ny; r++)
+        for (int c = 0; c < lattice.window.nx; c++) {
+            const int ix = lattice.window.ix0 + c, iy = lattice.window.iy0 + r;
+            mask(r, c) = ix >= area.window.ix0 && ix < area.window.ix0 + area.window.nx &&
+                         iy >= area.window.iy0 && iy < area.window.iy0 + area.window.ny;
         }
     AreaScores a;
     a.name = name;
@@ -196,7 +190,7 @@ AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
 }
 
 std::string reportJson(const std::map<std::string, MethodScore>& scores,
-                       const std::vector<std::string>& order, const EvalLattice& lattice,
+                       const std::vector<std::string>& order, const Lattice& lattice,
                        const std::vector<AreaScores>& areas) {
     // NaN is not JSON: unknown values are written as null.
     auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };

@@ -12,6 +12,15 @@
 
 namespace multibin {
 
+EsriAsciiGrid EsriAsciiGrid::onLattice(const Lattice& lattice) {
+    EsriAsciiGrid g;
+    g.cellsize_m = lattice.cellSize_m;
+    g.xllcenter_m = lattice.cellCenterX_m(0);
+    g.yllcenter_m = lattice.cellCenterY_m(0);
+    g.heights_m.setConstant(lattice.ny(), lattice.nx(), std::numeric_limits<float>::quiet_NaN());
+    return g;
+}
+
 namespace {
 [[noreturn]] void fail(const std::string& path, const std::string& what) {
     throw std::runtime_error("ESRI ASCII grid '" + path + "': " + what);

@@ -1,9 +1,12 @@
 /* Part of the multibin elevation-mapping library. */
-#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 #include <mrpt/rtti/CObject.h>
+#include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -42,6 +45,63 @@ namespace {
 const std::vector<std::string> kGenericMapKeys = {
     "enableSaveAs3DObject", "enableObservationLikelihood", "enableObservationInsertion"};
 
+/** options.validate(), its error prefixed with the file and section the options came from. */
+template <typename Options>
+void validateIn(const multibin::StrictConfigSection& s, const Options& options) {
+    try {
+        options.validate();
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(s.where() + ": " + e.what());
+    }
+}
+
+/** "ini file 'F'" or "ini" (a source that is not a file). Messages hold no ']': MRPT's exception
+ * wrapper takes the text up to one for a source location. */
+std::string iniName(const mrpt::config::CConfigFileBase& source) {
+    if (const auto* f = dynamic_cast<const mrpt::config::CConfigFile*>(&source))
+        return "ini file '" + f->getAssociatedFile() + "'";
+    return "ini";
+}
+
+constexpr int kMaxMapCount = 64;  //!< maps of this class in one CMultiMetricMap
+
+/** Checks what MRPT's TSetOfMetricMapInitializers does not, before it creates `count` map
+ * definitions (count = -1 or 100000 took 9-23 GB): the `multiBinElevationMap_count` key of the
+ * parent section, and every section of this map's prefix (`<parent>_multiBinElevationMap_NN_X`:
+ * NN below the count, X creationOpts or insertOpts), so a misspelt one is an error, not ignored. */
+void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::string& prefix) {
+    const std::string tag = "_multiBinElevationMap_";
+    const auto at = prefix.rfind(tag);
+    if (at == std::string::npos) return;  // not created through a CMultiMetricMap ini
+    const std::string parent = prefix.substr(0, at);
+    const std::string countKey = "multiBinElevationMap_count";
+    const std::string countText = source.read_string(parent, countKey, "0");
+    char* end = nullptr;
+    const long count = std::strtol(countText.c_str(), &end, 10);
+    if (countText.empty() || *end != '\0' || count < 0 || count > kMaxMapCount)
+        throw std::invalid_argument(iniName(source) + ", section '" + parent + "', key '" +
+                                    countKey + "': expected a whole number from 0 to " +
+                                    std::to_string(kMaxMapCount) + ", got '" + countText + "'");
+    std::vector<std::string> sections;
+    source.getAllSections(sections);
+    const std::string mapPrefix = parent + tag.substr(0, tag.size() - 1);
+    for (const auto& sec : sections) {
+        if (sec.compare(0, mapPrefix.size(), mapPrefix) != 0) continue;
+        bool known = false;
+        for (long i = 0; i < count && !known; i++) {
+            char nn[8];
+            std::snprintf(nn, sizeof nn, "%02ld", i);
+            for (const char* part : {"_creationOpts", "_insertOpts"})
+                known = known || sec == parent + tag + nn + part;
+        }
+        if (!known)
+            throw std::invalid_argument(
+                iniName(source) + ", section '" + sec + "': unknown section (this map reads '" +
+                parent + tag + "NN_creationOpts' and '" + parent + tag +
+                "NN_insertOpts', NN from 00 to " + std::to_string(count - 1) + ")");
+    }
+}
+
 const char* colormapName(mrpt::img::TColormap c) {
     switch (c) {
         case mrpt::img::cmGRAYSCALE:
@@ -77,7 +137,7 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     s.read("global_resolution", global_resolution_m);
     s.allow(kGenericMapKeys);
     s.finish();
-    validate();
+    validateIn(s, *this);
 }
 
 void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
@@ -97,6 +157,11 @@ void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CCo
     c.write(section, "global_resolution", global_resolution_m);
 }
 
+namespace {
+/** Largest cell index an option may produce: int with room for a window of 2^30 cells. */
+constexpr double kMaxCellIndex = 1 << 30;
+}  // namespace
+
 void CMultiBinElevationMap::TCreationOptions::validate() const {
     auto bad = [](const std::string& key, const std::string& what) {
         throw std::invalid_argument("CMultiBinElevationMap creation option '" + key + "': " + what);
@@ -107,6 +172,17 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
         bad("bin_height", "must be a positive bin height [m]");
     if (!(max_size_m > 0) || !std::isfinite(max_size_m))
         bad("max_size_m", "must be a positive size [m]");
+    for (const auto& [key, v] :
+         {std::pair{"min_x", min_x}, {"max_x", max_x}, {"min_y", min_y}, {"max_y", max_y}}) {
+        if (!std::isfinite(v)) bad(key, "must be finite [m]");
+        // Cell indices are int: an extent far from the origin would overflow them.
+        if (std::abs(v / resolution_m) > kMaxCellIndex) {
+            std::ostringstream os;
+            os << v << " m is cell index " << v / resolution_m << " at " << resolution_m
+               << " m cells, beyond the +-" << kMaxCellIndex << " the grid can index";
+            bad(key, os.str());
+        }
+    }
     if (max_x < min_x || max_y < min_y) bad("min_x/max_x/min_y/max_y", "max must not be below min");
     for (const auto& [key, v] : {std::pair{"local_size_m", local_size_m},
                                  {"local_resolution", local_resolution_m},
@@ -161,7 +237,7 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     fill.read(s);
     sensors.load(s);
     s.finish();
-    validate();
+    validateIn(s, *this);
 }
 
 void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
@@ -201,18 +277,25 @@ void CMultiBinElevationMap::TInsertionOptions::validate() const {
         throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key +
                                     "': " + what);
     };
-    if (!(certainty_increment > 0)) bad("certainty_increment", "must be positive");
-    if (!(max_elevation_uncertainty_m > 0))
-        bad("max_elevation_uncertainty", "must be positive [m]");
-    if (!(height_sigma_floor_m >= 0)) bad("height_sigma_floor", "must be >= 0 [m]");
-    if (default_pose_sigmas.size() != 6) bad("default_pose_sigmas", "needs 6 values");
+    const auto finite = [](double v) { return std::isfinite(v); };
+    if (!(certainty_increment > 0) || !finite(certainty_increment))
+        bad("certainty_increment", "must be positive and finite");
+    if (!(max_elevation_uncertainty_m > 0) || !finite(max_elevation_uncertainty_m))
+        bad("max_elevation_uncertainty", "must be positive and finite [m]");
+    if (!(height_sigma_floor_m >= 0) || !finite(height_sigma_floor_m))
+        bad("height_sigma_floor", "must be >= 0 and finite [m]");
+    if (default_pose_sigmas.size() != 6)
+        bad("default_pose_sigmas",
+            "needs 6 values, has " + std::to_string(default_pose_sigmas.size()));
     for (double v : default_pose_sigmas)
-        if (!(v >= 0)) bad("default_pose_sigmas", "values must be >= 0");
+        if (!(v >= 0) || !finite(v)) bad("default_pose_sigmas", "values must be >= 0 and finite");
     if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt", "must be >= 0 [s]");
-    if (!(range_sigma_m > 0)) bad("range_sigma", "must be positive [m]");
-    if (!(visibility.margin_m >= 0)) bad("visibility_margin", "must be >= 0 [m]");
-    if (!(visibility.certaintyDecrement > 0))
-        bad("visibility_certainty_decrement", "must be positive");
+    if (!(range_sigma_m > 0) || !finite(range_sigma_m))
+        bad("range_sigma", "must be positive and finite [m]");
+    if (!(visibility.margin_m >= 0) || !finite(visibility.margin_m))
+        bad("visibility_margin", "must be >= 0 and finite [m]");
+    if (!(visibility.certaintyDecrement > 0) || !finite(visibility.certaintyDecrement))
+        bad("visibility_certainty_decrement", "must be positive and finite");
     fill.validate();
     if (!(min_range_m >= 0 && max_range_m > min_range_m))
         bad("min_range/max_range", "need 0 <= min_range < max_range [m]");
@@ -235,6 +318,7 @@ CMultiBinElevationMap::TMapDefinition::TMapDefinition() = default;
 
 void CMultiBinElevationMap::TMapDefinition::loadFromConfigFile_map_specific(
     const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix) {
+    checkMapSections(source, sectionNamePrefix);
     creationOpts.loadFromConfigFile(source, sectionNamePrefix + "_creationOpts");
     insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 }
@@ -255,10 +339,46 @@ mrpt::maps::CMetricMap* CMultiBinElevationMap::internal_CreateFromMapDefinition(
 // ---------------------------------------------------------------------------------------------
 // Construction, queries
 // ---------------------------------------------------------------------------------------------
-CMultiBinElevationMap::CMultiBinElevationMap() { setCreationOptions(TCreationOptions()); }
+CMultiBinElevationMap::CMultiBinElevationMap() : m_impl(std::make_unique<Impl>()) {
+    setCreationOptions(TCreationOptions());
+}
 
-CMultiBinElevationMap::CMultiBinElevationMap(const TCreationOptions& creation) {
+CMultiBinElevationMap::CMultiBinElevationMap(const TCreationOptions& creation)
+    : m_impl(std::make_unique<Impl>()) {
     setCreationOptions(creation);
+}
+
+CMultiBinElevationMap::CMultiBinElevationMap(const CMultiBinElevationMap& other)
+    : CMetricMap(other),
+      CHeightGridMap2D_Base(other),
+      creationOptions(other.creationOptions),
+      insertionOptions(other.insertionOptions),
+      m_impl(std::make_unique<Impl>(*other.m_impl)) {}
+
+CMultiBinElevationMap& CMultiBinElevationMap::operator=(const CMultiBinElevationMap& other) {
+    if (this == &other) return *this;
+    CMetricMap::operator=(other);
+    CHeightGridMap2D_Base::operator=(other);
+    creationOptions = other.creationOptions;
+    insertionOptions = other.insertionOptions;
+    *m_impl = *other.m_impl;
+    return *this;
+}
+
+CMultiBinElevationMap::~CMultiBinElevationMap() = default;
+
+const multibin::BinGrid& CMultiBinElevationMap::grid() const { return m_impl->grid; }
+const multibin::BinGrid& CMultiBinElevationMap::localGrid() const { return m_impl->local; }
+bool CMultiBinElevationMap::fillIsStale() const { return m_impl->fillStale; }
+const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const { return m_impl->fill; }
+const multibin::InsertStats& CMultiBinElevationMap::insertStats() const { return m_impl->stats; }
+const multibin::VisibilityStats& CMultiBinElevationMap::visibilityStats() const {
+    return m_impl->visibilityStats;
+}
+size_t CMultiBinElevationMap::poseFallbackCount() const { return m_impl->poseFallbacks; }
+size_t CMultiBinElevationMap::skippedByLabelCount() const { return m_impl->skippedByLabel; }
+const multibin::sensors::SensorModelStats& CMultiBinElevationMap::sensorModelStats() const {
+    return m_impl->sensorState.stats;
 }
 
 void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation) {
@@ -284,21 +404,21 @@ void CMultiBinElevationMap::internal_clear() {
         };
         const int nl = side(c.local_size_m, c.local_resolution_m);
         const int ng = side(c.global_size_m, c.global_resolution_m);
-        m_local.reset(c.local_resolution_m, multibin::CellWindow{-nl / 2, -nl / 2, nl, nl});
-        m_grid.reset(c.global_resolution_m, multibin::CellWindow{-ng / 2, -ng / 2, ng, ng});
+        m_impl->local.reset(c.local_resolution_m, multibin::CellWindow{-nl / 2, -nl / 2, nl, nl});
+        m_impl->grid.reset(c.global_resolution_m, multibin::CellWindow{-ng / 2, -ng / 2, ng, ng});
     } else {
-        m_grid.reset(res, w);
-        m_local.reset(res, multibin::CellWindow{});
+        m_impl->grid.reset(res, w);
+        m_impl->local.reset(res, multibin::CellWindow{});
     }
-    m_stats = {};
-    m_visibilityStats = {};
-    m_poseFallbacks = 0;
-    m_skippedByLabel = 0;
-    m_lastRobotPose.reset();
-    m_sensorState.reset();
-    m_fill = {};
-    m_fillWindow = {};
-    m_fillStale = true;
+    m_impl->stats = {};
+    m_impl->visibilityStats = {};
+    m_impl->poseFallbacks = 0;
+    m_impl->skippedByLabel = 0;
+    m_impl->lastRobotPose.reset();
+    m_impl->sensorState.reset();
+    m_impl->fill = {};
+    m_impl->fillWindow = {};
+    m_impl->fillStale = true;
 }
 
 multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
@@ -314,32 +434,38 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
     multibin::CellSurface c;
-    if (!multibin::surfaceAt(m_grid, isDualGrid() ? &m_local : nullptr, x_m, y_m, binUpdateParams(),
-                             insertionOptions.relief_sigma, c))
+    if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,
+                             binUpdateParams(), insertionOptions.relief_sigma, c))
         return false;
     height_m = c.height_m;
     sigma_m = std::sqrt(c.variance_m2);
     return true;
 }
 
-bool CMultiBinElevationMap::isEmpty() const { return m_grid.empty() && m_local.empty(); }
+bool CMultiBinElevationMap::isEmpty() const {
+    return m_impl->grid.empty() && m_impl->local.empty();
+}
 
 std::string CMultiBinElevationMap::asString() const {
     std::ostringstream os;
-    os << "CMultiBinElevationMap: " << m_grid.window().nx << " x " << m_grid.window().ny
-       << " cells of " << m_grid.cellSize_m() << " m, x in [" << getXMin() << ", " << getXMax()
-       << "], y in [" << getYMin() << ", " << getYMax() << "] m, " << m_grid.binCount()
-       << " bins of " << creationOptions.bin_height_m << " m";
+    os << "CMultiBinElevationMap: " << m_impl->grid.window().nx << " x " << m_impl->grid.window().ny
+       << " cells of " << m_impl->grid.cellSize_m() << " m, x in [" << getXMin() << ", "
+       << getXMax() << "], y in [" << getYMin() << ", " << getYMax() << "] m, "
+       << m_impl->grid.binCount() << " bins of " << creationOptions.bin_height_m << " m";
     return os.str();
 }
 
-double CMultiBinElevationMap::getXMin() const { return m_grid.window().ix0 * m_grid.cellSize_m(); }
-double CMultiBinElevationMap::getXMax() const {
-    return (m_grid.window().ix0 + m_grid.window().nx) * m_grid.cellSize_m();
+double CMultiBinElevationMap::getXMin() const {
+    return m_impl->grid.window().ix0 * m_impl->grid.cellSize_m();
 }
-double CMultiBinElevationMap::getYMin() const { return m_grid.window().iy0 * m_grid.cellSize_m(); }
+double CMultiBinElevationMap::getXMax() const {
+    return (m_impl->grid.window().ix0 + m_impl->grid.window().nx) * m_impl->grid.cellSize_m();
+}
+double CMultiBinElevationMap::getYMin() const {
+    return m_impl->grid.window().iy0 * m_impl->grid.cellSize_m();
+}
 double CMultiBinElevationMap::getYMax() const {
-    return (m_grid.window().iy0 + m_grid.window().ny) * m_grid.cellSize_m();
+    return (m_impl->grid.window().iy0 + m_impl->grid.window().ny) * m_impl->grid.cellSize_m();
 }
 
 float CMultiBinElevationMap::compute3DMatchingRatio(const mrpt::maps::CMetricMap*,
@@ -363,6 +489,8 @@ bool CMultiBinElevationMap::internal_canComputeObservationLikelihood(
 // ---------------------------------------------------------------------------------------------
 bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y, const double z,
                                                   const TPointInsertParams& params) {
+    creationOptions.validate();
+    insertionOptions.validate();
     const double sigma = params.pt_z_std > 0 ? params.pt_z_std : insertionOptions.range_sigma_m;
     multibin::PointsWithCov pts(1);
     pts[0].point_m = Eigen::Vector3f(float(x), float(y), float(z));
@@ -373,6 +501,6 @@ bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y
     return insertPoints(pts).accepted == 1;
 }
 
-double CMultiBinElevationMap::dem_get_resolution() const { return m_grid.cellSize_m(); }
-size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_grid.window().nx); }
-size_t CMultiBinElevationMap::dem_get_size_y() const { return size_t(m_grid.window().ny); }
+double CMultiBinElevationMap::dem_get_resolution() const { return m_impl->grid.cellSize_m(); }
+size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_impl->grid.window().nx); }
+size_t CMultiBinElevationMap::dem_get_size_y() const { return size_t(m_impl->grid.window().ny); }

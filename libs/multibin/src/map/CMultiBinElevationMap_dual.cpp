@@ -7,8 +7,12 @@
  * global grid, which therefore holds everything seen; a local cell that enters starts empty and
  * queries combine it with the global estimate (getHeight), so the same data are never counted
  * twice. */
-#include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/obs/CObservationStereoImages.h>
+#include "CMultiBinElevationMap_impl.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <algorithm>
 #include <cmath>
@@ -16,32 +20,36 @@
 using namespace mrpt::maps;
 
 multibin::BinGrid& CMultiBinElevationMap::gridFor(const mrpt::obs::CObservation& obs) {
-    if (!isDualGrid()) return m_grid;
+    if (!isDualGrid()) return m_impl->grid;
     const auto& labels = insertionOptions.global_sensor_labels;
     const bool global = dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs) != nullptr ||
                         std::find(labels.begin(), labels.end(), obs.sensorLabel) != labels.end();
-    return global ? m_grid : m_local;
+    return global ? m_impl->grid : m_impl->local;
 }
 
 void CMultiBinElevationMap::writeBackLocalCell(int ix, int iy) {
-    const double x = m_local.cellCenter_m(ix), y = m_local.cellCenter_m(iy);
-    const int gx = m_grid.cellIndex(x), gy = m_grid.cellIndex(y);
-    if (!m_grid.window().contains(gx, gy)) return;  // beyond the global grid too
+    const double x = m_impl->local.cellCenter_m(ix), y = m_impl->local.cellCenter_m(iy);
+    const int gx = m_impl->grid.cellIndex(x), gy = m_impl->grid.cellIndex(y);
+    if (!m_impl->grid.window().contains(gx, gy)) return;  // beyond the global grid too
     const multibin::BinUpdateParams params = binUpdateParams();
-    m_local.forEachBin(ix, iy, [&](const multibin::Bin& b) {
-        if (b.certainty > 0) m_grid.fuseBin(gx, gy, b, params);
+    m_impl->local.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+        if (b.certainty > 0) m_impl->grid.fuseBin(gx, gy, b, params);
     });
 }
 
 void CMultiBinElevationMap::recenter(double x_m, double y_m) {
+    if (!std::isfinite(x_m) || !std::isfinite(y_m))
+        throw std::invalid_argument("CMultiBinElevationMap::recenter: the position (" +
+                                    std::to_string(x_m) + ", " + std::to_string(y_m) +
+                                    ") is not finite");
     if (!isDualGrid()) return;
-    m_fillStale = true;
+    m_impl->fillStale = true;
     // Global first, so that local cells written back land inside it.
-    for (multibin::BinGrid* g : {&m_grid, &m_local}) {
+    for (multibin::BinGrid* g : {&m_impl->grid, &m_impl->local}) {
         const multibin::CellWindow& w = g->window();
         const int ix0 = g->cellIndex(x_m) - w.nx / 2, iy0 = g->cellIndex(y_m) - w.ny / 2;
         if (ix0 == w.ix0 && iy0 == w.iy0) continue;
-        if (g == &m_local)
+        if (g == &m_impl->local)
             g->moveWindowTo(ix0, iy0, [&](int ix, int iy) { writeBackLocalCell(ix, iy); });
         else
             g->moveWindowTo(ix0, iy0);
@@ -50,10 +58,10 @@ void CMultiBinElevationMap::recenter(double x_m, double y_m) {
 
 void CMultiBinElevationMap::flushLocalToGlobal() {
     if (!isDualGrid()) return;
-    const multibin::CellWindow w = m_local.window();
+    const multibin::CellWindow w = m_impl->local.window();
     for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
         for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
             writeBackLocalCell(ix, iy);
-            m_local.clearCell(ix, iy);
+            m_impl->local.clearCell(ix, iy);
         }
 }

@@ -4,7 +4,7 @@
  * Filling is lazy: insertions only mark the last fill stale, and dem_update_map() (MRPT's hook
  * for "make every observation count") refills the whole window once. Filled cells keep
  * certainty 0; a cell measured after the fill answers with its measurement. */
-#include <mrpt/maps/CMultiBinElevationMap.h>
+#include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
 
@@ -13,18 +13,19 @@
 using namespace mrpt::maps;
 
 void CMultiBinElevationMap::dem_update_map() {
-    if (!m_fillStale) return;
-    const multibin::CellWindow w = m_grid.window();
-    multibin::fill::HeightRaster raster(w.nx, w.ny, m_grid.cellSize_m());
+    if (!m_impl->fillStale) return;
+    const multibin::CellWindow w = m_impl->grid.window();
+    multibin::fill::HeightRaster raster(multibin::Lattice{m_impl->grid.cellSize_m(), w});
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             double h, s;
-            if (getHeight(m_grid.cellCenter_m(w.ix0 + c), m_grid.cellCenter_m(w.iy0 + r), h, s))
+            if (getHeight(m_impl->grid.cellCenter_m(w.ix0 + c),
+                          m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
                 raster.setMeasured(c, r, float(h), float(s));
         }
-    m_fill = multibin::fill::fillGaps(raster, insertionOptions.fill);
-    m_fillWindow = w;
-    m_fillStale = false;
+    m_impl->fill = multibin::fill::fillGaps(raster, insertionOptions.fill);
+    m_impl->fillWindow = w;
+    m_impl->fillStale = false;
 }
 
 CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x_m, double y_m,
@@ -32,24 +33,24 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
     if (getHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
-    if (!includeFilled || m_fill.source.empty()) return HeightSource::Unknown;
-    const int ix = m_grid.cellIndex(x_m), iy = m_grid.cellIndex(y_m);
-    if (!m_fillWindow.contains(ix, iy)) return HeightSource::Unknown;
-    const size_t k = m_fill.index(ix - m_fillWindow.ix0, iy - m_fillWindow.iy0);
-    using multibin::fill::FillSource;
-    const FillSource src = m_fill.source[k];
-    if (src != FillSource::Median && src != FillSource::Gaussian) return HeightSource::Unknown;
-    height_m = m_fill.height_m[k];
-    sigma_m = m_fill.sigma_m[k];
-    return src == FillSource::Median ? HeightSource::FilledMedian : HeightSource::FilledSurface;
+    if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
+    const int ix = m_impl->grid.cellIndex(x_m), iy = m_impl->grid.cellIndex(y_m);
+    if (!m_impl->fillWindow.contains(ix, iy)) return HeightSource::Unknown;
+    const size_t k = m_impl->fill.index(ix - m_impl->fillWindow.ix0, iy - m_impl->fillWindow.iy0);
+    if (!m_impl->fill.isFilled(k)) return HeightSource::Unknown;
+    height_m = m_impl->fill.height_m[k];
+    sigma_m = m_impl->fill.sigma_m[k];
+    return m_impl->fill.source[k] == multibin::HeightSource::FilledMedian
+               ? HeightSource::FilledMedian
+               : HeightSource::FilledSurface;
 }
 
 bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
                                               double& z_out) const {
     if (cx >= dem_get_size_x() || cy >= dem_get_size_y()) return false;
-    const multibin::CellWindow& w = m_grid.window();
-    return dem_get_z(m_grid.cellCenter_m(w.ix0 + int(cx)), m_grid.cellCenter_m(w.iy0 + int(cy)),
-                     z_out);
+    const multibin::CellWindow& w = m_impl->grid.window();
+    return dem_get_z(m_impl->grid.cellCenter_m(w.ix0 + int(cx)),
+                     m_impl->grid.cellCenter_m(w.iy0 + int(cy)), z_out);
 }
 
 bool CMultiBinElevationMap::dem_get_z(const double x, const double y, double& z_out) const {

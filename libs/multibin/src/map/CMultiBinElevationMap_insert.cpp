@@ -1,13 +1,17 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: observation dispatch, pose PDFs and the insertion core. */
-#include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/system/datetime.h>
+#include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/VisibilityConstraint.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;
@@ -23,6 +27,21 @@ bool canGrowTheMap(const PointWithCov& p, const Eigen::Vector3d& sensor_m, doubl
            std::abs(p.point_m.y() - sensor_m.y()) <= half_m && !std::isnan(p.cov_m2.zz) &&
            params.passesEq13(p.cov_m2.zz);
 }
+
+/** Options may be set in code after construction: every insertion entry point checks them
+ * before they reach the grid (a NaN certainty increment makes invalid bins). */
+void validateOptions(const CMultiBinElevationMap& map) {
+    map.creationOptions.validate();
+    map.insertionOptions.validate();
+}
+
+/** t1 - t0 [s] without wrapping: MRPT's timeDifference subtracts int64 ticks, which wraps for
+ * timestamps 2^63 ticks apart. */
+double secondsBetween(mrpt::Clock::time_point t0, mrpt::Clock::time_point t1) {
+    const double ticks =
+        double(t1.time_since_epoch().count()) - double(t0.time_since_epoch().count());
+    return ticks * double(mrpt::Clock::period::num) / double(mrpt::Clock::period::den);
+}
 }  // namespace
 
 bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
@@ -33,28 +52,29 @@ bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
 bool CMultiBinElevationMap::internal_insertObservation(
     const mrpt::obs::CObservation& obs,
     const std::optional<const mrpt::poses::CPose3D>& robotPose) {
+    validateOptions(*this);
     if (const auto* rp = dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs)) {
         // Not inserted: kept as the pose PDF of the observations that follow.
-        m_lastRobotPose = rp->pose;
-        m_lastRobotPoseTime = rp->timestamp;
+        m_impl->lastRobotPose = rp->pose;
+        m_impl->lastRobotPoseTime = rp->timestamp;
         return false;
     }
     mrpt::poses::CPose3DPDFGaussian pdf;
     bool haveCov = false;
-    if (m_lastRobotPose) {
+    if (m_impl->lastRobotPose) {
         const bool timesKnown =
-            obs.timestamp != INVALID_TIMESTAMP && m_lastRobotPoseTime != INVALID_TIMESTAMP;
-        const double dt =
-            timesKnown ? std::abs(mrpt::system::timeDifference(m_lastRobotPoseTime, obs.timestamp))
-                       : std::numeric_limits<double>::infinity();
+            obs.timestamp != INVALID_TIMESTAMP && m_impl->lastRobotPoseTime != INVALID_TIMESTAMP;
+        const double dt = timesKnown
+                              ? std::abs(secondsBetween(m_impl->lastRobotPoseTime, obs.timestamp))
+                              : std::numeric_limits<double>::infinity();
         if (dt <= insertionOptions.robot_pose_max_dt_s) {
-            pdf = *m_lastRobotPose;
+            pdf = *m_impl->lastRobotPose;
             haveCov = true;
         }
     }
     if (!haveCov) {
         pdf.cov = insertionOptions.defaultPoseCovariance();
-        m_poseFallbacks++;
+        m_impl->poseFallbacks++;
     }
     if (robotPose)
         pdf.mean = *robotPose;  // the caller's mean wins; the covariance comes from the PDF
@@ -77,15 +97,24 @@ void CMultiBinElevationMap::forEachObservationWithPosePdf(
     const std::function<void(const mrpt::obs::CObservation&,
                              const mrpt::poses::CPose3DPDFGaussian&)>& visit,
     const std::function<void(size_t, size_t)>& progress) {
+    // Every keyframe is checked before any is visited: a null pose, sensory frame or observation
+    // (MRPT reads an object of the wrong class as null) is an error, not a silent skip.
     for (size_t i = 0; i < simplemap.size(); i++) {
         const auto& [posePdf, sf] = simplemap.get(i);
-        if (posePdf && sf) {
+        const std::string where = "CMultiBinElevationMap: simplemap keyframe " + std::to_string(i);
+        if (!posePdf) throw std::invalid_argument(where + " has no pose (null)");
+        if (!sf) throw std::invalid_argument(where + " has no sensory frame (null)");
+        for (const auto& obs : *sf)
+            if (!obs) throw std::invalid_argument(where + " holds a null observation");
+    }
+    for (size_t i = 0; i < simplemap.size(); i++) {
+        const auto& [posePdf, sf] = simplemap.get(i);
+        {
             mrpt::poses::CPose3DPDFGaussian pdf;
             const auto [cov, mean] = posePdf->getCovarianceAndMean();
             pdf.mean = mean;
             pdf.cov = cov;
-            for (const auto& obs : *sf)
-                if (obs) visit(*obs, pdf);
+            for (const auto& obs : *sf) visit(*obs, pdf);
         }
         if (progress) progress(i + 1, simplemap.size());
     }
@@ -105,8 +134,9 @@ size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
 
 bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
                                               const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    validateOptions(*this);
     if (!acceptsLabel(obs.sensorLabel)) {
-        m_skippedByLabel++;
+        m_impl->skippedByLabel++;
         return false;
     }
     for (int i = 0; i < 6; i++)
@@ -115,16 +145,18 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                                         obs.sensorLabel + "' has a NaN or infinite component");
     obs.load();  // externally stored observations
 
-    multibin::InsertStats sensorStats;  // rejections before the insertion core
     multibin::sensors::SensorPoints sensed;
     if (!multibin::sensors::observationToSensorPoints(
             obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-            insertionOptions.max_range_m, m_sensorState, sensorStats, sensed))
+            insertionOptions.max_range_m, m_impl->sensorState, sensed))
         return false;  // not an observation this map models
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
     const double continuityBound_m = sensed.continuityBound_m;
-    m_stats += sensorStats;
+    // Rejections before the insertion core: the model's own counts, added up here.
+    m_impl->sensorState.stats += sensed.stats;
+    m_impl->stats.outOfRange += sensed.stats.outOfRange();
+    m_impl->stats.notFinite += sensed.stats.notFinite();
     if (sensorPoints.empty()) return false;
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
@@ -158,14 +190,14 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
                                          const multibin::PosePropagator& propagator) const {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || sensorPoints.empty()) return false;
-    const multibin::CellWindow& w = m_grid.window();
+    const multibin::CellWindow& w = m_impl->grid.window();
     if (w.nx <= 0 || w.ny <= 0) return true;
     // growToCover() changes the window iff a point that canGrowTheMap() lies in a cell outside
     // it. The map-frame positions in double, from the same pose, differ from the propagator's
     // (single precision) by far less than `slack`: a point clearly inside the window, or clearly
     // farther than max_size_m / 2 from the sensor, cannot grow the map. The few others are
     // propagated exactly and tested as growToCover() would.
-    const double cell = m_grid.cellSize_m(), half = 0.5 * c.max_size_m;
+    const double cell = m_impl->grid.cellSize_m(), half = 0.5 * c.max_size_m;
     const double x0 = w.ix0 * cell, x1 = (w.ix0 + w.nx) * cell;
     const double y0 = w.iy0 * cell, y1 = (w.iy0 + w.ny) * cell;
     const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
@@ -179,9 +211,9 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
         bool grows = false;
         for (size_t i = 0; i < pending; i++) {
             const PointWithCov& p = exact[i];
-            grows = grows ||
-                    (canGrowTheMap(p, s, half, params) &&
-                     !w.contains(m_grid.cellIndex(p.point_m.x()), m_grid.cellIndex(p.point_m.y())));
+            grows = grows || (canGrowTheMap(p, s, half, params) &&
+                              !w.contains(m_impl->grid.cellIndex(p.point_m.x()),
+                                          m_impl->grid.cellIndex(p.point_m.y())));
         }
         pending = 0;
         return grows;
@@ -190,9 +222,8 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     for (const PointWithCov& p : sensorPoints) {
         const Eigen::Vector2d q = propagator.horizontalInMap_m(p.point_m);
         const double qx = q.x(), qy = q.y();
-        const double slack =
-            1e-4 + 1e-5 * (std::abs(p.point_m.x()) + std::abs(p.point_m.y()) +
-                           std::abs(p.point_m.z()) + tNorm);  // [m]
+        const double slack = 1e-4 + 1e-5 * (std::abs(p.point_m.x()) + std::abs(p.point_m.y()) +
+                                            std::abs(p.point_m.z()) + tNorm);  // [m]
         if (qx - slack >= x0 && qx + slack <= x1 && qy - slack >= y0 && qy + slack <= y1)
             continue;  // clearly inside the window
         if (std::abs(qx - s.x()) > half + slack || std::abs(qy - s.y()) > half + slack)
@@ -206,8 +237,9 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    validateOptions(*this);
     return insertIntoGrid(
-        isDualGrid() ? m_local : m_grid,
+        isDualGrid() ? m_impl->local : m_impl->grid,
         [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
             return g.insertPoints(mapPoints, params, continuityBound_m);
         },
@@ -219,16 +251,16 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
     const multibin::BinUpdateParams params = binUpdateParams();
     grid.beginCycle();
-    m_fillStale = true;
+    m_impl->fillStale = true;
     const multibin::InsertStats s = fuse(grid, params);
-    m_stats += s;
+    m_impl->stats += s;
     if (sensorOrigin_m) {
         const multibin::VisibilityStats v = multibin::applyVisibilityConstraint(
             grid, *sensorOrigin_m, insertionOptions.visibility, params);
-        m_visibilityStats.raysCast += v.raysCast;
-        m_visibilityStats.cellsVisited += v.cellsVisited;
-        m_visibilityStats.binsRemoved += v.binsRemoved;
-        m_visibilityStats.binsWeakened += v.binsWeakened;
+        m_impl->visibilityStats.raysCast += v.raysCast;
+        m_impl->visibilityStats.cellsVisited += v.cellsVisited;
+        m_impl->visibilityStats.binsRemoved += v.binsRemoved;
+        m_impl->visibilityStats.binsWeakened += v.binsWeakened;
     }
     return s;
 }
@@ -249,16 +281,16 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
         ymax = std::max(ymax, y);
     }
     if (!(xmin <= xmax)) return;
-    const multibin::CellWindow& cur = m_grid.window();
-    int ixLo = m_grid.cellIndex(xmin), ixHi = m_grid.cellIndex(xmax);
-    int iyLo = m_grid.cellIndex(ymin), iyHi = m_grid.cellIndex(ymax);
+    const multibin::CellWindow& cur = m_impl->grid.window();
+    int ixLo = m_impl->grid.cellIndex(xmin), ixHi = m_impl->grid.cellIndex(xmax);
+    int iyLo = m_impl->grid.cellIndex(ymin), iyHi = m_impl->grid.cellIndex(ymax);
     const bool haveWindow = cur.nx > 0 && cur.ny > 0;
     if (haveWindow && cur.contains(ixLo, iyLo) && cur.contains(ixHi, iyHi)) return;
 
     // Grow with a margin, so a moving sensor does not re-slot the grid at every scan.
-    const int margin = std::max(1, static_cast<int>(std::ceil(1.0 / m_grid.cellSize_m())));
+    const int margin = std::max(1, static_cast<int>(std::ceil(1.0 / m_impl->grid.cellSize_m())));
     const int maxCells =
-        std::max(1, static_cast<int>(std::floor(c.max_size_m / m_grid.cellSize_m())));
+        std::max(1, static_cast<int>(std::floor(c.max_size_m / m_impl->grid.cellSize_m())));
     auto clampAxis = [&](int curLo, int curN, int lo, int hi, int& outLo, int& outN) {
         lo -= margin;
         hi += margin;
@@ -279,5 +311,5 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
     multibin::CellWindow want;
     clampAxis(cur.ix0, cur.nx, ixLo, ixHi, want.ix0, want.nx);
     clampAxis(cur.iy0, cur.ny, iyLo, iyHi, want.iy0, want.ny);
-    m_grid.growToInclude(want);
+    m_impl->grid.growToInclude(want);
 }

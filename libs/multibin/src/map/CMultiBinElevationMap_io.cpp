@@ -1,9 +1,9 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: serialization, rasters, images and files. */
 #include <mrpt/config/CConfigFileMemory.h>
-#include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
+#include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
 #include <cmath>
@@ -96,9 +96,9 @@ void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) cons
     ini.getContent(iniText);
     out << iniText;
 
-    writeGrid(out, m_grid);
-    if (creationOptions.dual_grid) writeGrid(out, m_local);
-    out << uint64_t(m_grid.binCount() + m_local.binCount()) << kTrailerTag;
+    writeGrid(out, m_impl->grid);
+    if (creationOptions.dual_grid) writeGrid(out, m_impl->local);
+    out << uint64_t(m_impl->grid.binCount() + m_impl->local.binCount()) << kTrailerTag;
 }
 
 void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version) {
@@ -146,8 +146,8 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
             creationOptions = creation;
             insertionOptions = insertion;
             internal_clear();
-            m_grid = std::move(grid);
-            m_local = std::move(local);
+            m_impl->grid = std::move(grid);
+            m_impl->local = std::move(local);
         } break;
         default:
             MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
@@ -155,18 +155,15 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 }
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
-    const multibin::CellWindow& w = m_grid.window();
-    multibin::EsriAsciiGrid g;
-    g.cellsize_m = m_grid.cellSize_m();
-    g.xllcenter_m = m_grid.cellCenter_m(w.ix0);
-    g.yllcenter_m = m_grid.cellCenter_m(w.iy0);
-    g.heights_m.setConstant(w.ny, w.nx, NAN);
+    const multibin::CellWindow& w = m_impl->grid.window();
+    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             const int ix = w.ix0 + c, iy = w.iy0 + r;
             double h, s;
-            const HeightSource src = getElevation(m_grid.cellCenter_m(ix), m_grid.cellCenter_m(iy),
-                                                  h, s, insertionOptions.dem_return_filled);
+            const HeightSource src =
+                getElevation(m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy), h, s,
+                             insertionOptions.dem_return_filled);
             if (src == HeightSource::Unknown) continue;
             float& out = g.heights_m(r, c);
             switch (layer) {
@@ -183,10 +180,10 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
                     // The certainty of the surface the height layer reports (0 where filled).
                     multibin::CellSurface c;
                     out = src == HeightSource::Measured &&
-                                  multibin::surfaceAt(m_grid, isDualGrid() ? &m_local : nullptr,
-                                                      m_grid.cellCenter_m(ix),
-                                                      m_grid.cellCenter_m(iy), binUpdateParams(),
-                                                      false, c)
+                                  multibin::surfaceAt(
+                                      m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
+                                      m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy),
+                                      binUpdateParams(), false, c)
                               ? float(c.certainty)
                               : 0.f;
                 } break;

@@ -12,16 +12,32 @@
 #include <mrpt/serialization/CSerializable.h>
 
 #include <functional>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "multibin/map/BinGrid.h"
-#include "multibin/io/EsriAsciiGrid.h"
-#include "multibin/map/VisibilityConstraint.h"
 #include "multibin/fill/FillOptions.h"
-#include "multibin/fill/HeightRaster.h"
-#include "multibin/sensors/SensorDispatch.h"
+#include "multibin/geometry/PointsWithCovariance.h"
+#include "multibin/map/MapTypes.h"
+#include "multibin/sensors/SensorModelOptions.h"
+
+// The library's internals stay out of this header: these are only named here. Include
+// multibin/map/BinGrid.h to read grid(), multibin/io/EsriAsciiGrid.h to use toRaster(),
+// multibin/fill/HeightRaster.h for lastFill(), multibin/sensors/SensorStats.h for
+// sensorModelStats().
+namespace multibin {
+class BinGrid;
+class PosePropagator;
+struct EsriAsciiGrid;
+namespace fill {
+struct FillResult;
+}
+namespace sensors {
+struct SensorModelStats;
+}
+}  // namespace multibin
 
 namespace mrpt::maps {
 
@@ -140,6 +156,9 @@ public:
 
     CMultiBinElevationMap();
     explicit CMultiBinElevationMap(const TCreationOptions& creation);
+    CMultiBinElevationMap(const CMultiBinElevationMap& other);
+    CMultiBinElevationMap& operator=(const CMultiBinElevationMap& other);
+    ~CMultiBinElevationMap() override;
 
     /** Rebuilds an empty grid with new creation options. */
     void setCreationOptions(const TCreationOptions& creation);
@@ -175,24 +194,19 @@ public:
         const std::optional<Eigen::Vector3d>& sensorOrigin_m = std::nullopt);
 
     /** @name Queries @{ */
-    const multibin::BinGrid& grid() const { return m_grid; }
+    const multibin::BinGrid& grid() const;
     multibin::BinUpdateParams binUpdateParams() const;
-    /** Where a height comes from (getElevation()). */
-    enum class HeightSource : uint8_t {
-        Unknown = 0,   //!< never observed and not filled
-        Measured,      //!< the winning bin of an observed cell
-        FilledMedian,  //!< never observed; weighted median of the neighbours
-        FilledSurface  //!< never observed; Gaussian surface of eq 16 over its support area
-    };
+    /** Where a height comes from (getElevation()): the library's one source enum. */
+    using HeightSource = multibin::HeightSource;
     /** Height [m] and sigma [m] at (x, y): measured (the winning bin, as getHeight()) or, with
      * includeFilled, the result of the last gap filling (dem_update_map()) for a cell that is
      * still unobserved. Filled cells keep certainty 0. */
     HeightSource getElevation(double x_m, double y_m, double& height_m, double& sigma_m,
                               bool includeFilled = true) const;
     /** True when observations arrived after the last gap filling (dem_update_map() refills). */
-    bool fillIsStale() const { return m_fillStale; }
+    bool fillIsStale() const;
     /** The last gap filling's result over the grid window it was run on. */
-    const multibin::fill::FillResult& lastFill() const { return m_fill; }
+    const multibin::fill::FillResult& lastFill() const;
 
     /** Height [m] and sigma [m] at (x, y) from the winning bin; false if unobserved. With the
      * dual grid, where both grids know the place and agree within 3 sigma, their independent
@@ -202,7 +216,7 @@ public:
     /** @name Dual grid @{ */
     bool isDualGrid() const { return creationOptions.dual_grid; }
     /** The precise local grid (empty unless dual grid). grid() is the global one. */
-    const multibin::BinGrid& localGrid() const { return m_local; }
+    const multibin::BinGrid& localGrid() const;
     /** Centres both grids on (x, y) [m]: cells still inside are untouched; local cells that
      * leave are written back into the global grid. Called before each insertion. */
     void recenter(double x_m, double y_m);
@@ -224,21 +238,19 @@ public:
      * where unknown. */
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
     /** Sums of what every insertion did with its points. */
-    const multibin::InsertStats& insertStats() const { return m_stats; }
+    const multibin::InsertStats& insertStats() const;
     /** Sums of what the visibility constraint did. */
-    const multibin::VisibilityStats& visibilityStats() const { return m_visibilityStats; }
+    const multibin::VisibilityStats& visibilityStats() const;
     /** Observations inserted with the default pose covariance because no valid pose PDF was known.
      */
-    size_t poseFallbackCount() const { return m_poseFallbacks; }
+    size_t poseFallbackCount() const;
     /** True if observations with this sensor label are inserted (insertionOptions.sensor_labels
      * is empty or lists it). */
     bool acceptsLabel(const std::string& label) const;
     /** Observations skipped because their sensor label is not in insertionOptions.sensor_labels. */
-    size_t skippedByLabelCount() const { return m_skippedByLabel; }
+    size_t skippedByLabelCount() const;
     /** What the sensor models did (per sensor kind), since the last clear(). */
-    const multibin::sensors::SensorModelStats& sensorModelStats() const {
-        return m_sensorState.stats;
-    }
+    const multibin::sensors::SensorModelStats& sensorModelStats() const;
     /** @} */
 
     /** @name CMetricMap @{ */
@@ -311,21 +323,10 @@ private:
     void writeBackLocalCell(int ix, int iy);
     multibin::BinGrid& gridFor(const mrpt::obs::CObservation& obs);
 
-    multibin::BinGrid m_grid;   //!< the single grid, or the global grid of the dual grid
-    multibin::BinGrid m_local;  //!< dual grid only: the precise local grid
-    multibin::InsertStats m_stats;
-    multibin::VisibilityStats m_visibilityStats;
-    size_t m_poseFallbacks = 0;
-    size_t m_skippedByLabel = 0;
-    /** The latest CObservationRobotPose: its PDF and timestamp. */
-    std::optional<mrpt::poses::CPose3DPDFGaussian> m_lastRobotPose;
-    mrpt::Clock::time_point m_lastRobotPoseTime;
-    /** Previous laser scans (eq 14), stereo covariance table, sensor statistics. */
-    multibin::sensors::SensorModelState m_sensorState;
-    /** The last gap filling, over m_fillWindow of m_grid (absolute cell indices). */
-    multibin::fill::FillResult m_fill;
-    multibin::CellWindow m_fillWindow;
-    bool m_fillStale = true;
+    /** The map's state (grids, statistics, sensor-model state, last fill): see
+     * src/map/CMultiBinElevationMap_impl.h. Never null. */
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
 };
 
 }  // namespace mrpt::maps

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "multibin/geometry/Lattice.h"
 #include "multibin/io/EsriAsciiGrid.h"
 
 namespace multibin::eval {
@@ -15,44 +16,25 @@ namespace multibin::eval {
  * (south to north), column = x index. */
 using CellArray = Eigen::ArrayXXf;
 
-/** The evaluation lattice: cells (ix, iy) of the map's own lattice, cell ix covering
- * [ix, ix+1) * cellSize_m [m] (the lattice is anchored at the map origin, as BinGrid's is), for
- * ix0 <= ix < ix0 + nx and iy0 <= iy < iy0 + ny. */
-struct EvalLattice {
-    double cellSize_m = 0.02;
-    int ix0 = 0, iy0 = 0, nx = 0, ny = 0;
-
-    double cellCenterX_m(int col) const { return (ix0 + col + 0.5) * cellSize_m; }
-    double cellCenterY_m(int row) const { return (iy0 + row + 0.5) * cellSize_m; }
-    /** Area covered [m]: {xmin, xmax, ymin, ymax}. */
-    std::vector<double> area_m() const {
-        return {ix0 * cellSize_m, (ix0 + nx) * cellSize_m, iy0 * cellSize_m,
-                (iy0 + ny) * cellSize_m};
-    }
-    /** Column/row of the cell containing (x, y) [m]; false if outside the lattice. */
-    bool cellOf(double x_m, double y_m, int& col, int& row) const;
-};
-
 /** Ground truth on the lattice: a cell's truth is the mean of the truth samples whose centres lie
  * inside it; NaN where none does. The lattice covers exactly the cells that hold samples. */
-CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m,
-                               EvalLattice& latticeOut);
+CellArray groundTruthOnLattice(const EsriAsciiGrid& truth, double cellSize_m, Lattice& latticeOut);
 
 /** The cells of `lattice` whose centres lie inside area_m = {xmin, xmax, ymin, ymax} [m] (to
  * evaluate over part of the truth, e.g. a mock-up without the floor around it). Throws
  * std::invalid_argument naming the problem if the area is malformed or holds no cell centre. */
-EvalLattice subLattice(const EvalLattice& lattice, const std::vector<double>& area_m);
+Lattice subLattice(const Lattice& lattice, const std::vector<double>& area_m);
 
 /** The raw map of eq 17: range points simply registered in the grid, a cell's value being the
  * mean of the points that fall in it. */
 class RawPointGrid {
 public:
-    explicit RawPointGrid(const EvalLattice& lattice);
+    explicit RawPointGrid(const Lattice& lattice);
     void addPoint(double x_m, double y_m, double z_m);
     CellArray heights_m() const;  //!< mean height per cell, NaN where no point fell
 
 private:
-    EvalLattice m_lattice;
+    Lattice m_lattice;
     Eigen::ArrayXXd m_sum_m;
     Eigen::ArrayXXi m_count;
 };
@@ -110,15 +92,15 @@ struct AreaScores {
 };
 /** Scores the methods over the cells of `area` (a sub-lattice of `lattice`). */
 AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
-                     const std::vector<MethodEstimate>& methods, const EvalLattice& lattice,
-                     const EvalLattice& area);
+                     const std::vector<MethodEstimate>& methods, const Lattice& lattice,
+                     const Lattice& area);
 
 /** report.json: {"methods": {name: {rmse_m, pi, pi_shared, coverage, within_3sigma, insert_s,
  * fill_s, valid_cells}}, "cell_size_m", "area_m": [xmin, xmax, ymin, ymax]}; methods in `order`.
  * Each sub-area adds {"<name>": {"area_m": [...], "rmse_m": {method: x}, "cells": {method: n}}}.
  */
 std::string reportJson(const std::map<std::string, MethodScore>& scores,
-                       const std::vector<std::string>& order, const EvalLattice& lattice,
+                       const std::vector<std::string>& order, const Lattice& lattice,
                        const std::vector<AreaScores>& areas = {});
 /** The same numbers as a fixed-width text table. */
 std::string reportTable(const std::map<std::string, MethodScore>& scores,

@@ -4,6 +4,8 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "multibin/geometry/Lattice.h"
+
 namespace multibin {
 
 /** A height raster in ESRI ASCII grid format (GDAL driver AAIGrid).
@@ -17,6 +19,9 @@ struct EsriAsciiGrid {
     double yllcenter_m = 0;       //!< y of the centre of the lower-left sample [m]
     double cellsize_m = 1;        //!< sample spacing [m]
     double nodata_value = -9999;  //!< written for NaN samples
+
+    /** A raster with one NaN sample at the centre of every cell of `lattice`. */
+    static EsriAsciiGrid onLattice(const Lattice& lattice);
 
     int cols() const { return static_cast<int>(heights_m.cols()); }
     int rows() const { return static_cast<int>(heights_m.rows()); }

@@ -1,0 +1,35 @@
+/* Part of the multibin elevation-mapping library.
+ * CMultiBinElevationMap's state, kept out of the public header (which shows only the map, its
+ * option structs and plain result types). Included by the map's own source files only. */
+#pragma once
+
+#include <mrpt/maps/CMultiBinElevationMap.h>
+
+#include <optional>
+
+#include "multibin/fill/HeightRaster.h"
+#include "multibin/geometry/Lattice.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/sensors/SensorDispatch.h"
+
+namespace mrpt::maps {
+
+struct CMultiBinElevationMap::Impl {
+    multibin::BinGrid grid;   //!< the single grid, or the global grid of the dual grid
+    multibin::BinGrid local;  //!< dual grid only: the precise local grid
+    multibin::InsertStats stats;
+    multibin::VisibilityStats visibilityStats;
+    size_t poseFallbacks = 0;
+    size_t skippedByLabel = 0;
+    /** The latest CObservationRobotPose: its PDF and timestamp. */
+    std::optional<mrpt::poses::CPose3DPDFGaussian> lastRobotPose;
+    mrpt::Clock::time_point lastRobotPoseTime;
+    /** Previous laser scans (eq 14), stereo covariance table, sensor statistics. */
+    multibin::sensors::SensorModelState sensorState;
+    /** The last gap filling, over fillWindow of grid (absolute cell indices). */
+    multibin::fill::FillResult fill;
+    multibin::CellWindow fillWindow;
+    bool fillStale = true;
+};
+
+}  // namespace mrpt::maps
