@@ -142,6 +142,33 @@ TEST(BinGrid, RejectsBadPointsAndCountsThem) {
     EXPECT_TRUE(g.empty());
 }
 
+TEST(BinGrid, ZeroAndSingularCovariancesAreExactNotErrors) {
+    // A zero covariance (exact pose and sensor) and a range-only one (rank 1) describe points
+    // known exactly along some directions: fused, with finite heights, on both insertion paths
+    // (run of points and per point). An indefinite one (|correlation| of 2) is rejected.
+    for (const double bound : {std::numeric_limits<double>::infinity(), 0.05}) {
+        BinGrid g = gridAroundOrigin();
+        BinUpdateParams p;
+        PointWithCov exact = pointAt(0.05, 0.05, 0.02, 0.01), exact2 = exact;
+        exact.cov_m2 = {};
+        exact2.cov_m2 = {};
+        exact2.point_m.z() = 0.03f;
+        PointWithCov ranged = pointAt(0.15, 0.05, 0.02, 0.01);
+        ranged.cov_m2 = rangeOnlyCovariance(Eigen::Vector3f(0.6f, 0.0f, -0.8f), 0.01f);
+        PointWithCov indefinite = pointAt(0.25, 0.05, 0.02, 0.01);
+        indefinite.cov_m2 = {1e-4f, 2e-4f, 0, 1e-4f, 0, 1e-4f};
+        const InsertStats s = g.insertPoints({exact, exact2, ranged, indefinite}, p, bound);
+        EXPECT_EQ(s.accepted, 3u);
+        EXPECT_EQ(s.badCovariance, 1u);
+        ASSERT_NE(g.winningBin(0, 0), nullptr);
+        EXPECT_NEAR(g.winningBin(0, 0)->height_m, 0.025, 1e-6) << "two exact heights: their mean";
+        ASSERT_NE(g.winningBin(1, 0), nullptr);
+        EXPECT_NEAR(g.winningBin(1, 0)->height_m, 0.02, 1e-6);
+        EXPECT_NEAR(g.winningBin(1, 0)->variance_m2, 0.64e-4, 1e-9);
+        EXPECT_EQ(g.winningBin(2, 0), nullptr);
+    }
+}
+
 TEST(BinGrid, GrowingKeepsEveryBin) {
     BinGrid g(0.1);
     g.reset(0.1, CellWindow{0, 0, 4, 4});

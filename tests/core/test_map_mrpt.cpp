@@ -132,6 +132,46 @@ TEST(CMultiBinElevationMap, PitchedLaserOverFloorGivesFlatMapWithHonestSigma) {
     EXPECT_EQ(map.poseFallbackCount(), 0u);
 }
 
+TEST(CMultiBinElevationMap, ExactAndPartlyExactPosesAreFusedIndefiniteOnesRejected) {
+    // An icp-slam keyframe has an all-zero 6x6 covariance: an exact pose. With it (and with a
+    // rank-deficient one: only the yaw uncertain) every floor point the pose with 1e-4 sigmas
+    // fuses must be fused too, at the same height. An indefinite covariance (|correlation| of x
+    // and y of 2) is no covariance: every point is rejected and counted as such.
+    const auto scan = test_scenes::pitchedScanOverFloor(0.26, mrpt::DEG2RAD(45.0));
+    auto fuse = [&](const mrpt::math::CMatrixDouble66& cov, multibin::InsertStats& stats) {
+        CMultiBinElevationMap map;
+        CPose3DPDFGaussian pose;
+        pose.cov = cov;
+        map.insertObservation(*scan, pose);
+        stats = map.insertStats();
+        double h = NAN, s;
+        map.getHeight(0.26, 0.0, h, s);
+        return h;
+    };
+    mrpt::math::CMatrixDouble66 uncertain, zero, yawOnly, indefinite;
+    uncertain.setIdentity();
+    uncertain *= 1e-8;
+    zero.setZero();
+    yawOnly.setZero();
+    yawOnly(3, 3) = 1e-6;
+    indefinite.setZero();
+    indefinite(0, 0) = indefinite(1, 1) = 1e-4;
+    indefinite(0, 1) = indefinite(1, 0) = 2e-4;
+    multibin::InsertStats reference, stats;
+    const double h0 = fuse(uncertain, reference);
+    ASSERT_GT(reference.accepted, 300u);
+    for (const auto* cov : {&zero, &yawOnly}) {
+        const double h = fuse(*cov, stats);
+        EXPECT_EQ(stats.accepted, reference.accepted);
+        EXPECT_EQ(stats.badCovariance, 0u);
+        EXPECT_NEAR(h, h0, 1e-4);
+        EXPECT_NEAR(h, 0.0, 1e-3);
+    }
+    fuse(indefinite, stats);
+    EXPECT_EQ(stats.accepted, 0u);
+    EXPECT_EQ(stats.badCovariance, reference.accepted);
+}
+
 TEST(CMultiBinElevationMap, UsesLatestRobotPoseCovarianceWhileFresh) {
     CMultiBinElevationMap map;
     auto robotPose = mrpt::obs::CObservationRobotPose::Create();

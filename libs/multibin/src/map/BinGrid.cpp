@@ -202,15 +202,10 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
                 cb.status[i] = kNotFinite;
                 continue;
             }
-            // Positive-definite by Sylvester's criterion (leading minors), in double.
-            const double m1 = c.xx, m2 = double(c.xx) * c.yy - double(c.xy) * c.xy;
-            const double m3 = c.xx * (double(c.yy) * c.zz - double(c.yz) * c.yz) -
-                              c.xy * (double(c.xy) * c.zz - double(c.yz) * c.xz) +
-                              c.xz * (double(c.xy) * c.yz - double(c.yy) * c.xz);
             const int ix = cellIndex(p.point_m.x()), iy = cellIndex(p.point_m.y());
             int16_t n = 0;
             uint8_t status = kAccept;
-            if (!(m1 > 0 && m2 > 0 && m3 > 0))
+            if (!isCovariance(c))  // zero or singular: an exact pose, fused as it is
                 status = kBadCovariance;
             else if (!w.contains(ix, iy))
                 status = kOutsideMap;
@@ -230,7 +225,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
                 rejected[cb.status[i]]++;
                 continue;
             }
-            const double h = pts[i].point_m.z(), var = pts[i].cov_m2.zz;
+            const double h = pts[i].point_m.z();
+            const double var = std::max<double>(pts[i].cov_m2.zz, kMinFusedVariance_m2);
             const size_t s = cb.slot[i];
             if (perPoint) {
                 fuseMeasurement(s, cb.ix[i], cb.iy[i], cb.bin[i], h, var, params, continuityBound_m,

@@ -23,6 +23,26 @@ struct SymmetricCov3 {
     }
 };
 
+/** Whether `c`, not positive-definite, is still positive semi-definite: all principal minors
+ * >= 0 to within single-precision rounding (see isCovariance). */
+#if defined(__GNUC__)
+__attribute__((cold))  // exact poses only: kept out of the insertion loop's hot code
+#endif
+bool isSingularCovariance(const SymmetricCov3& c);
+
+/** Whether `c` is a covariance: finite and positive semi-definite. Zero and rank-deficient
+ * covariances pass (an exact pose, a range-only sensor: the point is exactly known along some
+ * directions); indefinite ones (a negative variance, |correlation| > 1) and NaN do not. */
+inline bool isCovariance(const SymmetricCov3& c) {
+    // Positive-definite by Sylvester's criterion (leading minors), in double: the common case.
+    const double xx = c.xx, xy = c.xy, xz = c.xz, yy = c.yy, yz = c.yz, zz = c.zz;
+    const double m2 = xx * yy - xy * xy;
+    const double m3 =
+        xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+    if (__builtin_expect(xx > 0 && m2 > 0 && m3 > 0, 1)) return true;
+    return isSingularCovariance(c);
+}
+
 /** One 3D point [m] with its full covariance [m^2]. */
 struct PointWithCov {
     Eigen::Vector3f point_m;

@@ -14,6 +14,11 @@ namespace multibin {
  * grid and the cell surface's merge of neighbouring bins all call these.
  * @{ */
 
+/** The least height variance a point is fused with [m^2]: an exact height (an exact pose and a
+ * horizontal range-only beam give variance 0) would make the information form's 1/var
+ * infinite; (1 um)^2 is exact for any terrain. */
+constexpr double kMinFusedVariance_m2 = 1e-12;
+
 /** Eq 15 in gain form: fuses a height `z_m` with variance `zVariance_m2` into the estimate
  * (height_m, variance_m2), stored as floats. Two exact estimates (both variances 0) average. */
 inline void fuse(float& height_m, float& variance_m2, double z_m, double zVariance_m2) {

@@ -26,7 +26,7 @@ struct InsertStats {
     size_t accepted = 0;            //!< fused into a bin
     size_t outOfRange = 0;          //!< sensor reading invalid or outside the accepted range
     size_t notFinite = 0;           //!< NaN/inf coordinates or covariance
-    size_t badCovariance = 0;       //!< covariance not symmetric positive-definite
+    size_t badCovariance = 0;       //!< covariance indefinite (zero and singular ones are exact)
     size_t outsideMap = 0;          //!< (x, y) outside the grid window (after any growth)
     size_t outsideBinRange = 0;     //!< height beyond the representable bin indices
     size_t tooUncertain = 0;        //!< eq 13 gate: 3 sigma_z > Delta_max
