@@ -45,7 +45,7 @@ ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -LE 'slow|install' 
 # New inputs go to a scratch corpus in the build tree; the committed ones stay as they are. A
 # crash, a sanitizer report, a leak or an out-of-memory (> 2 GB) fails the stage; the reproducer
 # is left in build-asan/fuzz-<target>-crash-*.
-for target in map_deserialize ini_options observation_insert; do
+for target in map_deserialize ini_options observation_insert rawlog_read; do
   exe="$build_dir/tests/fuzz/fuzz_$target"
   corpus="$root/tests/fuzz/corpus/$target"
   scratch="$build_dir/fuzz-corpus/$target"

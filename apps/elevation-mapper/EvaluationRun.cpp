@@ -1,6 +1,9 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #include "EvaluationRun.h"
 
+#include "MapOutputs.h"
+#include "ProgressBar.h"
+
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 
@@ -8,7 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -108,11 +111,10 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
 void EvaluationRun::insertRawPoints(const mrpt::obs::CObservation& obs,
                                     const mrpt::poses::CPose3DPDFGaussian& robotPose) {
     multibin::sensors::SensorPoints sp;
-    multibin::InsertStats ignored;
     const auto& io = m_evaluated.insertionOptions;
     if (!multibin::sensors::observationToSensorPoints(obs, robotPose, m_rawSensorOptions,
                                                       io.min_range_m, io.max_range_m,
-                                                      m_rawSensorState, ignored, sp))
+                                                      m_rawSensorState, sp))
         return;
     const mrpt::poses::CPose3D sensorInMap = robotPose.mean + sp.sensorPose;
     std::vector<mrpt::math::TPoint3D> points(sp.points.size());
@@ -178,7 +180,7 @@ MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBin
     return m;
 }
 
-std::string EvaluationRun::finish(const std::string& outDir, double multibinInsert_s,
+std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert_s,
                                   double multibinFill_s) {
     m_laserOnly.flushLocalToGlobal();
 
@@ -213,7 +215,8 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
 
     if (m_mrf) {
         const auto t0 = Clock::now();
-        m_mrf->dem_update_map();  // one GMRF solve over the crop
+        // One GMRF solve over the crop (a minute or more).
+        ProgressBar::runWithProgress("MRF solve", [&] { m_mrf->dem_update_map(); });
         MethodEstimate mrf;
         mrf.name = "mrpt_height_grid_mrf";
         mrf.baseline = "raw_all";
@@ -232,21 +235,21 @@ std::string EvaluationRun::finish(const std::string& outDir, double multibinInse
         areas.push_back(
             multibin::eval::scoreArea("mrf_crop", m_truth, methods, m_lattice, m_mrfLattice));
 
-    const fs::path out = outDir;
-    {
-        std::ofstream f(out / "report.json");
-        f << multibin::eval::reportJson(scores, order, m_lattice, areas);
-        if (!f) throw std::runtime_error("cannot write '" + (out / "report.json").string() + "'");
-    }
-    rasterOf(m_lattice, m_truth).save((out / "eval_truth.asc").string());
-    for (const auto& m : methods)
-        rasterOf(m_lattice, m.height_m).save((out / ("eval_" + m.name + ".asc")).string());
-    writeProfile((out / "profile.csv").string(), m_truth, methods);
+    out.write("report.json", multibin::eval::reportJson(scores, order, m_lattice, areas));
+    auto saveRaster = [&](const std::string& name, const CellArray& values) {
+        out.writeWith(name, [&](const std::string& path) {
+            rasterOf(m_lattice, values).save(path);
+            return true;
+        });
+    };
+    saveRaster("eval_truth.asc", m_truth);
+    for (const auto& m : methods) saveRaster("eval_" + m.name + ".asc", m.height_m);
+    out.write("profile.csv", profileCsv(m_truth, methods));
     return multibin::eval::reportTable(scores, order, areas);
 }
 
-void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth,
-                                 const std::vector<MethodEstimate>& methods) const {
+std::string EvaluationRun::profileCsv(const CellArray& truth,
+                                      const std::vector<MethodEstimate>& methods) const {
     std::vector<double> line = m_options.profile_m;
     if (line.empty()) {
         const auto a = m_lattice.area_m();
@@ -263,7 +266,7 @@ void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth
     const MethodEstimate* filled = find("multibin_filled");
     const MethodEstimate* raw = find("raw_all");
 
-    std::ofstream f(path);
+    std::ostringstream f;
     f << "s_m,x_m,y_m,truth_m,multibin_m,multibin_sigma_m,filled_m,filled_sigma_m,raw_m\n";
     const double dx = line[2] - line[0], dy = line[3] - line[1];
     const double length_m = std::hypot(dx, dy);
@@ -282,5 +285,5 @@ void EvaluationRun::writeProfile(const std::string& path, const CellArray& truth
           << value(filled->height_m, r, c) << ',' << value(filled->sigma_m, r, c) << ','
           << value(raw->height_m, r, c) << '\n';
     }
-    if (!f) throw std::runtime_error("cannot write '" + path + "'");
+    return f.str();
 }

@@ -12,6 +12,8 @@
 #include "multibin/eval/Evaluation.h"
 #include "multibin/sensors/SensorDispatch.h"
 
+class OutputFolder;
+
 /** Builds, side by side and from the same points, the maps that `--ground-truth` compares:
  * - raw_laser, raw_all: the range points simply registered in the grid (eq 17's raw map), from
  *   the laser alone and from every sensor;
@@ -44,10 +46,10 @@ public:
     void observe(const mrpt::obs::CObservation& obs,
                  const mrpt::poses::CPose3DPDFGaussian& robotPose, bool poseHasCovariance);
 
-    /** Scores and writes report.json, profile.csv and the per-method rasters into outDir; returns
-     * the text table. The evaluated map must be filled already (dem_update_map()); its insertion
-     * and fill times [s] go into the report. */
-    std::string finish(const std::string& outDir, double multibinInsert_s, double multibinFill_s);
+    /** Scores and writes report.json, profile.csv and the per-method rasters eval_*.asc into the
+     * folder; returns the text table. The evaluated map must be filled already (dem_update_map());
+     * its insertion and fill times [s] go into the report. */
+    std::string finish(const OutputFolder& out, double multibinInsert_s, double multibinFill_s);
 
 private:
     void insertRawPoints(const mrpt::obs::CObservation& obs,
@@ -55,8 +57,9 @@ private:
     multibin::eval::MethodEstimate sampleMap(const std::string& name,
                                              const mrpt::maps::CMultiBinElevationMap& map,
                                              bool filled) const;
-    void writeProfile(const std::string& path, const multibin::eval::CellArray& truth,
-                      const std::vector<multibin::eval::MethodEstimate>& methods) const;
+    /** profile.csv: the profile line's samples of the truth and the maps. */
+    std::string profileCsv(const multibin::eval::CellArray& truth,
+                           const std::vector<multibin::eval::MethodEstimate>& methods) const;
 
     Options m_options;
     mrpt::maps::CMultiBinElevationMap& m_evaluated;

@@ -2,7 +2,6 @@
 #include "RawlogSource.h"
 
 #include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/io/CFileInputStream.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -11,32 +10,80 @@
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <cmath>
 #include <cstdio>
-
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
+
+#include "RawlogSourceGuard.h"
 #include "multibin/io/ErrorMessage.h"
 
 namespace {
-/** Uncompressed size of a file [bytes]: a gzip file's trailer holds it (mod 4 GiB). */
-uint64_t uncompressedSize(const std::string& path) {
+/** deflate expands at most 1032:1, so a gz file holds at most this many bytes per stored byte. */
+constexpr uint64_t kMaxDeflateRatio = 1032;
+
+struct FileSize {
+    uint64_t progress_bytes;  // uncompressed size for the progress bar (gz trailer, mod 4 GiB)
+    uint64_t bound_bytes;     // an upper bound on the uncompressed bytes (for the read budget)
+};
+
+FileSize fileSize(const std::string& path) {
     std::ifstream f(path, std::ios::binary);
     if (!f) throw std::runtime_error("cannot open '" + path + "'");
     unsigned char magic[2] = {0, 0};
     f.read(reinterpret_cast<char*>(magic), 2);
+    f.clear();
     f.seekg(0, std::ios::end);
     const auto size = static_cast<uint64_t>(f.tellg());
-    if (magic[0] != 0x1f || magic[1] != 0x8b || size < 18) return size;
+    if (magic[0] != 0x1f || magic[1] != 0x8b || size < 18) return {size, size};
     unsigned char t[4];
     f.seekg(-4, std::ios::end);
     f.read(reinterpret_cast<char*>(t), 4);
-    return uint64_t(t[0]) | uint64_t(t[1]) << 8 | uint64_t(t[2]) << 16 | uint64_t(t[3]) << 24;
+    return {uint64_t(t[0]) | uint64_t(t[1]) << 8 | uint64_t(t[2]) << 16 | uint64_t(t[3]) << 24,
+            size * kMaxDeflateRatio};
 }
 
 void openOrThrow(mrpt::io::CFileGZInputStream& in, const std::string& path,
                  const std::string& what) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::is_directory(path, ec))
+        throw std::runtime_error(what + " '" + path + "' is a directory, not a file");
     if (!std::ifstream(path).good()) throw std::runtime_error(what + " '" + path + "' not found");
     if (!in.open(path)) throw std::runtime_error("cannot open " + what + " '" + path + "'");
+}
+
+std::string gigabytes(uint64_t bytes) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.3g GB", double(bytes) * 1e-9);
+    return b;
+}
+
+/** Reads one object under the read budget; a refused allocation becomes an error saying so
+ * (built after the budget ends: the budget is spent by then). */
+mrpt::serialization::CSerializable::Ptr readBounded(mrpt::serialization::CArchive& arch,
+                                                    uint64_t bytesLeft, const std::string& where) {
+    uint64_t asked = 0;
+    {
+        ReadBudget budget(ReadBudget::limitFor(bytesLeft));
+        try {
+            return arch.ReadObject();
+        } catch (const std::exception&) {
+            asked = ReadBudget::largestRefused();
+            if (asked == 0) throw;
+        }
+    }
+    throw std::runtime_error(where +
+                             " declares more data than the file holds: reading it asked for " +
+                             gigabytes(asked) + " in all, more than 64 MiB + 16 x the " +
+                             std::to_string(bytesLeft) + " bytes left");
+}
+
+bool finitePose(const mrpt::poses::CPose3D& p) {
+    for (int i = 0; i < 6; i++)
+        if (!std::isfinite(p[i])) return false;
+    return true;
 }
 }  // namespace
 
@@ -44,52 +91,108 @@ size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& vis
                                      const Progress& progress) {
     mrpt::io::CFileGZInputStream in;
     openOrThrow(in, path, "rawlog");
-    const double total = std::max<double>(1.0, double(uncompressedSize(path)));
-    auto arch = mrpt::serialization::archiveFrom(in);
+    const FileSize size = fileSize(path);
+    const double total = std::max<double>(1.0, double(size.progress_bytes));
+    return forEachInStream(in, "rawlog '" + path + "'", size.bound_bytes, visit,
+                           [&](double, size_t n) {
+                               if (progress) progress(double(in.getPosition()) / total, n);
+                           });
+}
 
+size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& name,
+                                     uint64_t sizeBound_bytes, const Visitor& visit,
+                                     const Progress& progress) {
+    auto arch = mrpt::serialization::archiveFrom(in);
+    const uint64_t start = in.getPosition();
     mrpt::poses::CPose3DPDFGaussian pose;  // latest CObservationRobotPose, or odometry
     bool poseHasCov = false;
     mrpt::poses::CPose3D odometry;
+    size_t entries = 0;
+    auto entryName = [&] { return name + ": entry " + std::to_string(entries); };
     auto visitObs = [&](const mrpt::obs::CObservation::Ptr& obs) {
         if (const auto rp = std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(obs)) {
+            if (!finitePose(rp->pose.mean))
+                throw std::runtime_error(entryName() + ": robot pose '" + rp->sensorLabel +
+                                         "' is not finite");
             pose = rp->pose;
             poseHasCov = true;
         }
-        visit(obs, pose, poseHasCov);
+        try {
+            visit(obs, pose, poseHasCov);
+        } catch (const std::exception& e) {
+            throw std::runtime_error(entryName() + ": " + multibin::oneLineMessage(e));
+        }
     };
-    size_t entries = 0;
-    for (;;) {
+    for (;; entries++) {
         mrpt::serialization::CSerializable::Ptr obj;
         const uint64_t entryStart = in.getPosition();
+        const uint64_t read = entryStart - start;
         try {
-            obj = arch.ReadObject();
-        } catch (const mrpt::serialization::CExceptionEOF& e) {
+            obj =
+                readBounded(arch, sizeBound_bytes > read ? sizeBound_bytes - read : 0, entryName());
+        } catch (const mrpt::serialization::CExceptionEOF&) {
             if (in.getPosition() == entryStart) break;  // clean end, between two entries
-            throw std::runtime_error("rawlog '" + path + "' is truncated inside entry " +
+            throw std::runtime_error(name + " is truncated inside entry " +
                                      std::to_string(entries));
+        } catch (const std::runtime_error& e) {
+            if (ReadBudget::largestRefused() > 0) throw;  // already names the entry
+            throw std::runtime_error(name + " is truncated or corrupt at entry " +
+                                     std::to_string(entries) + ": " + multibin::oneLineMessage(e));
         } catch (const std::exception& e) {
-            throw std::runtime_error("rawlog '" + path + "' is truncated or corrupt at entry " +
+            throw std::runtime_error(name + " is truncated or corrupt at entry " +
                                      std::to_string(entries) + ": " + multibin::oneLineMessage(e));
         }
-        entries++;
+        if (!obj) throw std::runtime_error(entryName() + " is empty (a null object)");
         if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
+            size_t k = 0;
+            for (const auto& obs : *sf) {
+                if (!obs)
+                    throw std::runtime_error(entryName() + " (a sensory frame): observation " +
+                                             std::to_string(k) +
+                                             " is null or an object that is not an observation");
+                k++;
+            }
             for (const auto& obs : *sf) visitObs(obs);
         } else if (auto obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj)) {
             visitObs(obs);
         } else if (auto acts = std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj)) {
-            // Odometry, used only while no CObservationRobotPose has been seen.
-            if (auto a3 = acts->getBestMovementEstimation(); a3) {
-                odometry = odometry + mrpt::poses::CPose3D(a3->poseChange->getMeanVal());
-            } else if (auto m3 = acts->getActionByClass<mrpt::obs::CActionRobotMovement3D>()) {
-                odometry = odometry + m3->poseChange.mean;
+            size_t k = 0;
+            for (const auto& a : *acts) {
+                if (!a.get())
+                    throw std::runtime_error(entryName() + " (an action collection): action " +
+                                             std::to_string(k) +
+                                             " is null or an object that is not an action");
+                if (const auto* m2 =
+                        dynamic_cast<const mrpt::obs::CActionRobotMovement2D*>(a.get());
+                    m2 && !m2->poseChange.get())
+                    throw std::runtime_error(entryName() + ": action " + std::to_string(k) +
+                                             " (2D odometry) has no pose change");
+                k++;
             }
+            // Odometry, used only while no CObservationRobotPose has been seen.
+            mrpt::poses::CPose3D step;
+            bool haveStep = false;
+            // MRPT's best estimate compares covariances: none when they are NaN.
+            auto a2 = acts->getBestMovementEstimation();
+            if (!a2) a2 = acts->getActionByClass<mrpt::obs::CActionRobotMovement2D>();
+            if (a2) {
+                step = mrpt::poses::CPose3D(a2->poseChange->getMeanVal());
+                haveStep = true;
+            } else if (auto m3 = acts->getActionByClass<mrpt::obs::CActionRobotMovement3D>()) {
+                step = m3->poseChange.mean;
+                haveStep = true;
+            }
+            if (haveStep && !finitePose(step))
+                throw std::runtime_error(entryName() +
+                                         " (an action collection): the odometry "
+                                         "is not finite");
+            if (haveStep) odometry = odometry + step;
             if (!poseHasCov) pose.mean = odometry;
-        } else if (obj) {
-            throw std::runtime_error("rawlog '" + path + "': entry " + std::to_string(entries - 1) +
-                                     " is a " + obj->GetRuntimeClass()->className +
+        } else {
+            throw std::runtime_error(entryName() + " is a " + obj->GetRuntimeClass()->className +
                                      ", not an observation, sensory frame or action");
         }
-        if (progress) progress(double(in.getPosition()) / total, entries);
+        if (progress) progress(0.0, entries + 1);
     }
     return entries;
 }
@@ -97,13 +200,44 @@ size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& vis
 mrpt::maps::CSimpleMap RawlogSource::loadSimplemap(const std::string& path) {
     mrpt::io::CFileGZInputStream in;
     openOrThrow(in, path, "simplemap");
+    return readSimplemap(in, "simplemap '" + path + "'", fileSize(path).bound_bytes);
+}
+
+mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const std::string& name,
+                                                   uint64_t sizeBound_bytes) {
     mrpt::maps::CSimpleMap sm;
+    uint64_t asked = 0;
     try {
-        auto arch = mrpt::serialization::archiveFrom(in);
-        arch >> sm;
+        ReadBudget budget(ReadBudget::limitFor(sizeBound_bytes));
+        try {
+            auto arch = mrpt::serialization::archiveFrom(in);
+            arch >> sm;
+        } catch (const std::exception&) {
+            asked = ReadBudget::largestRefused();
+            if (asked == 0) throw;
+        }
     } catch (const std::exception& e) {
-        throw std::runtime_error("simplemap '" + path +
-                                 "' is truncated or corrupt: " + multibin::oneLineMessage(e));
+        throw std::runtime_error(name + " is truncated or corrupt: " + multibin::oneLineMessage(e));
+    }
+    if (asked > 0)
+        throw std::runtime_error(name +
+                                 " declares more data than the file holds: reading it asked for " +
+                                 gigabytes(asked) + " in all, more than 64 MiB + 16 x its " +
+                                 std::to_string(sizeBound_bytes) + " bytes");
+    for (size_t i = 0; i < sm.size(); i++) {
+        const auto& [posePdf, sf] = sm.get(i);
+        const std::string where = name + ": keyframe " + std::to_string(i);
+        if (!posePdf) throw std::runtime_error(where + " has no pose (null or not a 3D pose PDF)");
+        if (!sf) throw std::runtime_error(where + " has no sensory frame (null or another class)");
+        size_t k = 0;
+        for (const auto& obs : *sf) {
+            if (!obs)
+                throw std::runtime_error(where + ": observation " + std::to_string(k) +
+                                         " is null or an object that is not an observation");
+            k++;
+        }
+        if (!finitePose(posePdf->getMeanVal()))
+            throw std::runtime_error(where + ": the pose is not finite");
     }
     return sm;
 }

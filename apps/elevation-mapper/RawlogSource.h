@@ -1,10 +1,12 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #pragma once
 
+#include <mrpt/io/CStream.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CObservation.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -12,10 +14,16 @@
 /** Streams the observations of a rawlog (either format: actions + sensory frames, or
  * observations only), each with the robot pose PDF it was taken at: the latest
  * CObservationRobotPose (mean and covariance), else the odometry of the actions composed from the
- * origin (mean only). */
+ * origin (mean only).
+ *
+ * Every entry is checked before use: a null entry, an object of another class, a null action or
+ * odometry PDF, a non-finite odometry are errors naming the file and the entry. Reading an entry
+ * may request at most ReadBudget::limitFor(bytes left in the file) in one allocation
+ * (RawlogSourceGuard.h), so a file that declares more objects or beams than it holds is refused
+ * before the memory is taken. */
 class RawlogSource {
 public:
-    /** obs, the pose PDF, whether the PDF carries a covariance (false: mean only). */
+    /** obs (never null), the pose PDF, whether the PDF carries a covariance (false: mean only). */
     using Visitor = std::function<void(const mrpt::obs::CObservation::Ptr& obs,
                                        const mrpt::poses::CPose3DPDFGaussian& robotPose,
                                        bool poseHasCovariance)>;
@@ -23,10 +31,21 @@ public:
     using Progress = std::function<void(double fraction, size_t entries)>;
 
     /** Reads the whole rawlog; throws std::runtime_error naming the file and the entry on a
-     * truncated or corrupt file. Returns the number of entries read. */
+     * truncated, corrupt or hostile file, and on an error of `visit` (prefixed with the file and
+     * the entry). Returns the number of entries read. */
     static size_t forEachInRawlog(const std::string& path, const Visitor& visit,
                                   const Progress& progress);
+    /** The same on an open stream of uncompressed rawlog bytes; `name` names it in errors,
+     * `sizeBound_bytes` bounds the bytes it holds from its current position. */
+    static size_t forEachInStream(mrpt::io::CStream& in, const std::string& name,
+                                  uint64_t sizeBound_bytes, const Visitor& visit,
+                                  const Progress& progress);
+
     /** Loads a simplemap file (gz-compressed or not); throws std::runtime_error naming the file
-     * if it is missing, truncated or corrupt. */
+     * (and the keyframe) if it is missing, truncated, corrupt or holds a null keyframe pose,
+     * sensory frame or observation. */
     static mrpt::maps::CSimpleMap loadSimplemap(const std::string& path);
+    /** The same on an open stream (see forEachInStream). */
+    static mrpt::maps::CSimpleMap readSimplemap(mrpt::io::CStream& in, const std::string& name,
+                                                uint64_t sizeBound_bytes);
 };

@@ -1,18 +1,15 @@
 /* Part of the multibin elevation-mapping library.
  *
  * elevation-mapper: builds a CMultiBinElevationMap from a rawlog or a simplemap and writes the
- * serialized map, images, rasters, a mesh and a .3Dscene; with --ground-truth it also evaluates
- * the map side by side with its baselines and MRPT's height maps (report.json and figures).
+ * outputs chosen with --outputs (serialized map, float TIFF, .3Dscene, PNG previews; ESRI ASCII
+ * rasters and a PLY mesh on request); with --ground-truth it also evaluates the map side by side
+ * with its baselines and MRPT's height maps (report.json and figures). `--help` lists the options.
  *
- *   elevation-mapper --config INI (--rawlog FILE | --simplemap FILE) --out DIR
- *                    [--ground-truth GT.asc [--with-mrf] [--profile x0,y0,x1,y1]
- *                     [--eval-area xmin,xmax,ymin,ymax]] [--no-plots]
- *
- * The ini file has the maps in section [MappingApplication], as MRPT's observations2map reads
- * them, so one file serves both programs. With no arguments it runs on the shipped default data. */
+ * The ini file has the maps in a section ([MappingApplication] unless --section), as MRPT's
+ * observations2map reads them, so one file serves both programs. With no arguments it runs on the
+ * shipped default data. */
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/img/CImage.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/serialization/CArchive.h>
@@ -30,7 +27,11 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "EvaluationRun.h"
+#include "MapOutputs.h"
+#include "ObservationTally.h"
 #include "ProgressBar.h"
 #include "RawlogSource.h"
 #include "multibin/fill/HeightRaster.h"
@@ -42,33 +43,60 @@ using mrpt::maps::CMultiBinElevationMap;
 
 namespace {
 
-constexpr const char* kMapsSection = "MappingApplication";
-
 struct Arguments {
-    std::string config, rawlog, simplemap, out, groundTruth, profile, evalArea;
+    std::string config, section = "MappingApplication", rawlog, simplemap,
+                        out = "elevation-mapper-out", groundTruth, profile, evalArea,
+                        outputs = OutputSelection::kDefault, sceneColour;
     bool withMrf = false, plots = true;
     bool usedDefaults = false;
 };
 
 void printUsage() {
+    const Arguments d;
     std::cout
-        << "Usage: elevation-mapper --config INI (--rawlog FILE | --simplemap FILE) --out DIR\n"
-           "                        [--ground-truth GT.asc [--with-mrf] [--profile x0,y0,x1,y1]\n"
-           "                         [--eval-area xmin,xmax,ymin,ymax]] [--no-plots]\n"
-           "       elevation-mapper            (runs on the shipped default data)\n\n"
-           "Builds a multi-bin elevation map (gaps filled) and writes to DIR: elevation_map.bin\n"
-           "(serialized map, gz), elevation_height.png, elevation_sigma.png, ESRI ASCII rasters\n"
-           "elevation_{height,sigma,certainty,source}.asc, elevation_height.tif (float32 TIFF),\n"
-           "elevation.ply (mesh) and elevation.3Dscene.\n"
-           "With --ground-truth it evaluates raw, laser_only, multibin, multibin_filled and\n"
-           "mrpt_height_grid (and mrpt_height_grid_mrf with --with-mrf, on a crop of 35 x 35\n"
-           "cells) over the truth's area (or the part of it inside --eval-area [m]) and writes\n"
-           "report.json, profile.csv and, unless\n"
-           "--no-plots, figures drawn by matplotlib (fig_pi.png, fig_profile.png, layers.png).\n"
-           "The ini file lists the maps in section ["
-        << kMapsSection
-        << "], as observations2map\n"
-           "reads them (multiBinElevationMap_count = 1, ...).\n";
+        << "Usage: elevation-mapper --config INI (--rawlog FILE | --simplemap FILE) [options]\n"
+           "       elevation-mapper            (no arguments: maps the shipped mock-up scenario)\n"
+           "\n"
+           "Builds a multi-bin elevation map, fills its gaps and writes the chosen outputs.\n"
+           "\n"
+           "Input:\n"
+           "  --config INI         ini file with the maps, as MRPT's observations2map reads it\n"
+           "                       (multiBinElevationMap_count = 1, ...); required\n"
+           "  -s, --section NAME   the ini section that lists the maps (default: "
+        << d.section
+        << ")\n"
+           "  --rawlog FILE        a rawlog (either format); robot poses from\n"
+           "                       CObservationRobotPose, else odometry\n"
+           "  --simplemap FILE     a simplemap (.simplemap or .simplemap.gz) with pose PDFs\n"
+           "                       (give exactly one of --rawlog and --simplemap)\n"
+           "Output:\n"
+           "  --out DIR            output folder, created if needed (default: "
+        << d.out
+        << ")\n"
+           "  --outputs LIST       comma-separated, or 'all' (default: "
+        << d.outputs << ")\n"
+        << OutputSelection::help()
+        << "  --scene-colour NAME  colour of elevation.3Dscene: height, sigma, certainty or\n"
+           "                       source (default: height; sigma if the ini sets\n"
+           "                       color_by_sigma = true)\n"
+           "                       Rasters cover the known cells plus "
+        << MapLayers::kMargin_cells
+        << " cells. No input is ever\n"
+           "                       overwritten; each file is written whole or not at all.\n"
+           "Evaluation (all off by default):\n"
+           "  --ground-truth GT.asc  evaluate against a truth raster: raw, laser_only, multibin,\n"
+           "                       multibin_filled, mrpt_height_grid; writes report.json,\n"
+           "                       profile.csv, eval_*.asc and the figures fig_pi.png,\n"
+           "                       fig_profile.png, layers.png (python3-matplotlib)\n"
+           "  --with-mrf           also MRPT's CHeightGridMap2D_MRF on a 35 x 35 cell crop (slow)\n"
+           "  --profile x0,y0,x1,y1  profile line of fig_profile.png [m] (default: along x\n"
+           "                       through the middle of the evaluated area)\n"
+           "  --eval-area xmin,xmax,ymin,ymax  evaluate only there [m] (default: the whole truth)\n"
+           "  --no-plots           do not draw the figures (default: drawn)\n"
+           "  -h, --help           this text\n"
+           "\n"
+           "Exit code 0 on success; 1 with a one-line error (naming the file) on bad input, or\n"
+           "when no point could be fused (the per-class report says why).\n";
 }
 
 Arguments parseArguments(int argc, char** argv) {
@@ -78,17 +106,14 @@ Arguments parseArguments(int argc, char** argv) {
         a.config = (src / "ini" / "mockup.ini").string();
         a.rawlog = (src / "rawlogs" / "mockup.rawlog").string();
         a.groundTruth = (src / "rawlogs" / "mockup_gt.asc").string();
-        a.out = "elevation-mapper-out";
         a.usedDefaults = true;
         return a;
     }
-    std::map<std::string, std::string*> flags{{"--config", &a.config},
-                                              {"--rawlog", &a.rawlog},
-                                              {"--simplemap", &a.simplemap},
-                                              {"--out", &a.out},
-                                              {"--ground-truth", &a.groundTruth},
-                                              {"--profile", &a.profile},
-                                              {"--eval-area", &a.evalArea}};
+    std::map<std::string, std::string*> flags{
+        {"--config", &a.config},      {"--section", &a.section},          {"-s", &a.section},
+        {"--rawlog", &a.rawlog},      {"--simplemap", &a.simplemap},      {"--out", &a.out},
+        {"--outputs", &a.outputs},    {"--ground-truth", &a.groundTruth}, {"--profile", &a.profile},
+        {"--eval-area", &a.evalArea}, {"--scene-colour", &a.sceneColour}};
     for (int i = 1; i < argc; i++) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
@@ -104,14 +129,16 @@ Arguments parseArguments(int argc, char** argv) {
             continue;
         }
         const auto it = flags.find(arg);
-        if (it == flags.end()) throw std::invalid_argument("unknown argument '" + arg + "'");
+        if (it == flags.end())
+            throw std::invalid_argument("unknown argument '" + arg + "' (see --help)");
         if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
         *it->second = argv[++i];
     }
     if (a.config.empty()) throw std::invalid_argument("--config INI is required");
     if (a.rawlog.empty() == a.simplemap.empty())
         throw std::invalid_argument("give exactly one of --rawlog FILE and --simplemap FILE");
-    if (a.out.empty()) throw std::invalid_argument("--out DIR is required");
+    if (a.out.empty()) throw std::invalid_argument("--out needs a folder");
+    if (a.section.empty()) throw std::invalid_argument("--section needs a name");
     if (a.groundTruth.empty() && (a.withMrf || !a.profile.empty() || !a.evalArea.empty()))
         throw std::invalid_argument("--with-mrf, --profile and --eval-area need --ground-truth");
     return a;
@@ -136,9 +163,10 @@ std::string plotScript() {
     return {};
 }
 
-/** Draws the figures with Debian's python3-matplotlib; a missing plotter is a warning, not an
- * error (every number is in report.json and the rasters). */
-void drawFigures(const fs::path& out) {
+/** Draws the figures with Debian's python3-matplotlib into `out`, the layer panels from the
+ * rasters in `rasterDir`; a missing plotter is a warning, not an error (every number is in
+ * report.json and the rasters). */
+void drawFigures(const fs::path& out, const fs::path& rasterDir) {
     const std::string script = plotScript();
     const std::string python = "/usr/bin/python3";
     if (script.empty() || !fs::exists(python)) {
@@ -146,10 +174,16 @@ void drawFigures(const fs::path& out) {
                   << " with python3-matplotlib and plot_report.py)\n";
         return;
     }
-    const std::string cmd = python + " '" + script + "' '" + out.string() + "'";
+    const std::string cmd =
+        python + " '" + script + "' '" + out.string() + "' '" + rasterDir.string() + "' >/dev/null";
     std::cout.flush();
-    if (std::system(cmd.c_str()) != 0)
+    int rc = 0;
+    ProgressBar::runWithProgress("figures", [&] { rc = std::system(cmd.c_str()); });
+    if (rc != 0)
         std::cerr << "elevation-mapper: warning: figures not drawn: '" << cmd << "' failed\n";
+    else
+        std::cout << "figures: " << (out / "fig_pi.png").string() << ", fig_profile.png, "
+                  << "layers.png\n";
 }
 
 /** Four comma-separated numbers given to `flag` (e.g. "--profile"), or none for empty text. */
@@ -169,17 +203,47 @@ std::vector<double> parseFourNumbers(const std::string& flag, const std::string&
     return v;
 }
 
+/** The files of the evaluation (EvaluationRun and the figures); '*' ends a prefix. */
+const std::vector<std::string> kEvaluationFiles{"report.json", "profile.csv",     "eval_*",
+                                                "fig_pi.png",  "fig_profile.png", "layers.png"};
+
 int run(const Arguments& args) {
+    OutputSelection selection = OutputSelection::parse(args.outputs);
+    const std::string inputName =
+        args.rawlog.empty() ? "simplemap '" + args.simplemap + "'" : "rawlog '" + args.rawlog + "'";
+    // Checked before the (long) mapping: no planned output may be one of the inputs.
+    const OutputFolder folder(args.out, {{"--config", args.config},
+                                         {"--rawlog", args.rawlog},
+                                         {"--simplemap", args.simplemap},
+                                         {"--ground-truth", args.groundTruth}});
+    for (const std::string& name : selection.fileNames()) folder.checkNotAnInput(name);
+    if (!args.groundTruth.empty())
+        for (const std::string& name : kEvaluationFiles) folder.checkNotAnInput(name);
+
     if (!fs::exists(args.config))
         throw std::runtime_error("config '" + args.config + "' not found");
+    if (fs::is_directory(args.config))
+        throw std::runtime_error("config '" + args.config + "' is a directory, not a file");
     mrpt::config::CConfigFile ini(args.config);
     mrpt::maps::TSetOfMetricMapInitializers inits;
-    inits.loadFromConfigFile(ini, kMapsSection);
+    inits.loadFromConfigFile(ini, args.section);
     mrpt::maps::CMultiMetricMap maps(inits);
     const auto elevation = maps.mapByClass<CMultiBinElevationMap>();
     if (!elevation)
         throw std::runtime_error("config '" + args.config +
-                                 "' defines no multiBinElevationMap in [" + kMapsSection + "]");
+                                 "' defines no multiBinElevationMap in [" + args.section +
+                                 "] (choose the section with --section)");
+
+    selection.sceneColouring = elevation->insertionOptions.color_by_sigma
+                                   ? multibin::SceneColouring::Sigma
+                                   : multibin::SceneColouring::Height;
+    if (!args.sceneColour.empty()) {
+        try {
+            selection.sceneColouring = multibin::sceneColouringFromName(args.sceneColour);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(std::string("--scene-colour: ") + e.what());
+        }
+    }
 
     std::unique_ptr<EvaluationRun> evaluation;
     if (!args.groundTruth.empty()) {
@@ -193,14 +257,15 @@ int run(const Arguments& args) {
 
     using Clock = std::chrono::steady_clock;
     double insert_s = 0;  // the multi-bin map's own insertion time
+    ObservationTally tally;
     auto insertTimed = [&](const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& pose, bool poseHasCov) {
+        tally.before(*elevation);
         const auto t0 = Clock::now();
-        if (poseHasCov)
-            elevation->insertObservation(obs, pose);
-        else
-            elevation->insertObservation(obs, pose.mean);
+        const bool inserted = poseHasCov ? elevation->insertObservation(obs, pose)
+                                         : elevation->insertObservation(obs, pose.mean);
         insert_s += std::chrono::duration<double>(Clock::now() - t0).count();
+        tally.after(obs, inserted, *elevation);
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
     ProgressBar bar("mapping");
@@ -231,23 +296,19 @@ int run(const Arguments& args) {
             });
     }
     bar.finish("done");
+    std::cout << tally.report();
+    if (elevation->insertStats().accepted == 0)
+        throw std::runtime_error(inputName + ": " +
+                                 tally.whyNothingFused(elevation->insertStats()));
 
-    fs::create_directories(args.out);
-    const fs::path out = args.out;
     elevation->flushLocalToGlobal();  // dual grid: the global grid holds the whole run
     const auto fill0 = Clock::now();
-    elevation->dem_update_map();  // gap filling, once
+    ProgressBar::runWithProgress("filling", [&] { elevation->dem_update_map(); });  // once
     const double fill_s = std::chrono::duration<double>(Clock::now() - fill0).count();
     std::string table;
-    if (evaluation) table = evaluation->finish(out.string(), insert_s, fill_s);
-    {
-        mrpt::io::CFileGZOutputStream f;
-        if (!f.open((out / "elevation_map.bin").string()))
-            throw std::runtime_error("cannot write '" + (out / "elevation_map.bin").string() + "'");
-        auto arch = mrpt::serialization::archiveFrom(f);
-        arch << *elevation;
-    }
-    elevation->saveMetricMapRepresentationToFile((out / "elevation").string());
+    if (evaluation) table = evaluation->finish(folder, insert_s, fill_s);
+    const MapLayers layers = MapLayers::of(*elevation);
+    const std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
 
     const auto& fs_ = elevation->lastFill().stats;
     std::cout << elevation->asString() << "\n"
@@ -258,12 +319,26 @@ int run(const Arguments& args) {
               << " by Gaussian surface (" << fs_.supportAreas << " support areas); " << fs_.unfilled
               << " left unknown\n"
               << "insertion time: " << insert_s << " s; fill time: " << fill_s << " s\n"
-              << "wrote " << fs::absolute(out).string()
-              << "/{elevation_map.bin, elevation_height.png, elevation_sigma.png, "
-                 "elevation_*.asc, elevation_height.tif, elevation.ply, elevation.3Dscene}\n";
+              << "rasters: " << layers.height.cols() << " x " << layers.height.rows()
+              << " cells (the known cells plus " << MapLayers::kMargin_cells << ")\n"
+              << "wrote " << fs::absolute(folder.dir()).string() << "/{";
+    for (size_t i = 0; i < written.size(); i++) std::cout << (i ? ", " : "") << written[i];
+    std::cout << "}\n";
     if (evaluation) {
         std::cout << "\nEvaluation against " << args.groundTruth << " (report.json):\n" << table;
-        if (args.plots) drawFigures(out);
+        if (args.plots) {
+            if (selection.asc) {
+                drawFigures(folder.dir(), folder.dir());
+            } else {  // the layer panels read the ESRI ASCII rasters: a scratch copy
+                const fs::path scratch = fs::temp_directory_path() /
+                                         ("elevation-mapper-layers-" + std::to_string(::getpid()));
+                const OutputFolder scratchFolder(scratch, {});
+                layers.saveAsc(scratchFolder);
+                drawFigures(folder.dir(), scratch);
+                std::error_code ec;
+                fs::remove_all(scratch, ec);
+            }
+        }
     }
     return 0;
 }

@@ -1,10 +1,10 @@
 #!/usr/bin/python3
 """Draws elevation-mapper's evaluation figures with matplotlib (Debian: python3-matplotlib).
 
-Usage: plot_report.py DIR
+Usage: plot_report.py DIR [RASTER_DIR]
 
-Reads DIR/report.json, DIR/profile.csv and the rasters DIR/elevation_*.asc that elevation-mapper
-wrote, and writes:
+Reads DIR/report.json, DIR/profile.csv and the rasters elevation_*.asc that elevation-mapper
+wrote (in RASTER_DIR, default DIR), and writes:
   DIR/fig_pi.png       the paper's Fig. 8: Performance Index (eq 17) per method, bars
   DIR/fig_profile.png  the paper's Fig. 3: a height profile with the +-3 sigma band and the truth
   DIR/layers.png       height, sigma, certainty and filled cells of the map, with colour bars
@@ -46,10 +46,17 @@ def plot_pi(report, out):
         names.append(name)
         values.append(m["pi"])
     fig, ax = plt.subplots(figsize=(7, 4))
-    bars = ax.bar(range(len(names)), values, color="tab:blue")
+    # The reference line passes behind the bars, and each value is written inside its bar's top,
+    # so no label crosses the line whatever the values.
+    ax.axhline(1.0, color="k", lw=0.8, ls="--", label="raw map (PI = 1)", zorder=1)
+    bars = ax.bar(range(len(names)), values, color="tab:blue", zorder=2)
+    top = max(values + [1.0])
     for b, v in zip(bars, values):
-        ax.text(b.get_x() + b.get_width() / 2, v, f"{v:.3f}", ha="center", va="bottom")
-    ax.axhline(1.0, color="k", lw=0.8, ls="--", label="raw map (PI = 1)")
+        inside = v > 0.12 * top
+        ax.text(b.get_x() + b.get_width() / 2, v - 0.02 * top if inside else v + 0.02 * top,
+                f"{v:.3f}", ha="center", va="top" if inside else "bottom",
+                color="white" if inside else "black", fontsize=9, zorder=3)
+    ax.set_ylim(0, 1.2 * top)
     ax.set_xticks(range(len(names)))
     ax.set_xticklabels(names, rotation=20, ha="right")
     ax.set_ylabel("Performance Index (eq 17), lower is better")
@@ -89,10 +96,19 @@ def plot_profile(path, out):
     plt.close(fig)
 
 
+# Categories of the source layer (CMultiBinElevationMap::HeightSource) and their colours, the
+# same as elevation_source.png's.
+SOURCES = [(1, "measured", "tab:blue"), (2, "filled: median", "tab:orange"),
+           (3, "filled: surface", "tab:green")]
+UNKNOWN_GREY = (200 / 255, 200 / 255, 200 / 255)
+
+
 def plot_layers(directory, out):
-    layers = [("height", "height [m]", "viridis"), ("sigma", "sigma [m]", "magma"),
-              ("certainty", "certainty c [-]", "cividis"),
-              ("source", "1 measured, 2 median, 3 surface", "Set1")]
+    from matplotlib.colors import BoundaryNorm, ListedColormap
+    from matplotlib.patches import Patch
+
+    layers = [("height", "height [m]", "viridis"), ("sigma", "sigma [m]", "inferno"),
+              ("certainty", "certainty c [-]", "cividis"), ("source", None, None)]
     fig, axes = plt.subplots(2, 2, figsize=(10, 9))
     for ax, (name, label, cmap) in zip(axes.flat, layers):
         path = os.path.join(directory, f"elevation_{name}.asc")
@@ -100,10 +116,20 @@ def plot_layers(directory, out):
             ax.set_axis_off()
             continue
         data, extent = load_asc(path)
-        kwargs = {"vmin": 1, "vmax": 3} if name == "source" else {}
-        im = ax.imshow(data, extent=extent, origin="upper", cmap=cmap, interpolation="nearest",
-                       **kwargs)
-        fig.colorbar(im, ax=ax, label=label, shrink=0.8)
+        ax.set_facecolor(UNKNOWN_GREY)  # NaN cells are not drawn: unknown shows grey
+        if name == "source":  # categorical: a legend, not a colour bar
+            cmap = ListedColormap([c for _, _, c in SOURCES])
+            norm = BoundaryNorm([0.5, 1.5, 2.5, 3.5], cmap.N)
+            ax.imshow(data, extent=extent, origin="upper", cmap=cmap, norm=norm,
+                      interpolation="nearest")
+            handles = [Patch(color=c, label=n) for _, n, c in SOURCES]
+            handles.append(Patch(facecolor=UNKNOWN_GREY, edgecolor="k", label="unknown"))
+            ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.02, 1.0),
+                      fontsize=8, title="source of the height", title_fontsize=8)
+        else:
+            im = ax.imshow(data, extent=extent, origin="upper", cmap=cmap,
+                           interpolation="nearest")
+            fig.colorbar(im, ax=ax, label=label + " (grey: unknown)", shrink=0.8)
         ax.set_title(name)
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
@@ -113,14 +139,15 @@ def plot_layers(directory, out):
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
     d = sys.argv[1]
+    rasters = sys.argv[2] if len(sys.argv) == 3 else d
     with open(os.path.join(d, "report.json")) as f:
         report = json.load(f)
     plot_pi(report, os.path.join(d, "fig_pi.png"))
     plot_profile(os.path.join(d, "profile.csv"), os.path.join(d, "fig_profile.png"))
-    plot_layers(d, os.path.join(d, "layers.png"))
+    plot_layers(rasters, os.path.join(d, "layers.png"))
     print(f"figures: {d}/fig_pi.png, {d}/fig_profile.png, {d}/layers.png")
 
 

@@ -362,11 +362,9 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
             if (!twoSteps->acceptsLabel(obs->sensorLabel)) continue;
             obs->load();
             const auto& io = twoSteps->insertionOptions;
-            InsertStats sensorStats;
             multibin::sensors::SensorPoints sensed;
             if (!multibin::sensors::observationToSensorPoints(*obs, pdf, io.sensors, io.min_range_m,
-                                                              io.max_range_m, state, sensorStats,
-                                                              sensed) ||
+                                                              io.max_range_m, state, sensed) ||
                 sensed.points.empty())
                 continue;
             observations++;
@@ -381,8 +379,7 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
             // path was never taken when the window had to grow.
             multibin::sensors::SensorPoints again;
             ASSERT_TRUE(multibin::sensors::observationToSensorPoints(
-                *obs, pdf, io.sensors, io.min_range_m, io.max_range_m, growingState, sensorStats,
-                again));
+                *obs, pdf, io.sensors, io.min_range_m, io.max_range_m, growingState, again));
             propagator.apply(again.points, mapPoints);
             const BinGrid& g = growing->grid();
             const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();

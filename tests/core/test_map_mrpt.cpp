@@ -337,7 +337,7 @@ TEST(StrictConfigSection, ReadChoiceTakesOnlyTheListedWords) {
         ADD_FAILURE() << "no exception";
     } catch (const std::invalid_argument& e) {
         EXPECT_STREQ(e.what(),
-                     "ini section [s], key 'bad': expected jet, hot or grayscale, got 'warm'");
+                     "ini section 's', key 'bad': expected jet, hot or grayscale, got 'warm'");
     }
     EXPECT_EQ(mode, Mode::Hot);
 }

@@ -78,3 +78,20 @@ TEST(CellSurface, OtherSurfacesInTheCellAddTheirCertaintyWeightedSpreadToSigma) 
     ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
     EXPECT_NEAR(s * s, kalman2, 1e-9);
 }
+
+TEST(CellSurface, EveryLayerDescribesTheSameSurface) {
+    // Six points of one surface at a bin boundary, three in bin 0 and three in bin 1: the height
+    // and sigma layers report the merged surface, so the certainty layer must count all six
+    // points' certainty (6), not the winning bin's share (3).
+    CMultiBinElevationMap map = fixedMap(0.1);
+    map.insertionOptions.relief_sigma = false;
+    for (double z : {0.048, 0.052, 0.047, 0.053, 0.049, 0.051}) insert(map, 0.55, 0.55, z, 0.003);
+    double h, s;
+    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    using Layer = CMultiBinElevationMap::RasterLayer;
+    EXPECT_FLOAT_EQ(map.toRaster(Layer::Height).heights_m(5, 5), float(h));
+    EXPECT_FLOAT_EQ(map.toRaster(Layer::Sigma).heights_m(5, 5), float(s));
+    EXPECT_FLOAT_EQ(map.toRaster(Layer::Certainty).heights_m(5, 5), 6.f);
+    ASSERT_NE(map.grid().winningBin(5, 5), nullptr);
+    EXPECT_FLOAT_EQ(map.grid().winningBin(5, 5)->certainty, 3.f) << "the case the test is about";
+}

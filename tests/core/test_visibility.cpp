@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "multibin/map/CellSurface.h"
 #include "multibin/map/VisibilityConstraint.h"
 #include "test_scenes.h"
 
@@ -20,7 +21,8 @@ PointWithCov pointAt(double x, double y, double z, double sigmaZ_m) {
     return p;
 }
 
-/** Reference: the constraint as it was before the local height bound (commit 483eb88). Every
+/** Reference: the constraint as it was before the local height bound (commit 483eb88), with
+ * the target's certainty taken from the cell's surface (CellSurface) as the map reports it. Every
  * ray is sampled every half cell from the updated cell towards the sensor until it clears the
  * highest bin ever stored in the grid, and every cell it enters is tested. The library's version
  * must edit exactly the same bins. */
@@ -42,8 +44,9 @@ VisibilityStats referenceVisibility(BinGrid& grid, const Eigen::Vector3d& sensor
         return above > minConflictMargin && above > conflictMargin(b);
     };
     for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
-        const Bin* winner = grid.winningBin(u.ix, u.iy);
-        const float targetCertainty = winner ? winner->certainty : 0.f;
+        CellSurface surface;  // the cell's certainty as the map reports it
+        const double targetCertainty =
+            cellSurface(grid, u.ix, u.iy, binParams, surface) ? surface.certainty : 0.0;
         const double tz = u.maxHeight_m;
         const float decrement = vis.certaintyDecrement * float(u.points);
         grid.editBins(u.ix, u.iy, [&](Bin& b) {
@@ -142,6 +145,31 @@ TEST(Visibility, StaleOccluderLessCertainThanTheTargetIsRemoved) {
     EXPECT_EQ(s.binsRemoved, 1u);
     EXPECT_EQ(g.winningBin(10, 0), nullptr);
     ASSERT_NE(g.winningBin(20, 0), nullptr);
+}
+
+TEST(Visibility, OccluderIsWeighedAgainstTheCellSurfaceNotItsWinningBin) {
+    // The target cell's surface lies at a bin boundary: two points in bin 0 and two in bin 1, one
+    // surface of certainty 4 whose winning bin alone has 2. A stale occluder of certainty 3 is
+    // less certain than the surface the map reports there: it goes, not merely weakened.
+    BinGrid g(0.1);
+    g.reset(0.1, CellWindow{-5, -5, 30, 10});
+    BinUpdateParams p;
+    VisibilityParams v;
+    g.beginCycle();
+    for (int i = 0; i < 3; i++) g.insertPoints({pointAt(1.05, 0.05, 0.35, 0.005)}, p);
+    g.insertPoints({pointAt(2.05, 0.05, 0.048, 0.005), pointAt(2.05, 0.05, 0.048, 0.005),
+                    pointAt(2.05, 0.05, 0.052, 0.005)},
+                   p);
+    g.beginCycle();
+    g.insertPoints({pointAt(2.05, 0.05, 0.052, 0.005)}, p);
+    CellSurface surface;
+    ASSERT_TRUE(cellSurface(g, 20, 0, p, surface));
+    EXPECT_DOUBLE_EQ(surface.certainty, 4.0);
+    EXPECT_FLOAT_EQ(g.winningBin(20, 0)->certainty, 2.f);
+    const VisibilityStats s = applyVisibilityConstraint(g, {0.05, 0.05, 0.5}, v, p);
+    EXPECT_EQ(s.binsRemoved, 1u);
+    EXPECT_EQ(s.binsWeakened, 0u);
+    EXPECT_EQ(g.winningBin(10, 0), nullptr);
 }
 
 TEST(Visibility, MoreCertainOccluderOnlyLosesCertainty) {

@@ -76,10 +76,10 @@ void coverageRow(const char* label, int size, const std::vector<Err>& errs) {
 }
 
 /** Filled cells of one kind (Gaussian or Median) with their errors against the truth. */
-void collect(const FillResult& res, const std::vector<Board>& boards, int board, FillSource kind,
+void collect(const FillResult& res, const std::vector<Board>& boards, int board, HeightSource kind,
              std::vector<Err>& out) {
-    for (int iy = 0; iy < res.ny; iy++)
-        for (int ix = 0; ix < res.nx; ix++) {
+    for (int iy = 0; iy < res.ny(); iy++)
+        for (int ix = 0; ix < res.nx(); ix++) {
             const size_t k = res.index(ix, iy);
             if (res.source[k] != kind) continue;
             const double t = boards[size_t(board)].at(kCropOffset + ix, kCropOffset + iy);
@@ -114,11 +114,11 @@ void runCalibrationSet(const std::vector<Board>& boards, const FillOptions& opt,
                        std::map<int, std::vector<Err>>& med) {
     for (const auto& c : makeGapCases(int(boards.size()), kLargeSizes, 4, 4, seed)) {
         const auto res = fillGaps(caseRaster(boards, c), opt);
-        collect(res, boards, c.board, FillSource::Gaussian, gauss[c.size]);
+        collect(res, boards, c.board, HeightSource::FilledSurface, gauss[c.size]);
     }
     for (int s : kSmallSizes)
         for (const auto& [r, b] : smallHoleRasters(boards, s, seed + 100u * unsigned(s)))
-            collect(fillGaps(r, opt), boards, b, FillSource::Median, med[s]);
+            collect(fillGaps(r, opt), boards, b, HeightSource::FilledMedian, med[s]);
 }
 
 std::vector<Err> flatten(const std::map<int, std::vector<Err>>& m) {
@@ -174,9 +174,9 @@ int coverage(const std::vector<Board>& boards) {
 
 // ----- Alternatives on the same gaps -----
 std::vector<double> inpaintFloat(const HeightRaster& r, int flags, double radius_cells) {
-    cv::Mat src(r.ny, r.nx, CV_32F), mask(r.ny, r.nx, CV_8U), dst;
-    for (int iy = 0; iy < r.ny; iy++)
-        for (int ix = 0; ix < r.nx; ix++) {
+    cv::Mat src(r.ny(), r.nx(), CV_32F), mask(r.ny(), r.nx(), CV_8U), dst;
+    for (int iy = 0; iy < r.ny(); iy++)
+        for (int ix = 0; ix < r.nx(); ix++) {
             const size_t k = r.index(ix, iy);
             const bool known = r.isMeasured(k);
             src.at<float>(iy, ix) = known ? r.height_m[k] : 0.f;
@@ -184,8 +184,8 @@ std::vector<double> inpaintFloat(const HeightRaster& r, int flags, double radius
         }
     cv::inpaint(src, mask, dst, radius_cells, flags);
     std::vector<double> out(r.size());
-    for (int iy = 0; iy < r.ny; iy++)
-        for (int ix = 0; ix < r.nx; ix++) out[r.index(ix, iy)] = dst.at<float>(iy, ix);
+    for (int iy = 0; iy < r.ny(); iy++)
+        for (int ix = 0; ix < r.nx(); ix++) out[r.index(ix, iy)] = dst.at<float>(iy, ix);
     return out;
 }
 
@@ -197,9 +197,9 @@ std::vector<double> inpaint16(const HeightRaster& r, int flags, double radius_ce
         if (r.isMeasured(k))
             lo = std::min(lo, double(r.height_m[k])), hi = std::max(hi, double(r.height_m[k]));
     const double scale = 65535.0 / std::max(hi - lo, 1e-9);
-    cv::Mat src(r.ny, r.nx, CV_16U), mask(r.ny, r.nx, CV_8U), dst;
-    for (int iy = 0; iy < r.ny; iy++)
-        for (int ix = 0; ix < r.nx; ix++) {
+    cv::Mat src(r.ny(), r.nx(), CV_16U), mask(r.ny(), r.nx(), CV_8U), dst;
+    for (int iy = 0; iy < r.ny(); iy++)
+        for (int ix = 0; ix < r.nx(); ix++) {
             const size_t k = r.index(ix, iy);
             const bool known = r.isMeasured(k);
             src.at<uint16_t>(iy, ix) =
@@ -208,21 +208,21 @@ std::vector<double> inpaint16(const HeightRaster& r, int flags, double radius_ce
         }
     cv::inpaint(src, mask, dst, radius_cells, flags);
     std::vector<double> out(r.size());
-    for (int iy = 0; iy < r.ny; iy++)
-        for (int ix = 0; ix < r.nx; ix++)
+    for (int iy = 0; iy < r.ny(); iy++)
+        for (int ix = 0; ix < r.nx(); ix++)
             out[r.index(ix, iy)] = lo + dst.at<uint16_t>(iy, ix) / scale;
     return out;
 }
 
 std::vector<double> mrfFill(const HeightRaster& r) {
-    const double res = r.cellSize_m;
+    const double res = r.cellSize_m();
     mrpt::maps::CHeightGridMap2D_MRF mrf(mrpt::maps::CRandomFieldGridMap2D::mrGMRF_SD, 0,
-                                         r.nx * res, 0, r.ny * res, res, false);
+                                         r.nx() * res, 0, r.ny() * res, res, false);
     mrf.insertionOptions.GMRF_skip_variance = true;  // only the mean is compared
     mrpt::maps::CHeightGridMap2D_Base::TPointInsertParams p;
     p.update_map_after_insertion = false;
-    for (int iy = 0; iy < r.ny; iy++)
-        for (int ix = 0; ix < r.nx; ix++) {
+    for (int iy = 0; iy < r.ny(); iy++)
+        for (int ix = 0; ix < r.nx(); ix++) {
             const size_t k = r.index(ix, iy);
             if (!r.isMeasured(k)) continue;
             p.pt_z_std = r.sigma_m[k];
@@ -230,8 +230,8 @@ std::vector<double> mrfFill(const HeightRaster& r) {
         }
     mrf.dem_update_map();
     std::vector<double> out(r.size(), std::numeric_limits<double>::quiet_NaN());
-    for (int iy = 0; iy < r.ny; iy++)
-        for (int ix = 0; ix < r.nx; ix++) {
+    for (int iy = 0; iy < r.ny(); iy++)
+        for (int ix = 0; ix < r.nx(); ix++) {
             double z;
             if (mrf.dem_get_z((ix + 0.5) * res, (iy + 0.5) * res, z)) out[r.index(ix, iy)] = z;
         }

@@ -13,6 +13,7 @@
 #include "multibin/fill/ParticleSwarm.h"
 #include "multibin/io/StrictConfigSection.h"
 
+using multibin::HeightSource;
 using namespace multibin::fill;
 
 namespace {
@@ -265,7 +266,7 @@ TEST(WeightedMedian, OuterCellsOutweighInnerOnes) {
     o.sigmaModel = FillSigmaModel::Paper;
     const auto f = weightedMedianFill(r, o);
     const size_t c = f.index(2, 2);
-    EXPECT_EQ(f.source[c], FillSource::Median);
+    EXPECT_EQ(f.source[c], HeightSource::FilledMedian);
     EXPECT_FLOAT_EQ(f.height_m[c], 0.20f);
     // Paper sigma: the same weights over the neighbours' sigma.
     const double wIn = 4 + 4 * std::sqrt(2.0), wOut = 4 * 2 * std::sqrt(2.0) + 2 * 2;
@@ -288,11 +289,11 @@ TEST(WeightedMedian, FillsOnlyNeverObservedCellsAndNeverWritesZero) {
     const auto f = weightedMedianFill(r, o);
     for (size_t k = 0; k < r.size(); k++) {
         if (r.isMeasured(k)) {
-            EXPECT_EQ(f.source[k], FillSource::Measured);
+            EXPECT_EQ(f.source[k], HeightSource::Measured);
             EXPECT_EQ(f.height_m[k], r.height_m[k]);
             EXPECT_EQ(f.sigma_m[k], r.sigma_m[k]);
         } else {
-            EXPECT_EQ(f.source[k], FillSource::Median);
+            EXPECT_EQ(f.source[k], HeightSource::FilledMedian);
             EXPECT_GT(f.height_m[k], 0.05f);
         }
     }
@@ -302,7 +303,7 @@ TEST(WeightedMedian, FillsOnlyNeverObservedCellsAndNeverWritesZero) {
     HeightRaster empty(10, 10, 0.015);
     const auto e = fillGaps(empty, o);
     for (size_t k = 0; k < empty.size(); k++) {
-        EXPECT_EQ(e.source[k], FillSource::Unfilled);
+        EXPECT_EQ(e.source[k], HeightSource::Unknown);
         EXPECT_TRUE(std::isnan(e.height_m[k]));
     }
     // One lonely measurement, too few for medianMinKnown = 3: still NaN.
@@ -370,7 +371,7 @@ TEST(FillGaps, SmallGapsByMedianLargeByGaussianHugeUnfilled) {
     for (int iy = 13; iy < 23; iy++)
         for (int ix = 15; ix < 25; ix++) {
             const size_t k = f.index(ix, iy);
-            EXPECT_EQ(f.source[k], FillSource::Gaussian);
+            EXPECT_EQ(f.source[k], HeightSource::FilledSurface);
             worst = std::max(worst, std::abs(f.height_m[k] - hill(ix, iy)));
             EXPECT_GE(f.sigma_m[k], o.sigmaFloor_m);
         }

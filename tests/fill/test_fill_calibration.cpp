@@ -6,6 +6,7 @@
 #include "FillTestData.h"
 #include "multibin/fill/GapFilling.h"
 
+using multibin::HeightSource;
 using namespace multibin::fill;
 using namespace multibin::filltest;
 
@@ -18,9 +19,9 @@ struct Coverage {
     double frac1() const { return double(in1) / n; }
 };
 
-void add(const FillResult& f, const GapCase& c, FillSource kind, Coverage& cov) {
-    for (int iy = 0; iy < f.ny; iy++)
-        for (int ix = 0; ix < f.nx; ix++) {
+void add(const FillResult& f, const GapCase& c, HeightSource kind, Coverage& cov) {
+    for (int iy = 0; iy < f.ny(); iy++)
+        for (int ix = 0; ix < f.nx(); ix++) {
             const size_t k = f.index(ix, iy);
             if (f.source[k] != kind) continue;
             const double z =
@@ -53,9 +54,9 @@ TEST(FillCalibration, GaussianFilledCellsWithinThreeSigma) {
         for (const auto& c : makeGapCases(int(boards().size()), {size}, 2, 4, 2)) {
             const auto r = caseRaster(boards(), c);
             const auto f = fillGaps(r, FillOptions{});
-            add(f, c, FillSource::Gaussian, perSize);
-            add(f, c, FillSource::Gaussian, calibrated);
-            add(fillGaps(r, paperOpt), c, FillSource::Gaussian, paper);
+            add(f, c, HeightSource::FilledSurface, perSize);
+            add(f, c, HeightSource::FilledSurface, calibrated);
+            add(fillGaps(r, paperOpt), c, HeightSource::FilledSurface, paper);
         }
         ASSERT_EQ(perSize.n, 6 * 2 * size * size);  // every hidden cell filled by eq 16
         EXPECT_GE(perSize.frac3(), 0.95) << "gap side " << size;
@@ -76,7 +77,7 @@ TEST(FillCalibration, MedianFilledCellsWithinThreeSigma) {
             auto r = caseRaster(boards(), c);  // size 0: nothing hidden yet
             std::uniform_int_distribution<int> pos(0, kCropSide - size);
             for (int h = 0; h < 25; h++) hideBox(r, pos(rng), pos(rng), size, size);
-            add(fillGaps(r, FillOptions{}), c, FillSource::Median, cov);
+            add(fillGaps(r, FillOptions{}), c, HeightSource::FilledMedian, cov);
         }
     ASSERT_GT(cov.n, 500);
     EXPECT_GE(cov.frac3(), 0.95);

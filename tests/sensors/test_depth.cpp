@@ -12,6 +12,7 @@
 
 #include "mc_check.h"
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/BinGrid.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/SensorDispatch.h"
 
@@ -104,10 +105,9 @@ TEST(DepthModel, PointCloudObservationUsesTheModel) {
     cloud.pointcloud = pts;
     SensorModelOptions opts;
     SensorModelState state;
-    InsertStats core;
     SensorPoints sp;
     ASSERT_TRUE(observationToSensorPoints(cloud, mrpt::poses::CPose3DPDFGaussian(), opts, 0.02, 20,
-                                          state, core, sp));
+                                          state, sp));
     ASSERT_EQ(sp.points.size(), 2u);
     const Eigen::Matrix3d C = sp.points[1].cov_m2.toMatrix();
     const Eigen::Vector3d d = Eigen::Vector3d(3, 1, -1).normalized();
@@ -134,10 +134,9 @@ TEST(DepthModel, RealMrptDepthFrameInsertsWithoutNaN) {
         frames++;
         // The points carry the depth model's covariance.
         SensorModelState state;
-        InsertStats core;
         SensorPoints sp;
         ASSERT_TRUE(observationToSensorPoints(*depth, mrpt::poses::CPose3DPDFGaussian(), opts, 0.02,
-                                              6.0, state, core, sp));
+                                              6.0, state, sp));
         ASSERT_GT(sp.points.size(), 1000u);
         for (const auto& p : sp.points) {
             const Eigen::Matrix3d C = p.cov_m2.toMatrix();

@@ -3,6 +3,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
+#include "multibin/io/StrictConfigSection.h"
 #include "multibin/sensors/SensorModelOptions.h"
 
 using multibin::sensors::SensorModelOptions;

@@ -5,19 +5,100 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
+#include "multibin/fill/GaussianSurface.h"
 #include "multibin/io/StrictConfigSection.h"
 
 namespace multibin::fill {
 
 namespace {
-const char* criterionName(ModelCriterion c) {
-    return c == ModelCriterion::BIC ? "bic" : c == ModelCriterion::Holdout ? "holdout" : "aic";
+// One table per choice key: the names read and the names written.
+template <class T>
+using Names = std::vector<std::pair<std::string, T>>;
+
+const Names<ResidualModel> kResidualModels{{"kriging", ResidualModel::Kriging},
+                                           {"harmonic", ResidualModel::Harmonic},
+                                           {"biharmonic", ResidualModel::Biharmonic}};
+const Names<CovarianceFamily> kCovarianceFamilies{{"exponential", CovarianceFamily::Exponential},
+                                                  {"matern32", CovarianceFamily::Matern32}};
+const Names<KrigingNeighbourhood> kNeighbourhoods{{"auto", KrigingNeighbourhood::Auto},
+                                                  {"moving", KrigingNeighbourhood::Moving},
+                                                  {"unique", KrigingNeighbourhood::Unique}};
+const Names<ModelCriterion> kCriteria{{"aic", ModelCriterion::AICc},
+                                      {"bic", ModelCriterion::BIC},
+                                      {"holdout", ModelCriterion::Holdout}};
+const Names<FillSigmaModel> kSigmaModels{{"calibrated", FillSigmaModel::Calibrated},
+                                         {"paper", FillSigmaModel::Paper}};
+
+template <class T>
+std::string nameOf(const Names<T>& names, T value) {
+    for (const auto& [name, v] : names)
+        if (v == value) return name;
+    return names.front().first;
 }
 
-const char* sigmaModelName(FillSigmaModel m) {
-    return m == FillSigmaModel::Paper ? "paper" : "calibrated";
+/** Calls visit(key, member) for every plain key and visit(key, member, names) for every choice
+ * key of `o` (a FillOptions or a const one): the one list of keys that read and write share. */
+template <class Options, class Visit>
+void visitKeys(Options& o, Visit&& visit) {
+    visit("fill_enabled", o.enabled);
+    visit("fill_median_window", o.medianWindow_cells);
+    visit("fill_median_min_known", o.medianMinKnown);
+    visit("fill_gaussian", o.gaussianEnabled);
+    visit("fill_max_gap_cells", o.maxGapCells);
+    visit("fill_support_margin", o.supportMargin_cells);
+    visit("fill_max_training_points", o.maxTrainingPoints);
+    visit("fill_residual_correction", o.residualCorrection);
+    visit("fill_residual_model", o.residualModel, kResidualModels);
+    visit("fill_kriging_covariance", o.krigingCovariance, kCovarianceFamilies);
+    visit("fill_terms_outside_gap", o.termsOutsideGap);
+    visit("fill_kriging_max_points", o.krigingMaxPoints);
+    visit("fill_moving_rim_check", o.movingRimCheck);
+    visit("fill_kriging_neighbourhood", o.krigingNeighbourhood, kNeighbourhoods);
+    visit("fill_model_averaging", o.modelAveraging);
+    visit("fill_extrapolation_margin", o.extrapolationMargin);
+    visit("fill_model_criterion", o.criterion, kCriteria);
+    visit("fill_max_terms", o.maxTerms);
+    visit("fill_min_width", o.minWidth_cells);
+    visit("fill_pso_particles", o.swarmParticles);
+    visit("fill_pso_iterations", o.swarmIterations);
+    visit("fill_pso_seed", o.swarmSeed);
+    visit("fill_sigma_model", o.sigmaModel, kSigmaModels);
+    visit("fill_median_sigma_gain", o.medianSigmaGain);
+    visit("fill_gaussian_sigma_gain", o.gaussianSigmaGain);
+    visit("fill_sigma_floor", o.sigmaFloor_m);
 }
+
+struct KeyReader {
+    StrictConfigSection& s;
+    template <class T>
+    void operator()(const char* key, T& value) const {
+        s.read(key, value);
+    }
+    template <class T>
+    void operator()(const char* key, T& value, const Names<T>& names) const {
+        s.readChoice(key, value, names);
+    }
+};
+
+struct KeyWriter {
+    mrpt::config::CConfigFileBase& c;
+    const std::string& section;
+    template <class T>
+    void operator()(const char* key, const T& value) const {
+        if constexpr (std::is_same_v<T, unsigned>)
+            c.write(section, key, int(value));
+        else
+            c.write(section, key, value);
+    }
+    template <class T>
+    void operator()(const char* key, const T& value, const Names<T>& names) const {
+        c.write(section, key, nameOf(names, value));
+    }
+};
 }  // namespace
 
 GaussianFitOptions FillOptions::gaussianFitOptions() const {
@@ -32,45 +113,7 @@ GaussianFitOptions FillOptions::gaussianFitOptions() const {
 }
 
 void FillOptions::read(StrictConfigSection& s) {
-    s.read("fill_enabled", enabled);
-    s.read("fill_median_window", medianWindow_cells);
-    s.read("fill_median_min_known", medianMinKnown);
-    s.read("fill_gaussian", gaussianEnabled);
-    s.read("fill_max_gap_cells", maxGapCells);
-    s.read("fill_support_margin", supportMargin_cells);
-    s.read("fill_max_training_points", maxTrainingPoints);
-    s.read("fill_residual_correction", residualCorrection);
-    s.readChoice<ResidualModel>("fill_residual_model", residualModel,
-                                {{"kriging", ResidualModel::Kriging},
-                                 {"harmonic", ResidualModel::Harmonic},
-                                 {"biharmonic", ResidualModel::Biharmonic}});
-    s.readChoice<CovarianceFamily>(
-        "fill_kriging_covariance", krigingCovariance,
-        {{"exponential", CovarianceFamily::Exponential}, {"matern32", CovarianceFamily::Matern32}});
-    s.read("fill_terms_outside_gap", termsOutsideGap);
-    s.read("fill_kriging_max_points", krigingMaxPoints);
-    s.read("fill_moving_rim_check", movingRimCheck);
-    s.readChoice<KrigingNeighbourhood>("fill_kriging_neighbourhood", krigingNeighbourhood,
-                                       {{"auto", KrigingNeighbourhood::Auto},
-                                        {"moving", KrigingNeighbourhood::Moving},
-                                        {"unique", KrigingNeighbourhood::Unique}});
-    s.read("fill_model_averaging", modelAveraging);
-    s.read("fill_extrapolation_margin", extrapolationMargin);
-    s.readChoice<ModelCriterion>("fill_model_criterion", criterion,
-                                 {{"aic", ModelCriterion::AICc},
-                                  {"bic", ModelCriterion::BIC},
-                                  {"holdout", ModelCriterion::Holdout}});
-    s.read("fill_max_terms", maxTerms);
-    s.read("fill_min_width", minWidth_cells);
-    s.read("fill_pso_particles", swarmParticles);
-    s.read("fill_pso_iterations", swarmIterations);
-    s.read("fill_pso_seed", swarmSeed);
-    s.readChoice<FillSigmaModel>(
-        "fill_sigma_model", sigmaModel,
-        {{"calibrated", FillSigmaModel::Calibrated}, {"paper", FillSigmaModel::Paper}});
-    s.read("fill_median_sigma_gain", medianSigmaGain);
-    s.read("fill_gaussian_sigma_gain", gaussianSigmaGain);
-    s.read("fill_sigma_floor", sigmaFloor_m);
+    visitKeys(*this, KeyReader{s});
     validate();
 }
 
@@ -83,40 +126,7 @@ void FillOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& source
 
 void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                    const std::string& section) const {
-    c.write(section, "fill_enabled", enabled);
-    c.write(section, "fill_median_window", medianWindow_cells);
-    c.write(section, "fill_median_min_known", medianMinKnown);
-    c.write(section, "fill_gaussian", gaussianEnabled);
-    c.write(section, "fill_max_gap_cells", maxGapCells);
-    c.write(section, "fill_support_margin", supportMargin_cells);
-    c.write(section, "fill_max_training_points", maxTrainingPoints);
-    c.write(section, "fill_residual_correction", residualCorrection);
-    c.write(section, "fill_residual_model",
-            std::string(residualModel == ResidualModel::Harmonic     ? "harmonic"
-                        : residualModel == ResidualModel::Biharmonic ? "biharmonic"
-                                                                     : "kriging"));
-    c.write(
-        section, "fill_kriging_covariance",
-        std::string(krigingCovariance == CovarianceFamily::Matern32 ? "matern32" : "exponential"));
-    c.write(section, "fill_terms_outside_gap", termsOutsideGap);
-    c.write(section, "fill_kriging_max_points", krigingMaxPoints);
-    c.write(section, "fill_moving_rim_check", movingRimCheck);
-    c.write(section, "fill_kriging_neighbourhood",
-            std::string(krigingNeighbourhood == KrigingNeighbourhood::Moving   ? "moving"
-                        : krigingNeighbourhood == KrigingNeighbourhood::Unique ? "unique"
-                                                                               : "auto"));
-    c.write(section, "fill_model_averaging", modelAveraging);
-    c.write(section, "fill_extrapolation_margin", extrapolationMargin);
-    c.write(section, "fill_model_criterion", std::string(criterionName(criterion)));
-    c.write(section, "fill_max_terms", maxTerms);
-    c.write(section, "fill_min_width", minWidth_cells);
-    c.write(section, "fill_pso_particles", swarmParticles);
-    c.write(section, "fill_pso_iterations", swarmIterations);
-    c.write(section, "fill_pso_seed", int(swarmSeed));
-    c.write(section, "fill_sigma_model", std::string(sigmaModelName(sigmaModel)));
-    c.write(section, "fill_median_sigma_gain", medianSigmaGain);
-    c.write(section, "fill_gaussian_sigma_gain", gaussianSigmaGain);
-    c.write(section, "fill_sigma_floor", sigmaFloor_m);
+    visitKeys(*this, KeyWriter{c, section});
 }
 
 void FillOptions::validate() const {

@@ -109,7 +109,8 @@ PosePropagator::PosePropagator(const mrpt::poses::CPose3DPDFGaussian& robotPoseI
     const mrpt::poses::CPose3D& R = robotPoseInMap.mean;
     const Eigen::Matrix3d rotRobotToMap = toEigen(R.getRotationMatrix());
     const Eigen::Matrix3d rotSensorToRobot = toEigen(sensorPoseOnRobot.getRotationMatrix());
-    const Eigen::Matrix3d rotSensorToMap = rotRobotToMap * rotSensorToRobot;
+    m_rotSensorToMap = rotRobotToMap * rotSensorToRobot;
+    const Eigen::Matrix3d& rotSensorToMap = m_rotSensorToMap;
     const Eigen::Vector3d tRobot_m(R.x(), R.y(), R.z());
     const Eigen::Vector3d tSensorOnRobot_m(sensorPoseOnRobot.x(), sensorPoseOnRobot.y(),
                                            sensorPoseOnRobot.z());

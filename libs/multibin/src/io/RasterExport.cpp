@@ -1,45 +1,82 @@
-/* Part of the multibin elevation-mapping library: raster exports (float TIFF, PLY mesh). */
+/* Part of the multibin elevation-mapping library: raster exports (crop to the known area, float
+ * TIFF with world file, PLY mesh, PNG previews). */
 #include "multibin/io/RasterExport.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
-#include <vector>
+
+#include "multibin/io/OutputFile.h"
 
 namespace multibin {
 
-void saveFloatTiff(const EsriAsciiGrid& raster, const std::string& path) {
+RasterBox knownBox(const EsriAsciiGrid& raster, int margin_cells) {
+    int r0 = raster.rows(), r1 = -1, c0 = raster.cols(), c1 = -1;
+    for (int r = 0; r < raster.rows(); r++)
+        for (int c = 0; c < raster.cols(); c++)
+            if (std::isfinite(raster.heights_m(r, c))) {
+                r0 = std::min(r0, r);
+                r1 = std::max(r1, r);
+                c0 = std::min(c0, c);
+                c1 = std::max(c1, c);
+            }
+    RasterBox b;
+    if (r1 < 0) return b;
+    const int m = std::max(0, margin_cells);
+    b.row0 = std::max(0, r0 - m);
+    b.col0 = std::max(0, c0 - m);
+    b.rows = std::min(raster.rows() - 1, r1 + m) - b.row0 + 1;
+    b.cols = std::min(raster.cols() - 1, c1 + m) - b.col0 + 1;
+    return b;
+}
+
+EsriAsciiGrid cropRaster(const EsriAsciiGrid& raster, const RasterBox& box) {
+    EsriAsciiGrid g = raster;
+    if (box.empty()) {
+        g.heights_m.resize(0, 0);
+        return g;
+    }
+    if (box.row0 < 0 || box.col0 < 0 || box.row0 + box.rows > raster.rows() ||
+        box.col0 + box.cols > raster.cols())
+        throw std::invalid_argument("cropRaster: the box reaches outside the raster");
+    g.heights_m = raster.heights_m.block(box.row0, box.col0, box.rows, box.cols);
+    g.xllcenter_m = raster.xllcenter_m + box.col0 * raster.cellsize_m;
+    g.yllcenter_m = raster.yllcenter_m + box.row0 * raster.cellsize_m;
+    return g;
+}
+
+std::vector<uint8_t> encodeFloatTiff(const EsriAsciiGrid& raster) {
     const int rows = raster.rows(), cols = raster.cols();
-    if (rows == 0 || cols == 0)
-        throw std::runtime_error("cannot write '" + path + "': the raster is empty");
+    if (rows == 0 || cols == 0) throw std::invalid_argument("the raster is empty");
     cv::Mat img(rows, cols, CV_32FC1);
     for (int r = 0; r < rows; r++)  // image row 0 is the northernmost
         for (int c = 0; c < cols; c++) img.at<float>(rows - 1 - r, c) = raster.heights_m(r, c);
-    bool ok = false;
-    try {
-        ok = cv::imwrite(path, img);
-    } catch (const cv::Exception& e) {
-        throw std::runtime_error("cannot write '" + path + "': " + e.what());
-    }
-    if (!ok) throw std::runtime_error("cannot write '" + path + "'");
+    std::vector<uint8_t> bytes;
+    if (!cv::imencode(".tif", img, bytes)) throw std::runtime_error("TIFF encoding failed");
+    return bytes;
+}
 
-    // World file: pixel size in x, rotation terms, pixel size in y (negative: rows go south),
-    // centre of the upper-left pixel.
-    const std::string worldPath = std::filesystem::path(path).replace_extension(".tfw").string();
-    std::ofstream w(worldPath);
+std::string worldFileText(const EsriAsciiGrid& raster) {
+    // Pixel size in x, rotation terms, pixel size in y (negative: rows go south), centre of the
+    // upper-left pixel.
+    std::ostringstream w;
     w.precision(12);
     w << raster.cellsize_m << "\n0\n0\n"
       << -raster.cellsize_m << "\n"
       << raster.xllcenter_m << "\n"
       << raster.yMax_m() << "\n";
-    if (!w) throw std::runtime_error("cannot write '" + worldPath + "'");
+    return w.str();
 }
 
-void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {
+std::string meshPlyText(const EsriAsciiGrid& raster) {
     const int rows = raster.rows(), cols = raster.cols();
     std::vector<int> vertexOf(size_t(rows) * size_t(cols), -1);
     int vertices = 0;
@@ -67,8 +104,7 @@ void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {
             }
         }
 
-    std::ofstream out(path);
-    if (!out) throw std::runtime_error("cannot write '" + path + "'");
+    std::ostringstream out;
     out << "ply\nformat ascii 1.0\ncomment multibin elevation map, map frame [m]\n"
         << "element vertex " << vertices << "\nproperty float x\nproperty float y\n"
         << "property float z\nelement face " << faces.size()
@@ -81,7 +117,181 @@ void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {
                     << raster.yllcenter_m + r * raster.cellsize_m << ' ' << raster.heights_m(r, c)
                     << '\n';
     for (const auto& f : faces) out << "3 " << f[0] << ' ' << f[1] << ' ' << f[2] << '\n';
-    if (!out) throw std::runtime_error("cannot write '" + path + "'");
+    return out.str();
+}
+
+namespace {
+
+/** 1, 2 or 5 times a power of ten, near `rough`. */
+double niceStep(double rough) {
+    if (!(rough > 0)) return 1;
+    const double p = std::pow(10.0, std::floor(std::log10(rough)));
+    for (const double m : {1.0, 2.0, 5.0})
+        if (m * p >= rough) return m * p;
+    return 10 * p;
+}
+
+std::string formatted(const char* format, double v) {
+    if (std::abs(v) < 1e-9) v = 0;  // no "-0"
+    char buf[64];
+    std::snprintf(buf, sizeof buf, format, v);
+    return buf;
+}
+
+/** Decimals that show `step` [m] exactly enough ("%.2f" for 0.25). */
+std::string metreFormat(double step) {
+    const int decimals = std::clamp(int(std::ceil(-std::log10(step) - 1e-9)), 0, 6);
+    return "%." + std::to_string(decimals) + "f";
+}
+
+const cv::Scalar kBlack(0, 0, 0);
+const cv::Scalar kUnknown(kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]);  // BGR
+
+void text(cv::Mat& img, const std::string& s, cv::Point at, double size = 0.4) {
+    cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, size, kBlack, 1, cv::LINE_AA);
+}
+
+int textWidth(const std::string& s, double size = 0.4) {
+    int base = 0;
+    return cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, size, 1, &base).width;
+}
+
+/** Categorical colours (BGR), the tab10 palette's first entries. */
+cv::Vec3b categoryColour(size_t i) {
+    static const cv::Vec3b palette[] = {{180, 119, 31}, {14, 127, 255},  {44, 160, 44},
+                                        {40, 39, 214},  {189, 103, 148}, {75, 86, 140}};
+    return palette[i % (sizeof palette / sizeof palette[0])];
+}
+
+}  // namespace
+
+std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const PreviewStyle& style) {
+    const int rows = raster.rows(), cols = raster.cols();
+    if (rows == 0 || cols == 0) throw std::invalid_argument("the raster is empty");
+    const bool categorical = !style.categories.empty();
+
+    // Map panel about 600 px on its long side: whole pixels per cell when enlarging.
+    double scale = 600.0 / std::max(rows, cols);
+    if (scale >= 1) scale = std::min(20.0, std::floor(scale));
+    const int W = std::max(1, int(std::lround(cols * scale)));
+    const int H = std::max(1, int(std::lround(rows * scale)));
+    const int L = 70, T = 34, R = 170, B = 70;
+    const int panelH = std::max(H, 280);
+    cv::Mat img(panelH + T + B, W + L + R, CV_8UC3, cv::Scalar(255, 255, 255));
+
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (int r = 0; r < rows; r++)
+        for (int c = 0; c < cols; c++) {
+            const float v = raster.heights_m(r, c);
+            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+        }
+    if (!(lo <= hi)) lo = hi = 0;
+    const float span = hi > lo ? hi - lo : 1.f;
+    cv::Mat ramp(1, 256, CV_8UC1), lut;
+    for (int i = 0; i < 256; i++) ramp.at<uint8_t>(0, i) = uint8_t(i);
+    cv::applyColorMap(ramp, lut, style.colormap);
+
+    auto colourOf = [&](float v) -> cv::Vec3b {
+        if (!std::isfinite(v)) return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
+        if (categorical) {
+            for (size_t i = 0; i < style.categories.size(); i++)
+                if (int(std::lround(v)) == style.categories[i].first) return categoryColour(i);
+            return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
+        }
+        const int k = std::clamp(int((v - lo) / span * 255.f + 0.5f), 0, 255);
+        return lut.at<cv::Vec3b>(0, k);
+    };
+    for (int py = 0; py < H; py++) {
+        const int r = rows - 1 - std::min(rows - 1, int(py / scale));  // north up
+        for (int px = 0; px < W; px++) {
+            const int c = std::min(cols - 1, int(px / scale));
+            img.at<cv::Vec3b>(T + py, L + px) = colourOf(raster.heights_m(r, c));
+        }
+    }
+    cv::rectangle(img, {L - 1, T - 1}, {L + W, T + H}, kBlack);
+
+    // Axes in metres: ticks at cell edges' coordinates, nice steps.
+    const double cs = raster.cellsize_m, x0 = raster.xllcenter_m - cs / 2,
+                 y0 = raster.yllcenter_m - cs / 2;
+    const double pxPerM = scale / cs;
+    const double xSpan = cols * cs, ySpan = rows * cs;
+    const double step = niceStep(std::max(xSpan, ySpan) / 6);
+    const std::string fmt = metreFormat(step);
+    for (double x = std::ceil(x0 / step) * step; x <= x0 + xSpan + 1e-9; x += step) {
+        const int px = L + int(std::lround((x - x0) * pxPerM));
+        cv::line(img, {px, T + H}, {px, T + H + 4}, kBlack);
+        const std::string s = formatted(fmt.c_str(), x);
+        text(img, s, {px - textWidth(s) / 2, T + H + 17});
+    }
+    for (double y = std::ceil(y0 / step) * step; y <= y0 + ySpan + 1e-9; y += step) {
+        const int py = T + H - int(std::lround((y - y0) * pxPerM));
+        cv::line(img, {L - 5, py}, {L - 1, py}, kBlack);
+        const std::string s = formatted(fmt.c_str(), y);
+        text(img, s, {L - 8 - textWidth(s), py + 4});
+    }
+    text(img, "x [m]", {L + W / 2 - 15, T + H + 33});
+    text(img, "y [m]", {4, T - 8});
+    text(img, style.title, {L, 22}, 0.55);
+
+    // Scale bar under the axis.
+    const double barM = niceStep(xSpan / 4);
+    const int barPx = std::max(1, int(std::lround(barM * pxPerM)));
+    const int sy = T + H + 52;
+    cv::rectangle(img, {L, sy - 3}, {L + barPx, sy + 3}, kBlack, cv::FILLED);
+    text(img, formatted(metreFormat(barM).c_str(), barM) + " m", {L + barPx + 8, sy + 5});
+
+    // Colour bar or categorical legend, then the unknown swatch.
+    const int bx = L + W + 24;
+    int legendBottom = T;
+    if (categorical) {
+        for (size_t i = 0; i < style.categories.size(); i++) {
+            const int y = T + int(i) * 24;
+            const cv::Vec3b c = categoryColour(i);
+            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, cv::Scalar(c[0], c[1], c[2]),
+                          cv::FILLED);
+            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, kBlack);
+            text(img, style.categories[i].second, {bx + 24, y + 13});
+            legendBottom = y + 24;
+        }
+    } else {
+        const int barH = 200;
+        for (int i = 0; i < barH; i++) {
+            const cv::Vec3b c =
+                lut.at<cv::Vec3b>(0, std::clamp(255 - i * 255 / (barH - 1), 0, 255));
+            cv::line(img, {bx, T + i}, {bx + 18, T + i}, cv::Scalar(c[0], c[1], c[2]));
+        }
+        cv::rectangle(img, {bx, T}, {bx + 18, T + barH - 1}, kBlack);
+        for (int k = 0; k <= 4; k++) {
+            const double v = hi - (hi - lo) * k / 4.0;
+            const int y = T + (barH - 1) * k / 4;
+            cv::line(img, {bx + 18, y}, {bx + 22, y}, kBlack);
+            text(img, formatted(style.valueFormat.c_str(), v), {bx + 26, y + 4});
+        }
+        legendBottom = T + barH + 8;
+    }
+    cv::rectangle(img, {bx, legendBottom}, {bx + 16, legendBottom + 16}, kUnknown, cv::FILLED);
+    cv::rectangle(img, {bx, legendBottom}, {bx + 16, legendBottom + 16}, kBlack);
+    text(img, "unknown", {bx + 24, legendBottom + 13});
+
+    std::vector<uint8_t> bytes;
+    if (!cv::imencode(".png", img, bytes)) throw std::runtime_error("PNG encoding failed");
+    return bytes;
+}
+
+void saveFloatTiff(const EsriAsciiGrid& raster, const std::string& path) {
+    std::vector<uint8_t> tiff;
+    try {
+        tiff = encodeFloatTiff(raster);
+    } catch (const std::exception& e) {
+        throw std::runtime_error("cannot write '" + path + "': " + e.what());
+    }
+    writeFileAtomically(path, tiff);
+    writeFileAtomically(std::filesystem::path(path).replace_extension(".tfw").string(),
+                        worldFileText(raster));
+}
+
+void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {
+    writeFileAtomically(path, meshPlyText(raster));
 }
 
 }  // namespace multibin

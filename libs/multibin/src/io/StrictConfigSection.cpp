@@ -3,10 +3,14 @@
 
 #include "multibin/io/NumberText.h"
 
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -48,16 +52,62 @@ std::vector<std::string> splitList(const std::string& s) {
     return out;
 }
 
+/** The ini text behind `source` when it can be had (a file or memory), else empty. */
+std::string iniText(const mrpt::config::CConfigFileBase& source, const std::string& file) {
+    if (const auto* mem = dynamic_cast<const mrpt::config::CConfigFileMemory*>(&source)) {
+        std::string text;
+        mem->getContent(text);
+        return text;
+    }
+    if (file.empty()) return {};
+    std::ifstream f(file);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+/** The first key given more than once in `section` of ini `text` ("" if none). MRPT's reader
+ * keeps the last value without a word. */
+std::string duplicatedKey(const std::string& text, const std::string& section) {
+    std::set<std::string> seen;
+    bool inSection = false;
+    size_t start = 0;
+    while (start <= text.size()) {
+        size_t end = text.find('\n', start);
+        if (end == std::string::npos) end = text.size();
+        const std::string line = trim(text.substr(start, end - start));
+        start = end + 1;
+        if (line.empty()) continue;
+        if (line.front() == '[') {
+            const auto close = line.find(']');
+            inSection = close != std::string::npos && trim(line.substr(1, close - 1)) == section;
+            continue;
+        }
+        const auto eq = line.find('=');
+        if (!inSection || eq == std::string::npos) continue;
+        const std::string key = trim(line.substr(0, eq));
+        if (!seen.insert(key).second) return key;
+    }
+    return {};
+}
 }  // namespace
 
 StrictConfigSection::StrictConfigSection(const mrpt::config::CConfigFileBase& source,
                                          std::string section)
     : m_source(source), m_section(std::move(section)) {
+    if (const auto* f = dynamic_cast<const mrpt::config::CConfigFile*>(&source))
+        m_file = f->getAssociatedFile();
     if (m_source.sectionExists(m_section)) {
         m_source.getAllKeys(m_section, m_keys);
         for (const auto& k : m_keys)
             m_values.push_back(trim(m_source.read_string(m_section, k, "")));
+        if (const std::string dup = duplicatedKey(iniText(source, m_file), m_section); !dup.empty())
+            fail(dup, "given more than once in the section");
     }
+}
+
+std::string StrictConfigSection::where() const {
+    // No brackets: MRPT's exception wrapper takes the text up to a ']' for a source location.
+    return (m_file.empty() ? std::string("ini") : "ini file '" + m_file + "',") + " section '" +
+           m_section + "'";
 }
 
 bool StrictConfigSection::has(const std::string& key) const {
@@ -88,7 +138,7 @@ std::string StrictConfigSection::listOfWords(const std::vector<std::string>& wor
 }
 
 void StrictConfigSection::fail(const std::string& key, const std::string& problem) const {
-    throw std::invalid_argument("ini section [" + m_section + "], key '" + key + "': " + problem);
+    throw std::invalid_argument(where() + ", key '" + key + "': " + problem);
 }
 
 void StrictConfigSection::read(const std::string& key, double& value) {

@@ -1,14 +1,18 @@
 /* Part of the multibin elevation-mapping library. */
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 #include <mrpt/rtti/CObject.h>
 #include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 
 #include "multibin/io/StrictConfigSection.h"
+#include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
 
@@ -40,6 +44,63 @@ namespace {
 // Keys MRPT itself puts in every `_creationOpts` section (TMapGenericParams).
 const std::vector<std::string> kGenericMapKeys = {
     "enableSaveAs3DObject", "enableObservationLikelihood", "enableObservationInsertion"};
+
+/** options.validate(), its error prefixed with the file and section the options came from. */
+template <typename Options>
+void validateIn(const multibin::StrictConfigSection& s, const Options& options) {
+    try {
+        options.validate();
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(s.where() + ": " + e.what());
+    }
+}
+
+/** "ini file 'F'" or "ini" (a source that is not a file). Messages hold no ']': MRPT's exception
+ * wrapper takes the text up to one for a source location. */
+std::string iniName(const mrpt::config::CConfigFileBase& source) {
+    if (const auto* f = dynamic_cast<const mrpt::config::CConfigFile*>(&source))
+        return "ini file '" + f->getAssociatedFile() + "'";
+    return "ini";
+}
+
+constexpr int kMaxMapCount = 64;  //!< maps of this class in one CMultiMetricMap
+
+/** Checks what MRPT's TSetOfMetricMapInitializers does not, before it creates `count` map
+ * definitions (count = -1 or 100000 took 9-23 GB): the `multiBinElevationMap_count` key of the
+ * parent section, and every section of this map's prefix (`<parent>_multiBinElevationMap_NN_X`:
+ * NN below the count, X creationOpts or insertOpts), so a misspelt one is an error, not ignored. */
+void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::string& prefix) {
+    const std::string tag = "_multiBinElevationMap_";
+    const auto at = prefix.rfind(tag);
+    if (at == std::string::npos) return;  // not created through a CMultiMetricMap ini
+    const std::string parent = prefix.substr(0, at);
+    const std::string countKey = "multiBinElevationMap_count";
+    const std::string countText = source.read_string(parent, countKey, "0");
+    char* end = nullptr;
+    const long count = std::strtol(countText.c_str(), &end, 10);
+    if (countText.empty() || *end != '\0' || count < 0 || count > kMaxMapCount)
+        throw std::invalid_argument(iniName(source) + ", section '" + parent + "', key '" +
+                                    countKey + "': expected a whole number from 0 to " +
+                                    std::to_string(kMaxMapCount) + ", got '" + countText + "'");
+    std::vector<std::string> sections;
+    source.getAllSections(sections);
+    const std::string mapPrefix = parent + tag.substr(0, tag.size() - 1);
+    for (const auto& sec : sections) {
+        if (sec.compare(0, mapPrefix.size(), mapPrefix) != 0) continue;
+        bool known = false;
+        for (long i = 0; i < count && !known; i++) {
+            char nn[8];
+            std::snprintf(nn, sizeof nn, "%02ld", i);
+            for (const char* part : {"_creationOpts", "_insertOpts"})
+                known = known || sec == parent + tag + nn + part;
+        }
+        if (!known)
+            throw std::invalid_argument(
+                iniName(source) + ", section '" + sec + "': unknown section (this map reads '" +
+                parent + tag + "NN_creationOpts' and '" + parent + tag +
+                "NN_insertOpts', NN from 00 to " + std::to_string(count - 1) + ")");
+    }
+}
 
 const char* colormapName(mrpt::img::TColormap c) {
     switch (c) {
@@ -76,7 +137,7 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     s.read("global_resolution", global_resolution_m);
     s.allow(kGenericMapKeys);
     s.finish();
-    validate();
+    validateIn(s, *this);
 }
 
 void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
@@ -96,6 +157,11 @@ void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CCo
     c.write(section, "global_resolution", global_resolution_m);
 }
 
+namespace {
+/** Largest cell index an option may produce: int with room for a window of 2^30 cells. */
+constexpr double kMaxCellIndex = 1 << 30;
+}  // namespace
+
 void CMultiBinElevationMap::TCreationOptions::validate() const {
     auto bad = [](const std::string& key, const std::string& what) {
         throw std::invalid_argument("CMultiBinElevationMap creation option '" + key + "': " + what);
@@ -106,6 +172,17 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
         bad("bin_height", "must be a positive bin height [m]");
     if (!(max_size_m > 0) || !std::isfinite(max_size_m))
         bad("max_size_m", "must be a positive size [m]");
+    for (const auto& [key, v] :
+         {std::pair{"min_x", min_x}, {"max_x", max_x}, {"min_y", min_y}, {"max_y", max_y}}) {
+        if (!std::isfinite(v)) bad(key, "must be finite [m]");
+        // Cell indices are int: an extent far from the origin would overflow them.
+        if (std::abs(v / resolution_m) > kMaxCellIndex) {
+            std::ostringstream os;
+            os << v << " m is cell index " << v / resolution_m << " at " << resolution_m
+               << " m cells, beyond the +-" << kMaxCellIndex << " the grid can index";
+            bad(key, os.str());
+        }
+    }
     if (max_x < min_x || max_y < min_y) bad("min_x/max_x/min_y/max_y", "max must not be below min");
     for (const auto& [key, v] : {std::pair{"local_size_m", local_size_m},
                                  {"local_resolution", local_resolution_m},
@@ -160,7 +237,7 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     fill.read(s);
     sensors.load(s);
     s.finish();
-    validate();
+    validateIn(s, *this);
 }
 
 void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
@@ -200,18 +277,25 @@ void CMultiBinElevationMap::TInsertionOptions::validate() const {
         throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key +
                                     "': " + what);
     };
-    if (!(certainty_increment > 0)) bad("certainty_increment", "must be positive");
-    if (!(max_elevation_uncertainty_m > 0))
-        bad("max_elevation_uncertainty", "must be positive [m]");
-    if (!(height_sigma_floor_m >= 0)) bad("height_sigma_floor", "must be >= 0 [m]");
-    if (default_pose_sigmas.size() != 6) bad("default_pose_sigmas", "needs 6 values");
+    const auto finite = [](double v) { return std::isfinite(v); };
+    if (!(certainty_increment > 0) || !finite(certainty_increment))
+        bad("certainty_increment", "must be positive and finite");
+    if (!(max_elevation_uncertainty_m > 0) || !finite(max_elevation_uncertainty_m))
+        bad("max_elevation_uncertainty", "must be positive and finite [m]");
+    if (!(height_sigma_floor_m >= 0) || !finite(height_sigma_floor_m))
+        bad("height_sigma_floor", "must be >= 0 and finite [m]");
+    if (default_pose_sigmas.size() != 6)
+        bad("default_pose_sigmas",
+            "needs 6 values, has " + std::to_string(default_pose_sigmas.size()));
     for (double v : default_pose_sigmas)
-        if (!(v >= 0)) bad("default_pose_sigmas", "values must be >= 0");
+        if (!(v >= 0) || !finite(v)) bad("default_pose_sigmas", "values must be >= 0 and finite");
     if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt", "must be >= 0 [s]");
-    if (!(range_sigma_m > 0)) bad("range_sigma", "must be positive [m]");
-    if (!(visibility.margin_m >= 0)) bad("visibility_margin", "must be >= 0 [m]");
-    if (!(visibility.certaintyDecrement > 0))
-        bad("visibility_certainty_decrement", "must be positive");
+    if (!(range_sigma_m > 0) || !finite(range_sigma_m))
+        bad("range_sigma", "must be positive and finite [m]");
+    if (!(visibility.margin_m >= 0) || !finite(visibility.margin_m))
+        bad("visibility_margin", "must be >= 0 and finite [m]");
+    if (!(visibility.certaintyDecrement > 0) || !finite(visibility.certaintyDecrement))
+        bad("visibility_certainty_decrement", "must be positive and finite");
     fill.validate();
     if (!(min_range_m >= 0 && max_range_m > min_range_m))
         bad("min_range/max_range", "need 0 <= min_range < max_range [m]");
@@ -234,6 +318,7 @@ CMultiBinElevationMap::TMapDefinition::TMapDefinition() = default;
 
 void CMultiBinElevationMap::TMapDefinition::loadFromConfigFile_map_specific(
     const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix) {
+    checkMapSections(source, sectionNamePrefix);
     creationOpts.loadFromConfigFile(source, sectionNamePrefix + "_creationOpts");
     insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 }
@@ -346,113 +431,14 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
     return p;
 }
 
-namespace {
-/** The surface estimate of one cell: its winning bin, fused with the neighbouring bins (index
- * +-1, +-2, ... while contiguous) whose heights agree with it within 3 sigma. A surface whose
- * height lies near a bin boundary spreads its points over two bins, each of which then holds a
- * truncated, biased share; they are one hypothesis, not two. Bins that disagree stay alternative
- * hypotheses. */
-struct CellSurface {
-    double height_m = 0, variance_m2 = 0, certainty = 0;
-    int firstBin = 0, lastBin = 0;  //!< the bin indices merged into the surface
-};
-bool cellSurface(const multibin::BinGrid& grid, double x_m, double y_m,
-                 const multibin::BinUpdateParams& p, CellSurface& out) {
-    const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
-    const multibin::Bin* win = grid.winningBin(ix, iy);
-    if (!win) return false;
-    const double floor_m2 = p.varianceFloor_m2;
-    double info = 1.0 / std::max<double>(win->variance_m2, floor_m2);
-    double weighted_m = info * win->height_m;
-    out.certainty = win->certainty;
-    out.firstBin = out.lastBin = win->index;
-    for (const int dir : {-1, 1}) {
-        for (int n = win->index + dir;; n += dir) {
-            const multibin::Bin* next = nullptr;
-            grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
-                if (b.index == n && b.certainty > 0) next = &b;
-            });
-            if (!next) break;
-            const double v = std::max<double>(next->variance_m2, floor_m2);
-            const double h = weighted_m / info, vNow = 1.0 / info;
-            if ((next->height_m - h) * (next->height_m - h) > 9.0 * (v + vNow)) break;
-            info += 1.0 / v;
-            weighted_m += next->height_m / v;
-            out.certainty += next->certainty;
-            (dir < 0 ? out.firstBin : out.lastBin) = n;
-        }
-    }
-    out.height_m = weighted_m / info;
-    out.variance_m2 = std::max(1.0 / info, floor_m2);
-    return true;
-}
-
-/** Adds the relief of the cell to its variance [m^2]: the map gives one height per cell, the
- * points sample parts of it, and over a cell of side s on a slope g the heights spread with
- * variance (g s)^2 / 12 (uniform over the cell). g comes from the neighbours' surfaces (central
- * differences, one-sided at gaps). Without it sigma is a few mm on 45 degree rock faces where
- * the cell's height is uncertain by a centimetre. */
-void addReliefVariance(const multibin::BinGrid& grid, double x_m, double y_m,
-                       const multibin::BinUpdateParams& p, CellSurface& cell) {
-    const double s = grid.cellSize_m();
-    double slope2 = 0;
-    for (const auto& [dx, dy] : {std::pair<double, double>{s, 0.0}, {0.0, s}}) {
-        CellSurface lo, hi;
-        const bool haveLo = cellSurface(grid, x_m - dx, y_m - dy, p, lo);
-        const bool haveHi = cellSurface(grid, x_m + dx, y_m + dy, p, hi);
-        double g = 0;
-        if (haveLo && haveHi)
-            g = (hi.height_m - lo.height_m) / (2 * s);
-        else if (haveLo)
-            g = (cell.height_m - lo.height_m) / s;
-        else if (haveHi)
-            g = (hi.height_m - cell.height_m) / s;
-        slope2 += g * g;
-    }
-    cell.variance_m2 += slope2 * s * s / 12.0;
-    // Certain bins outside the surface: the cell also holds surfaces at other heights (a step
-    // inside the cell, its top and its foot seen from different places). The truth of the cell,
-    // the mean over its area, lies between them: their spread around the reported height,
-    // weighted by each bin's share of the cell's certainty, is part of the cell's uncertainty.
-    double otherCertainty = 0, otherSpread_m2 = 0;
-    grid.forEachBin(grid.cellIndex(x_m), grid.cellIndex(y_m), [&](const multibin::Bin& b) {
-        if (b.certainty <= 0 || (b.index >= cell.firstBin && b.index <= cell.lastBin)) return;
-        otherCertainty += b.certainty;
-        otherSpread_m2 += b.certainty * (b.height_m - cell.height_m) * (b.height_m - cell.height_m);
-    });
-    if (otherCertainty > 0) cell.variance_m2 += otherSpread_m2 / (otherCertainty + cell.certainty);
-}
-}  // namespace
-
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
-    const multibin::BinUpdateParams p = binUpdateParams();
-    CellSurface g, l;
-    const bool haveG = cellSurface(m_impl->grid, x_m, y_m, p, g);
-    const bool haveL = isDualGrid() && cellSurface(m_impl->local, x_m, y_m, p, l);
-    if (!haveG && !haveL) return false;
-    if (insertionOptions.relief_sigma) {
-        if (haveG) addReliefVariance(m_impl->grid, x_m, y_m, p, g);
-        if (haveL) addReliefVariance(m_impl->local, x_m, y_m, p, l);
-    }
-    if (!haveG || !haveL) {
-        const CellSurface& c = haveG ? g : l;
-        height_m = c.height_m;
-        sigma_m = std::sqrt(c.variance_m2);
-        return true;
-    }
-    // Both grids: their data are disjoint (each observation updates one grid), so agreeing
-    // estimates are fused by inverse variance; disagreeing ones leave the more certain.
-    const double d = l.height_m - g.height_m;
-    if (d * d <= 9.0 * (g.variance_m2 + l.variance_m2)) {
-        const double v = 1.0 / (1.0 / g.variance_m2 + 1.0 / l.variance_m2);
-        height_m = v * (l.height_m / l.variance_m2 + g.height_m / g.variance_m2);
-        sigma_m = std::sqrt(v);
-    } else {
-        const CellSurface& c = l.certainty >= g.certainty ? l : g;
-        height_m = c.height_m;
-        sigma_m = std::sqrt(c.variance_m2);
-    }
+    multibin::CellSurface c;
+    if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,
+                             binUpdateParams(), insertionOptions.relief_sigma, c))
+        return false;
+    height_m = c.height_m;
+    sigma_m = std::sqrt(c.variance_m2);
     return true;
 }
 
@@ -503,6 +489,8 @@ bool CMultiBinElevationMap::internal_canComputeObservationLikelihood(
 // ---------------------------------------------------------------------------------------------
 bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y, const double z,
                                                   const TPointInsertParams& params) {
+    creationOptions.validate();
+    insertionOptions.validate();
     const double sigma = params.pt_z_std > 0 ? params.pt_z_std : insertionOptions.range_sigma_m;
     multibin::PointsWithCov pts(1);
     pts[0].point_m = Eigen::Vector3f(float(x), float(y), float(z));

@@ -10,6 +10,10 @@
 #include <mrpt/obs/CObservationStereoImages.h>
 #include "CMultiBinElevationMap_impl.h"
 
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
 #include <algorithm>
 #include <cmath>
 
@@ -34,6 +38,10 @@ void CMultiBinElevationMap::writeBackLocalCell(int ix, int iy) {
 }
 
 void CMultiBinElevationMap::recenter(double x_m, double y_m) {
+    if (!std::isfinite(x_m) || !std::isfinite(y_m))
+        throw std::invalid_argument("CMultiBinElevationMap::recenter: the position (" +
+                                    std::to_string(x_m) + ", " + std::to_string(y_m) +
+                                    ") is not finite");
     if (!isDualGrid()) return;
     m_impl->fillStale = true;
     // Global first, so that local cells written back land inside it.

@@ -15,7 +15,7 @@ using namespace mrpt::maps;
 void CMultiBinElevationMap::dem_update_map() {
     if (!m_impl->fillStale) return;
     const multibin::CellWindow w = m_impl->grid.window();
-    multibin::fill::HeightRaster raster(w.nx, w.ny, m_impl->grid.cellSize_m());
+    multibin::fill::HeightRaster raster(multibin::Lattice{m_impl->grid.cellSize_m(), w});
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             double h, s;
@@ -37,12 +37,12 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
     const int ix = m_impl->grid.cellIndex(x_m), iy = m_impl->grid.cellIndex(y_m);
     if (!m_impl->fillWindow.contains(ix, iy)) return HeightSource::Unknown;
     const size_t k = m_impl->fill.index(ix - m_impl->fillWindow.ix0, iy - m_impl->fillWindow.iy0);
-    using multibin::fill::FillSource;
-    const FillSource src = m_impl->fill.source[k];
-    if (src != FillSource::Median && src != FillSource::Gaussian) return HeightSource::Unknown;
+    if (!m_impl->fill.isFilled(k)) return HeightSource::Unknown;
     height_m = m_impl->fill.height_m[k];
     sigma_m = m_impl->fill.sigma_m[k];
-    return src == FillSource::Median ? HeightSource::FilledMedian : HeightSource::FilledSurface;
+    return m_impl->fill.source[k] == multibin::HeightSource::FilledMedian
+               ? HeightSource::FilledMedian
+               : HeightSource::FilledSurface;
 }
 
 bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,

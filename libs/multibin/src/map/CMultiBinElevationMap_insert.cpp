@@ -6,9 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/VisibilityConstraint.h"
+#include "multibin/sensors/SensorDispatch.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;
@@ -24,6 +27,21 @@ bool canGrowTheMap(const PointWithCov& p, const Eigen::Vector3d& sensor_m, doubl
            std::abs(p.point_m.y() - sensor_m.y()) <= half_m && !std::isnan(p.cov_m2.zz) &&
            params.passesEq13(p.cov_m2.zz);
 }
+
+/** Options may be set in code after construction: every insertion entry point checks them
+ * before they reach the grid (a NaN certainty increment makes invalid bins). */
+void validateOptions(const CMultiBinElevationMap& map) {
+    map.creationOptions.validate();
+    map.insertionOptions.validate();
+}
+
+/** t1 - t0 [s] without wrapping: MRPT's timeDifference subtracts int64 ticks, which wraps for
+ * timestamps 2^63 ticks apart. */
+double secondsBetween(mrpt::Clock::time_point t0, mrpt::Clock::time_point t1) {
+    const double ticks =
+        double(t1.time_since_epoch().count()) - double(t0.time_since_epoch().count());
+    return ticks * double(mrpt::Clock::period::num) / double(mrpt::Clock::period::den);
+}
 }  // namespace
 
 bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
@@ -34,6 +52,7 @@ bool CMultiBinElevationMap::acceptsLabel(const std::string& label) const {
 bool CMultiBinElevationMap::internal_insertObservation(
     const mrpt::obs::CObservation& obs,
     const std::optional<const mrpt::poses::CPose3D>& robotPose) {
+    validateOptions(*this);
     if (const auto* rp = dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs)) {
         // Not inserted: kept as the pose PDF of the observations that follow.
         m_impl->lastRobotPose = rp->pose;
@@ -45,10 +64,9 @@ bool CMultiBinElevationMap::internal_insertObservation(
     if (m_impl->lastRobotPose) {
         const bool timesKnown =
             obs.timestamp != INVALID_TIMESTAMP && m_impl->lastRobotPoseTime != INVALID_TIMESTAMP;
-        const double dt =
-            timesKnown
-                ? std::abs(mrpt::system::timeDifference(m_impl->lastRobotPoseTime, obs.timestamp))
-                : std::numeric_limits<double>::infinity();
+        const double dt = timesKnown
+                              ? std::abs(secondsBetween(m_impl->lastRobotPoseTime, obs.timestamp))
+                              : std::numeric_limits<double>::infinity();
         if (dt <= insertionOptions.robot_pose_max_dt_s) {
             pdf = *m_impl->lastRobotPose;
             haveCov = true;
@@ -79,15 +97,24 @@ void CMultiBinElevationMap::forEachObservationWithPosePdf(
     const std::function<void(const mrpt::obs::CObservation&,
                              const mrpt::poses::CPose3DPDFGaussian&)>& visit,
     const std::function<void(size_t, size_t)>& progress) {
+    // Every keyframe is checked before any is visited: a null pose, sensory frame or observation
+    // (MRPT reads an object of the wrong class as null) is an error, not a silent skip.
     for (size_t i = 0; i < simplemap.size(); i++) {
         const auto& [posePdf, sf] = simplemap.get(i);
-        if (posePdf && sf) {
+        const std::string where = "CMultiBinElevationMap: simplemap keyframe " + std::to_string(i);
+        if (!posePdf) throw std::invalid_argument(where + " has no pose (null)");
+        if (!sf) throw std::invalid_argument(where + " has no sensory frame (null)");
+        for (const auto& obs : *sf)
+            if (!obs) throw std::invalid_argument(where + " holds a null observation");
+    }
+    for (size_t i = 0; i < simplemap.size(); i++) {
+        const auto& [posePdf, sf] = simplemap.get(i);
+        {
             mrpt::poses::CPose3DPDFGaussian pdf;
             const auto [cov, mean] = posePdf->getCovarianceAndMean();
             pdf.mean = mean;
             pdf.cov = cov;
-            for (const auto& obs : *sf)
-                if (obs) visit(*obs, pdf);
+            for (const auto& obs : *sf) visit(*obs, pdf);
         }
         if (progress) progress(i + 1, simplemap.size());
     }
@@ -107,6 +134,7 @@ size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
 
 bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
                                               const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+    validateOptions(*this);
     if (!acceptsLabel(obs.sensorLabel)) {
         m_impl->skippedByLabel++;
         return false;
@@ -117,23 +145,25 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                                         obs.sensorLabel + "' has a NaN or infinite component");
     obs.load();  // externally stored observations
 
-    multibin::InsertStats sensorStats;  // rejections before the insertion core
     multibin::sensors::SensorPoints sensed;
     if (!multibin::sensors::observationToSensorPoints(
             obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-            insertionOptions.max_range_m, m_impl->sensorState, sensorStats, sensed))
+            insertionOptions.max_range_m, m_impl->sensorState, sensed))
         return false;  // not an observation this map models
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
     const double continuityBound_m = sensed.continuityBound_m;
-    m_impl->stats += sensorStats;
+    // Rejections before the insertion core: the model's own counts, added up here.
+    m_impl->sensorState.stats += sensed.stats;
+    m_impl->stats.outOfRange += sensed.stats.outOfRange();
+    m_impl->stats.notFinite += sensed.stats.notFinite();
     if (sensorPoints.empty()) return false;
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
     if (isDualGrid()) {
         recenter(robotPose.mean.x(), robotPose.mean.y());
-    } else if (growthNeeded(sensorPoints, robotPose.mean + sensorPose, propagator)) {
+    } else if (growthNeeded(sensorPoints, propagator)) {
         // Growth is sized by all map-frame points: propagate them first (the rare case).
         PointsWithCov mapPoints;
         propagator.apply(sensorPoints, mapPoints);
@@ -157,7 +187,6 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
 }
 
 bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
-                                         const mrpt::poses::CPose3D& sensorInMap,
                                          const multibin::PosePropagator& propagator) const {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || sensorPoints.empty()) return false;
@@ -171,10 +200,8 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     const double cell = m_impl->grid.cellSize_m(), half = 0.5 * c.max_size_m;
     const double x0 = w.ix0 * cell, x1 = (w.ix0 + w.nx) * cell;
     const double y0 = w.iy0 * cell, y1 = (w.iy0 + w.ny) * cell;
-    const Eigen::Matrix3d R = sensorInMap.getRotationMatrix().asEigen();
-    const double tx = sensorInMap.x(), ty = sensorInMap.y();
-    const double tNorm = std::abs(tx) + std::abs(ty) + std::abs(sensorInMap.z());
     const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
+    const double tNorm = s.cwiseAbs().sum();
     const multibin::BinUpdateParams params = binUpdateParams();
     constexpr size_t kBatch = 256;
     PointWithCov exact[kBatch];
@@ -192,14 +219,11 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
         return grows;
     };
     // Scalar code: about 20 instructions a point, most points leave at the first test.
-    const double r00 = R(0, 0), r01 = R(0, 1), r02 = R(0, 2);
-    const double r10 = R(1, 0), r11 = R(1, 1), r12 = R(1, 2);
     for (const PointWithCov& p : sensorPoints) {
-        const double px = p.point_m.x(), py = p.point_m.y(), pz = p.point_m.z();
-        const double qx = r00 * px + r01 * py + r02 * pz + tx;
-        const double qy = r10 * px + r11 * py + r12 * pz + ty;
-        const double slack =
-            1e-4 + 1e-5 * (std::abs(px) + std::abs(py) + std::abs(pz) + tNorm);  // [m]
+        const Eigen::Vector2d q = propagator.horizontalInMap_m(p.point_m);
+        const double qx = q.x(), qy = q.y();
+        const double slack = 1e-4 + 1e-5 * (std::abs(p.point_m.x()) + std::abs(p.point_m.y()) +
+                                            std::abs(p.point_m.z()) + tNorm);  // [m]
         if (qx - slack >= x0 && qx + slack <= x1 && qy - slack >= y0 && qy + slack <= y1)
             continue;  // clearly inside the window
         if (std::abs(qx - s.x()) > half + slack || std::abs(qy - s.y()) > half + slack)
@@ -213,6 +237,7 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    validateOptions(*this);
     return insertIntoGrid(
         isDualGrid() ? m_impl->local : m_impl->grid,
         [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {

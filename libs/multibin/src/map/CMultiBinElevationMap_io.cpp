@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "multibin/io/RasterExport.h"
+#include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
 
@@ -176,8 +177,15 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
                     out = float(static_cast<int>(src));
                     break;
                 case RasterLayer::Certainty: {
-                    const multibin::Bin* b = m_impl->grid.winningBin(ix, iy);
-                    out = b ? b->certainty : 0.f;
+                    // The certainty of the surface the height layer reports (0 where filled).
+                    multibin::CellSurface c;
+                    out = src == HeightSource::Measured &&
+                                  multibin::surfaceAt(
+                                      m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
+                                      m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy),
+                                      binUpdateParams(), false, c)
+                              ? float(c.certainty)
+                              : 0.f;
                 } break;
             }
         }

@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/map/VisibilityConstraint.h"
 
+#include "multibin/map/CellSurface.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -96,15 +98,16 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     for (const BinGrid::UpdatedCell& u : updated) {
         const double tz = u.maxHeight_m;
         const float decrement = vis.certaintyDecrement * float(u.points);
-        // The certainty of the cell's winning bin before its own edit (below); needed only when
-        // a ray meets a conflicting bin. Rays never edit updated cells, so a late look-up gives
-        // the same value unless the cell's own edit ran: then it is taken first.
-        float targetCertainty = 0;
+        // The certainty of the cell's surface (CellSurface) before its own edit (below); needed
+        // only when a ray meets a conflicting bin. Rays never edit updated cells, so a late
+        // look-up gives the same value unless the cell's own edit ran: then it is taken first.
+        double targetCertainty = 0;
         bool haveTarget = false;
         auto target = [&]() {
             if (!haveTarget) {
-                const Bin* winner = grid.winningBin(u.ix, u.iy);
-                targetCertainty = winner ? winner->certainty : 0.f;
+                CellSurface surface;
+                targetCertainty =
+                    cellSurface(grid, u.ix, u.iy, binParams, surface) ? surface.certainty : 0.0;
                 haveTarget = true;
             }
             return targetCertainty;

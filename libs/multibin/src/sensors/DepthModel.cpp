@@ -7,52 +7,35 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
+
+#include "RayPoint.h"
 
 namespace multibin::sensors {
 
-DepthStats& DepthStats::operator+=(const DepthStats& o) {
-    points += o.points;
-    notFinite += o.notFinite;
-    outOfRange += o.outOfRange;
-    kept += o.kept;
-    return *this;
-}
-
 SymmetricCov3 depthPointCovariance(const Eigen::Vector3f& p_m, const DepthModelOptions& opts) {
     const double r = p_m.cast<double>().norm();
-    const Eigen::Vector3d d = p_m.cast<double>() / r;
-    const double sa = opts.axialSigma_m(r), sl = opts.lateralSigma_rad * r;
-    const Eigen::Matrix3d C =
-        sa * sa * d * d.transpose() + sl * sl * (Eigen::Matrix3d::Identity() - d * d.transpose());
-    return SymmetricCov3::fromMatrix(C);
+    return rayCovariance(p_m, opts.axialSigma_m(r), opts.lateralSigma_rad * r);
 }
 
 void appendDepthPoint(const Eigen::Vector3f& p_m, const DepthModelOptions& opts, double minRange_m,
                       double maxRange_m, PointsWithCov& out, DepthStats& stats) {
     stats.points++;
-    if (!p_m.allFinite()) {
-        stats.notFinite++;
-        return;
-    }
-    const float r = p_m.norm();
-    if (!(r > 0) || r < minRange_m || r > maxRange_m) {
-        stats.outOfRange++;
-        return;
-    }
-    out.push_back({p_m, depthPointCovariance(p_m, opts)});
-    stats.kept++;
+    count(appendRayPoint(
+              p_m, minRange_m, maxRange_m,
+              [&](double r) {
+                  return std::pair{opts.axialSigma_m(r), opts.lateralSigma_rad * r};
+              },
+              out),
+          stats);
 }
 
 namespace {
 void appendPointsMap(const mrpt::maps::CPointsMap& pts, const DepthModelOptions& opts,
                      double minRange_m, double maxRange_m, PointsWithCov& out, DepthStats& stats) {
-    const auto& xs = pts.getPointsBufferRef_x();
-    const auto& ys = pts.getPointsBufferRef_y();
-    const auto& zs = pts.getPointsBufferRef_z();
-    out.reserve(out.size() + xs.size());
-    for (size_t i = 0; i < xs.size(); i++)
-        appendDepthPoint(Eigen::Vector3f(xs[i], ys[i], zs[i]), opts, minRange_m, maxRange_m, out,
-                         stats);
+    forEachCloudPoint(pts, out, [&](const Eigen::Vector3f& p) {
+        appendDepthPoint(p, opts, minRange_m, maxRange_m, out, stats);
+    });
 }
 }  // namespace
 

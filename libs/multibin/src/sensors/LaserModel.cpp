@@ -8,17 +8,6 @@
 
 namespace multibin::sensors {
 
-LaserStats& LaserStats::operator+=(const LaserStats& o) {
-    beams += o.beams;
-    noReturn += o.noReturn;
-    notFinite += o.notFinite;
-    outOfRange += o.outOfRange;
-    lowIntensity += o.lowIntensity;
-    mixedPixel += o.mixedPixel;
-    kept += o.kept;
-    return *this;
-}
-
 double restoredIntensity(double rawIntensity, double agcVoltage) {
     return std::sqrt(std::max(0.0, rawIntensity) * 1023.0 / agcVoltage);
 }

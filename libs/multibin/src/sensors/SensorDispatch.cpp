@@ -4,80 +4,58 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRotatingScan.h>
+#include <mrpt/obs/CObservationStereoImages.h>
+#include <mrpt/obs/CObservationVelodyneScan.h>
 #include <mrpt/system/datetime.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <stdexcept>
+#include <string>
 
-#include "multibin/sensors/StereoDisparity.h"
+#include "multibin/sensors/DepthModel.h"
+#include "multibin/sensors/LaserModel.h"
+#include "multibin/sensors/LidarModel.h"
 #include "multibin/sensors/StereoModel.h"
 
 namespace multibin::sensors {
 
-StereoStats& StereoStats::operator+=(const StereoStats& o) {
-    pairs += o.pairs;
-    tableBuilds += o.tableBuilds;
-    pixels += o.pixels;
-    noDisparity += o.noDisparity;
-    halo += o.halo;
-    nearCluster += o.nearCluster;
-    tooNear += o.tooNear;
-    outOfRange += o.outOfRange;
-    kept += o.kept;
-    return *this;
+namespace {
+/** The model chosen for `obs` (its label's entry in sensor_models, else `classDefault`), which must
+ * be one of `allowed`. */
+SensorModelKind chooseModel(const mrpt::obs::CObservation& obs, const SensorModelOptions& opts,
+                            SensorModelKind classDefault,
+                            std::initializer_list<SensorModelKind> allowed) {
+    const SensorModelKind kind = opts.modelFor(obs.sensorLabel, classDefault);
+    for (SensorModelKind k : allowed)
+        if (k == kind) return kind;
+    std::string names;
+    for (SensorModelKind k : allowed)
+        names += std::string(names.empty() ? "" : " or ") + sensorModelName(k);
+    throw std::invalid_argument("CMultiBinElevationMap insertion option 'sensor_models': label '" +
+                                obs.sensorLabel + "' is given the " + sensorModelName(kind) +
+                                " model, but its observation is a " +
+                                obs.GetRuntimeClass()->className + ", which takes " + names);
 }
-
-void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const StereoModelOptions& opts,
-                    double minRange_m, double maxRange_m, SensorModelState& state,
-                    PointsWithCov& out) {
-    StereoStats& st = state.stats.stereo;
-    const StereoGeometry g = StereoGeometry::fromObservation(obs);
-    DisparityImage disp;
-    if (obs.hasImageDisparity) {
-        disp = decodeDisparityImage(obs.imageDisparity);
-    } else {
-        if (!obs.hasImageRight)
-            throw std::invalid_argument(
-                "CObservationStereoImages '" + obs.sensorLabel +
-                "': neither a disparity image nor a right image (hasImageRight = false)");
-        disp = computeDisparitySGBM(obs.imageLeft, obs.imageRight, opts);
-    }
-    if (disp.width != g.width || disp.height != g.height)
-        throw std::invalid_argument("CObservationStereoImages '" + obs.sensorLabel +
-                                    "': image size differs from leftCamera's ncols x nrows");
-    if (opts.haloFilter) st.halo += removeHalos(disp, opts);
-    if (opts.nearClusterFilter) st.nearCluster += removeNearClusters(disp, opts);
-
-    auto& cached = state.stereoTables[obs.sensorLabel];
-    if (!cached || !cached->matches(g, opts)) {
-        cached = std::make_shared<const StereoCovarianceTable>(g, opts);
-        st.tableBuilds++;
-    }
-    const StereoCovarianceTable& table = *cached;
-    st.pairs++;
-    out.clear();
-    const StereoPixelCounts c =
-        table.appendPoints(disp, opts.subsample, opts.minDepth_m, minRange_m, maxRange_m, out);
-    st.pixels += c.pixels;
-    st.noDisparity += c.noDisparity;
-    st.tooNear += c.tooNear;
-    st.outOfRange += c.outOfRange;
-    st.kept += c.kept;
-}
+}  // namespace
 
 bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
                                const mrpt::poses::CPose3DPDFGaussian& robotPose,
                                const SensorModelOptions& opts, double minRange_m, double maxRange_m,
-                               SensorModelState& state, InsertStats& coreStats, SensorPoints& out) {
+                               SensorModelState& state, SensorPoints& out) {
+    using K = SensorModelKind;
     out.points.clear();
     out.continuityBound_m = std::numeric_limits<double>::infinity();
+    out.stats = {};
     if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
-        LaserStats ls;
-        laserScanToPoints(*scan, opts.laser, minRange_m, maxRange_m, out.points, ls);
-        state.stats.laser += ls;
-        coreStats.outOfRange += ls.noReturn + ls.outOfRange;
-        coreStats.notFinite += ls.notFinite;
         out.sensorPose = scan->sensorPose;
+        if (chooseModel(obs, opts, K::laser, {K::laser, K::lidar}) == K::lidar) {
+            lidarScanToPoints(*scan, opts.lidar, minRange_m, maxRange_m, out.points,
+                              out.stats.lidar);
+            return true;
+        }
+        laserScanToPoints(*scan, opts.laser, minRange_m, maxRange_m, out.points, out.stats.laser);
         if (opts.laser.continuity) {
             const auto prev = state.previousScan.find(scan->sensorLabel);
             const bool timesKnown = prev != state.previousScan.end() &&
@@ -93,26 +71,50 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
         return true;
     }
     if (const auto* stereo = dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs)) {
-        const size_t before = state.stats.stereo.tooNear + state.stats.stereo.outOfRange;
-        stereoToPoints(*stereo, opts.stereo, minRange_m, maxRange_m, state, out.points);
-        coreStats.outOfRange += state.stats.stereo.tooNear + state.stats.stereo.outOfRange - before;
+        chooseModel(obs, opts, K::stereo, {K::stereo});
+        stereoToPoints(*stereo, opts.stereo, minRange_m, maxRange_m,
+                       state.stereoTables[stereo->sensorLabel], out.points, out.stats.stereo);
         out.sensorPose = mrpt::poses::CPose3D(stereo->cameraPose);  // left camera on the robot
         return true;
     }
-    DepthStats ds;
     if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
-        depthScanToPoints(*depth, opts.depth, minRange_m, maxRange_m, out.points, ds);
+        chooseModel(obs, opts, K::depth, {K::depth});
+        depthScanToPoints(*depth, opts.depth, minRange_m, maxRange_m, out.points, out.stats.depth);
         out.sensorPose = depth->sensorPose;
-    } else if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
-        pointCloudToPoints(*cloud, opts.depth, minRange_m, maxRange_m, out.points, ds);
-        out.sensorPose = cloud->sensorPose;
-    } else {
-        return false;
+        return true;
     }
-    state.stats.depth += ds;
-    coreStats.outOfRange += ds.outOfRange;
-    coreStats.notFinite += ds.notFinite;
-    return true;
+    if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
+        out.sensorPose = cloud->sensorPose;
+        switch (chooseModel(obs, opts, K::depth, {K::depth, K::lidar, K::stereo})) {
+            case K::lidar:
+                lidarCloudToPoints(*cloud, opts.lidar, minRange_m, maxRange_m, out.points,
+                                   out.stats.lidar);
+                break;
+            case K::stereo:
+                stereoCloudToPoints(*cloud, opts.stereo, minRange_m, maxRange_m, out.points,
+                                    out.stats.stereo);
+                break;
+            default:
+                pointCloudToPoints(*cloud, opts.depth, minRange_m, maxRange_m, out.points,
+                                   out.stats.depth);
+        }
+        return true;
+    }
+    if (const auto* velodyne = dynamic_cast<const mrpt::obs::CObservationVelodyneScan*>(&obs)) {
+        chooseModel(obs, opts, K::lidar, {K::lidar});
+        velodyneScanToPoints(*velodyne, opts.lidar, minRange_m, maxRange_m, out.points,
+                             out.stats.lidar);
+        out.sensorPose = velodyne->sensorPose;
+        return true;
+    }
+    if (const auto* rotating = dynamic_cast<const mrpt::obs::CObservationRotatingScan*>(&obs)) {
+        chooseModel(obs, opts, K::lidar, {K::lidar});
+        rotatingScanToPoints(*rotating, opts.lidar, minRange_m, maxRange_m, out.points,
+                             out.stats.lidar);
+        out.sensorPose = rotating->sensorPose;
+        return true;
+    }
+    return false;
 }
 
 }  // namespace multibin::sensors

@@ -1,12 +1,16 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/SensorModelOptions.h"
 
+#include <mrpt/config/CConfigFileBase.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
+
+#include "multibin/io/StrictConfigSection.h"
 
 namespace multibin::sensors {
 
@@ -31,25 +35,89 @@ std::string joined(const Seq& v) {
     return os.str();
 }
 
-/** Parses `LABEL:value[,LABEL:value...]`. */
-std::map<std::string, double> parseAgc(StrictConfigSection& s, const std::string& key) {
+/** Parses `LABEL:value[,LABEL:value...]` into a map, each value through `parse(label, value)`,
+ * which fails the key itself for a bad value. */
+template <typename T, typename Parse>
+std::map<std::string, T> parseByLabel(StrictConfigSection& s, const std::string& key,
+                                      const Parse& parse) {
     std::vector<std::string> items;
     s.read(key, items);
-    std::map<std::string, double> out;
+    std::map<std::string, T> out;
     for (const auto& item : items) {
         const auto colon = item.rfind(':');
         if (colon == std::string::npos || colon == 0 || colon + 1 == item.size())
             s.fail(key, "expected LABEL:value, got '" + item + "'");
-        const std::string label = item.substr(0, colon), value = item.substr(colon + 1);
+        const std::string label = item.substr(0, colon);
+        out[label] = parse(label, item.substr(colon + 1));
+    }
+    return out;
+}
+
+std::map<std::string, double> parseAgc(StrictConfigSection& s, const std::string& key) {
+    return parseByLabel<double>(s, key, [&](const std::string& label, const std::string& value) {
         char* end = nullptr;
         const double v = std::strtod(value.c_str(), &end);
         if (end != value.c_str() + value.size() || !std::isfinite(v))
             s.fail(key, "AGC value of '" + label + "' is not a number: '" + value + "'");
-        out[label] = v;
-    }
-    return out;
+        return v;
+    });
+}
+
+constexpr std::pair<const char*, SensorModelKind> kModelNames[] = {
+    {"laser", SensorModelKind::laser},
+    {"lidar", SensorModelKind::lidar},
+    {"stereo", SensorModelKind::stereo},
+    {"depth", SensorModelKind::depth}};
+
+std::map<std::string, SensorModelKind> parseModels(StrictConfigSection& s, const std::string& key) {
+    return parseByLabel<SensorModelKind>(
+        s, key, [&](const std::string& label, const std::string& name) {
+            for (const auto& [word, kind] : kModelNames)
+                if (name == word) return kind;
+            s.fail(key, "unknown sensor model '" + name + "' for label '" + label +
+                            "': expected laser, lidar, stereo or depth");
+        });
 }
 }  // namespace
+
+const char* sensorModelName(SensorModelKind kind) {
+    for (const auto& [word, k] : kModelNames)
+        if (k == kind) return word;
+    return "?";
+}
+
+SensorModelKind SensorModelOptions::modelFor(const std::string& label,
+                                             SensorModelKind classDefault) const {
+    const auto it = modelByLabel.find(label);
+    return it == modelByLabel.end() ? classDefault : it->second;
+}
+
+LidarModelOptions LidarModelOptions::forSensor(const std::string& name) {
+    // Sources and derivations: doc/sensor-models.md, "Lidar".
+    LidarModelOptions o;
+    o.sensor = name;
+    if (name == "vlp16") {
+        o.rangeSigma = {0.03, 0.0, 0.0};  // +-3 cm typical
+        o.angularSigma_rad = 0.001;       // 0.2 deg azimuth step / sqrt(12)
+        o.beamDivergence_rad = 0.003;     // 3.0 mrad (the larger, horizontal)
+    } else if (name == "os1") {
+        o.rangeSigma = {0.03, 0.0, 0.0};  // 1 sigma at SNR 100
+        o.angularSigma_rad = 0.00017;     // +-0.01 deg angular sampling accuracy
+        o.beamDivergence_rad = 0.0039;    // 0.13 deg FWHM -> 1/e^2 full angle
+    } else if (name == "utm30lx") {
+        o.rangeSigma = {0.03, 0.00067, 0.0};  // +-30 mm to 10 m, +-50 mm at 30 m
+        o.angularSigma_rad = 0.0013;          // 0.25 deg step / sqrt(12)
+        o.beamDivergence_rad = 0.0;           // not published
+    } else {
+        throw std::invalid_argument("unknown lidar '" + name + "': expected vlp16, os1 or utm30lx");
+    }
+    return o;
+}
+
+double LidarModelOptions::lateralSigma_m(double range_m) const {
+    return range_m * std::sqrt(angularSigma_rad * angularSigma_rad +
+                               beamDivergence_rad * beamDivergence_rad / 16.0);
+}
 
 int StereoModelOptions::numDisparitiesFor(int width_px) const {
     if (sgbmNumDisparities > 0) return sgbmNumDisparities;
@@ -98,6 +166,26 @@ void SensorModelOptions::load(StrictConfigSection& s) {
     s.read("stereo_near_cluster_max_area", stereo.nearClusterMaxArea_px);
     s.read("stereo_near_cluster_step", stereo.nearClusterStep_px);
     s.read("stereo_near_cluster_jump", stereo.nearClusterJump_px);
+    s.read("stereo_cloud_focal_length", stereo.cloudFocalLength_px);
+    s.read("stereo_cloud_baseline", stereo.cloudBaseline_m);
+    // Lidar: the sensor's published figures first, then the keys that override them
+    if (s.has("lidar_sensor")) {
+        std::string name;
+        s.read("lidar_sensor", name);
+        try {
+            lidar = LidarModelOptions::forSensor(name);
+        } catch (const std::invalid_argument& e) {
+            s.fail("lidar_sensor", e.what());
+        }
+    }
+    if (s.has("lidar_range_sigma_coeffs")) {
+        std::vector<double> c;
+        s.read("lidar_range_sigma_coeffs", c, 3);
+        lidar.rangeSigma = RangeSigmaCurve{c[0], c[1], c[2]};
+    }
+    s.read("lidar_angular_sigma", lidar.angularSigma_rad);
+    s.read("lidar_beam_divergence", lidar.beamDivergence_rad);
+    if (s.has("sensor_models")) modelByLabel = parseModels(s, "sensor_models");
     // Depth camera
     s.read("depth_axial_sigma", depth.axialSigma0_m);
     s.read("depth_axial_sigma_quadratic", depth.axialSigmaQuadratic_per_m);
@@ -151,6 +239,18 @@ void SensorModelOptions::save(mrpt::config::CConfigFileBase& c, const std::strin
     c.write(sec, "stereo_near_cluster_max_area", stereo.nearClusterMaxArea_px);
     c.write(sec, "stereo_near_cluster_step", stereo.nearClusterStep_px);
     c.write(sec, "stereo_near_cluster_jump", stereo.nearClusterJump_px);
+    c.write(sec, "stereo_cloud_focal_length", stereo.cloudFocalLength_px);
+    c.write(sec, "stereo_cloud_baseline", stereo.cloudBaseline_m);
+    c.write(sec, "lidar_sensor", lidar.sensor);
+    const RangeSigmaCurve& lr = lidar.rangeSigma;
+    c.write(sec, "lidar_range_sigma_coeffs",
+            joined(std::array<double, 3>{lr.c0_m, lr.c1, lr.c2_per_m}));
+    c.write(sec, "lidar_angular_sigma", lidar.angularSigma_rad);
+    c.write(sec, "lidar_beam_divergence", lidar.beamDivergence_rad);
+    std::string models;
+    for (const auto& [label, kind] : modelByLabel)
+        models += (models.empty() ? "" : ",") + label + ':' + sensorModelName(kind);
+    c.write(sec, "sensor_models", models);
     c.write(sec, "depth_axial_sigma", depth.axialSigma0_m);
     c.write(sec, "depth_axial_sigma_quadratic", depth.axialSigmaQuadratic_per_m);
     c.write(sec, "depth_axial_offset", depth.axialOffset_m);
@@ -205,6 +305,14 @@ void SensorModelOptions::validate() const {
     if (stereo.nearClusterMaxArea_px < 1) bad("stereo_near_cluster_max_area", "must be >= 1 [px]");
     if (!(stereo.nearClusterStep_px > 0)) bad("stereo_near_cluster_step", "must be positive [px]");
     if (!(stereo.nearClusterJump_px > 0)) bad("stereo_near_cluster_jump", "must be positive [px]");
+    if (!(stereo.cloudFocalLength_px > 0))
+        bad("stereo_cloud_focal_length", "must be positive [px]");
+    if (!(stereo.cloudBaseline_m > 0)) bad("stereo_cloud_baseline", "must be positive [m]");
+    const RangeSigmaCurve& lr = lidar.rangeSigma;
+    if (!(lr.c0_m >= 0 && lr.c1 >= 0 && lr.c2_per_m >= 0 && lr.c0_m + lr.c1 + lr.c2_per_m > 0))
+        bad("lidar_range_sigma_coeffs", "need c0, c1, c2 >= 0, not all zero");
+    if (!(lidar.angularSigma_rad >= 0)) bad("lidar_angular_sigma", "must be >= 0 [rad]");
+    if (!(lidar.beamDivergence_rad >= 0)) bad("lidar_beam_divergence", "must be >= 0 [rad]");
     if (!(depth.axialSigma0_m > 0)) bad("depth_axial_sigma", "must be positive [m]");
     if (!(depth.axialSigmaQuadratic_per_m >= 0)) bad("depth_axial_sigma_quadratic", "must be >= 0");
     if (!(depth.axialOffset_m >= 0)) bad("depth_axial_offset", "must be >= 0 [m]");

@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/StereoModel.h"
 
+#include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/poses/CPose3D.h>
 
 #include <Eigen/Geometry>
@@ -11,6 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <utility>
+
+#include "RayPoint.h"
 
 namespace multibin::sensors {
 
@@ -451,6 +454,57 @@ StereoPixelCounts StereoCovarianceTable::appendPoints(const DisparityImage& disp
         packRow(perRow, b, out, counts);
     }
     return counts;
+}
+
+void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const StereoModelOptions& opts,
+                    double minRange_m, double maxRange_m,
+                    std::shared_ptr<const StereoCovarianceTable>& table, PointsWithCov& out,
+                    StereoStats& stats) {
+    const StereoGeometry g = StereoGeometry::fromObservation(obs);
+    DisparityImage disp;
+    if (obs.hasImageDisparity) {
+        disp = decodeDisparityImage(obs.imageDisparity);
+    } else {
+        if (!obs.hasImageRight)
+            throw std::invalid_argument(
+                "CObservationStereoImages '" + obs.sensorLabel +
+                "': neither a disparity image nor a right image (hasImageRight = false)");
+        disp = computeDisparitySGBM(obs.imageLeft, obs.imageRight, opts);
+    }
+    if (disp.width != g.width || disp.height != g.height)
+        throw std::invalid_argument("CObservationStereoImages '" + obs.sensorLabel +
+                                    "': image size differs from leftCamera's ncols x nrows");
+    if (opts.haloFilter) stats.halo += removeHalos(disp, opts);
+    if (opts.nearClusterFilter) stats.nearCluster += removeNearClusters(disp, opts);
+
+    if (!table || !table->matches(g, opts)) {
+        table = std::make_shared<const StereoCovarianceTable>(g, opts);
+        stats.tableBuilds++;
+    }
+    stats.pairs++;
+    out.clear();
+    const StereoPixelCounts c =
+        table->appendPoints(disp, opts.subsample, opts.minDepth_m, minRange_m, maxRange_m, out);
+    stats.pixels += c.pixels;
+    stats.noDisparity += c.noDisparity;
+    stats.tooNear += c.tooNear;
+    stats.outOfRange += c.outOfRange;
+    stats.kept += c.kept;
+}
+
+void stereoCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
+                         const StereoModelOptions& opts, double minRange_m, double maxRange_m,
+                         PointsWithCov& out, StereoStats& stats) {
+    out.clear();
+    stats.pairs++;
+    if (!cloud.pointcloud) return;
+    const double f = opts.cloudFocalLength_px, sm = opts.matchingSigma_px;
+    const double axialPerR2 = std::sqrt(2.0) * sm / (f * opts.cloudBaseline_m);  // [1/m]
+    auto sigmas = [&](double r) { return std::pair{axialPerR2 * r * r, r * sm / f}; };
+    forEachCloudPoint(*cloud.pointcloud, out, [&](const Eigen::Vector3f& p) {
+        stats.pixels++;
+        count(appendRayPoint(p, minRange_m, maxRange_m, sigmas, out), stats);
+    });
 }
 
 }  // namespace multibin::sensors

@@ -311,7 +311,6 @@ private:
      * `sensorInMap` (the robot pose's mean composed with the sensor pose), without propagating
      * more than the few points near the window's edge. */
     bool growthNeeded(const multibin::PointsWithCov& sensorPoints,
-                      const mrpt::poses::CPose3D& sensorInMap,
                       const multibin::PosePropagator& propagator) const;
 
     /** The insertion core of one update cycle: BinGrid::insertPoints or insertSensorPoints. */

@@ -3,8 +3,7 @@
 
 #include <string>
 
-#include "multibin/fill/GaussianSurface.h"
-#include "multibin/fill/Kriging.h"
+// Included by the public map header: no other header of the library here.
 
 namespace mrpt::config {
 class CConfigFileBase;
@@ -15,6 +14,25 @@ class StrictConfigSection;
 }
 
 namespace multibin::fill {
+
+struct GaussianFitOptions;
+
+/** How the model size m of eq 16 is chosen. */
+enum class ModelCriterion {
+    AICc,  //!< corrected Akaike criterion (the paper's AIC; default)
+    BIC,   //!< Bayesian criterion: a stronger penalty, k ln n instead of about 2 k
+    /** Prediction of held-out data: the cells within 2 cells of the gap are hidden, the model is
+     * fitted on the rest and m minimises the weighted error of the fill (surface plus rim
+     * residuals) on them. Needs the gap, so only fillGaps() applies it; fitGaussianSurface()
+     * treats it as AICc. */
+    Holdout
+};
+
+/** Correlation function of the terrain residuals about the trend (isotropic, distance in cells). */
+enum class CovarianceFamily {
+    Exponential,  //!< rho(d) = exp(-d / r): rough, continuous surface (Matern nu = 1/2)
+    Matern32      //!< rho(d) = (1 + sqrt3 d / r) exp(-sqrt3 d / r): once differentiable
+};
 
 /** How a filled cell gets its sigma. */
 enum class FillSigmaModel {

@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "multibin/fill/FillOptions.h"
 #include "multibin/fill/ParticleSwarm.h"
 
 namespace multibin::fill {
@@ -41,17 +42,6 @@ struct GaussianSurface {
     double operator()(double i, double j) const;
     /** Parameters of the model: m + 1 amplitudes and 4 m shape parameters. */
     int parameters() const { return 1 + 5 * int(terms.size()); }
-};
-
-/** How the model size m is chosen. */
-enum class ModelCriterion {
-    AICc,  //!< corrected Akaike criterion (the paper's AIC; default)
-    BIC,   //!< Bayesian criterion: a stronger penalty, k ln n instead of about 2 k
-    /** Prediction of held-out data: the cells within 2 cells of the gap are hidden, the model is
-     * fitted on the rest and m minimises the weighted error of the fill (surface plus rim
-     * residuals) on them. Needs the gap, so only fillGaps() applies it; fitGaussianSurface()
-     * treats it as AICc. */
-    Holdout
 };
 
 /** How eq 16 is fitted. */

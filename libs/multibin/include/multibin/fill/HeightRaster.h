@@ -1,39 +1,37 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
-#include <cstdint>
 #include <vector>
+
+#include "multibin/geometry/Lattice.h"
+#include "multibin/map/MapTypes.h"
 
 namespace multibin::fill {
 
-/** Where the height of a cell of a FillResult comes from. */
-enum class FillSource : std::uint8_t {
-    Measured = 0,  //!< observed (certainty > 0): copied unchanged
-    Median = 1,    //!< never observed, filled by the weighted median of its neighbours
-    Gaussian = 2,  //!< never observed, filled by the Gaussian surface of its support area (eq 16)
-    Unfilled = 3   //!< never observed and left unknown (NaN): gap too large or no data near it
-};
-
 /** The input of gap filling: the winning bin of every cell of an elevation grid, as plain rows.
  *
- * Cell (ix, iy) is stored at index iy * nx + ix; ix grows with x (columns), iy with y (rows).
- * A cell is *measured* when certainty > 0 and its height and sigma are finite, sigma > 0; every
- * other cell is a gap to be filled (the map's "never observed": c = 0 in every bin). */
+ * The geometry is a multibin::Lattice: cell (ix, iy), column ix and row iy of the lattice, is
+ * stored at lattice.index(ix, iy) = iy * nx + ix. A cell is *measured* when certainty > 0 and its
+ * height and sigma are finite, sigma > 0; every other cell is a gap to be filled (the map's "never
+ * observed": c = 0 in every bin). */
 struct HeightRaster {
-    int nx = 0;                    //!< number of columns (x) [cells]
-    int ny = 0;                    //!< number of rows (y) [cells]
-    double cellSize_m = 0.015;     //!< cell side [m]
+    Lattice lattice;               //!< cells covered and their size
     std::vector<float> height_m;   //!< winning-bin height [m]; NaN where unknown
     std::vector<float> sigma_m;    //!< 1-sigma of that height [m]; NaN where unknown
     std::vector<float> certainty;  //!< winning-bin certainty c [-]; 0 = never observed
 
     HeightRaster() = default;
-    /** An nx x ny raster with every cell unknown (NaN height and sigma, certainty 0). */
+    /** A raster over `lattice` with every cell unknown (NaN height and sigma, certainty 0). */
+    explicit HeightRaster(const Lattice& lattice);
+    /** An nx x ny raster anchored at cell (0, 0), every cell unknown. */
     HeightRaster(int nx, int ny, double cellSize_m);
 
-    size_t size() const { return size_t(nx) * size_t(ny); }
-    size_t index(int ix, int iy) const { return size_t(iy) * size_t(nx) + size_t(ix); }
-    bool inside(int ix, int iy) const { return ix >= 0 && iy >= 0 && ix < nx && iy < ny; }
+    int nx() const { return lattice.nx(); }  //!< number of columns (x) [cells]
+    int ny() const { return lattice.ny(); }  //!< number of rows (y) [cells]
+    double cellSize_m() const { return lattice.cellSize_m; }
+    size_t size() const { return lattice.cellCount(); }
+    size_t index(int ix, int iy) const { return lattice.index(ix, iy); }
+    bool inside(int ix, int iy) const { return lattice.inside(ix, iy); }
     /** True if the cell holds a usable measurement (see the class comment). */
     bool isMeasured(size_t k) const;
     /** Marks a cell measured with the given height and sigma [m] (certainty 1 if c <= 0). */
@@ -45,17 +43,18 @@ struct HeightRaster {
     void validate() const;
 };
 
-/** The output of gap filling: one height, sigma and source per cell of the input raster.
+/** The output of gap filling: one height, sigma and source per cell of the input raster, on the
+ * input's lattice.
  *
  * Measured cells keep their height and sigma; filled cells get a height and a 1-sigma
- * uncertainty; Unfilled cells stay NaN. A height is never set to zero for lack of data. The
+ * uncertainty; Unknown cells stay NaN. A height is never set to zero for lack of data. The
  * input certainty is not part of the result: filled cells keep certainty 0 in the map, so
  * foothold selection can still avoid them. */
 struct FillResult {
-    int nx = 0, ny = 0;
-    std::vector<float> height_m;     //!< [m], NaN for Unfilled cells
-    std::vector<float> sigma_m;      //!< 1-sigma [m], NaN for Unfilled cells
-    std::vector<FillSource> source;  //!< where each height comes from
+    Lattice lattice;                   //!< the input raster's lattice
+    std::vector<float> height_m;       //!< [m], NaN for Unknown cells
+    std::vector<float> sigma_m;        //!< 1-sigma [m], NaN for Unknown cells
+    std::vector<HeightSource> source;  //!< where each height comes from
 
     /** Statistics of one run (for logs, tests and tuning). */
     struct Stats {
@@ -67,9 +66,11 @@ struct FillResult {
         int rimCheckHarmonic = 0;      //!< of those, gaps the rim check gave to the harmonic path
     } stats;
 
-    size_t index(int ix, int iy) const { return size_t(iy) * size_t(nx) + size_t(ix); }
+    int nx() const { return lattice.nx(); }
+    int ny() const { return lattice.ny(); }
+    size_t index(int ix, int iy) const { return lattice.index(ix, iy); }
     bool isFilled(size_t k) const {
-        return source[k] == FillSource::Median || source[k] == FillSource::Gaussian;
+        return source[k] == HeightSource::FilledMedian || source[k] == HeightSource::FilledSurface;
     }
 };
 

@@ -8,12 +8,6 @@
 
 namespace multibin::fill {
 
-/** Correlation function of the terrain residuals about the trend (isotropic, distance in cells). */
-enum class CovarianceFamily {
-    Exponential,  //!< rho(d) = exp(-d / r): rough, continuous surface (Matern nu = 1/2)
-    Matern32      //!< rho(d) = (1 + sqrt3 d / r) exp(-sqrt3 d / r): once differentiable
-};
-
 /** Covariance of the residual field z(x) - trend(x) at two cells d apart [cells]:
  * C(d) = sill_m2 rho(d / range_cells) for d > 0 and C(0) = sill_m2 + nugget_m2 (micro-scale
  * variance of a cell beyond the sensor noise, which each sample adds on its own). */

@@ -48,6 +48,15 @@ public:
     /** Sensor origin in the map frame [m]. */
     const Eigen::Vector3d& sensorOriginInMap_m() const { return m_sensorOrigin_m; }
 
+    /** Map-frame x and y of a sensor-frame point [m], in double from the same pose (apply()
+     * evaluates in single precision): for tests that must bound apply()'s result cheaply. */
+    Eigen::Vector2d horizontalInMap_m(const Eigen::Vector3f& p_m) const {
+        const double px = p_m.x(), py = p_m.y(), pz = p_m.z();
+        const Eigen::Matrix3d& A = m_rotSensorToMap;
+        return {A(0, 0) * px + A(0, 1) * py + A(0, 2) * pz + m_sensorOrigin_m.x(),
+                A(1, 0) * px + A(1, 1) * py + A(1, 2) * pz + m_sensorOrigin_m.y()};
+    }
+
     /** Coefficients of the per-point evaluation (single precision), public for the kernel. */
     struct Coefficients {
         float rot[9];    //!< sensor-to-map rotation, row-major
@@ -62,7 +71,8 @@ public:
 
 private:
     Eigen::Vector3d m_sensorOrigin_m;
-    Eigen::Matrix3d m_dRot[3];  //!< dRot/dyaw, dRot/dpitch, dRot/droll of the robot pose
+    Eigen::Matrix3d m_rotSensorToMap;  //!< sensor-to-map rotation
+    Eigen::Matrix3d m_dRot[3];         //!< dRot/dyaw, dRot/dpitch, dRot/droll of the robot pose
     Coefficients m_k;
 };
 

@@ -1,20 +1,64 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "multibin/io/EsriAsciiGrid.h"
 
 namespace multibin {
 
-/** Writes a raster as a single-band float32 TIFF, north up, NaN where unknown, with an ESRI world
- * file beside it (PATH with extension .tfw) so GIS tools (GDAL, QGIS) place it in the map frame
- * [m]. Throws std::runtime_error naming the file if it cannot be written. */
+/** A block of a raster's samples: rows [row0, row0 + rows), columns [col0, col0 + cols). */
+struct RasterBox {
+    int row0 = 0, col0 = 0, rows = 0, cols = 0;
+    bool empty() const { return rows <= 0 || cols <= 0; }
+};
+
+/** The bounding box of the raster's known (finite) samples grown by `margin_cells` on every side
+ * and clipped to the raster; empty when no sample is known. Exports cover this box, not the
+ * whole grown window, so a sparse map cannot write hundreds of MB of NODATA. */
+RasterBox knownBox(const EsriAsciiGrid& raster, int margin_cells);
+
+/** The samples of `raster` inside `box`, with the georeference moved accordingly. */
+EsriAsciiGrid cropRaster(const EsriAsciiGrid& raster, const RasterBox& box);
+
+/** A single-band float32 TIFF of the raster, north up, NaN where unknown. Throws
+ * std::invalid_argument if the raster is empty. */
+std::vector<uint8_t> encodeFloatTiff(const EsriAsciiGrid& raster);
+
+/** The ESRI world file (.tfw) that places encodeFloatTiff()'s image in the map frame [m]. */
+std::string worldFileText(const EsriAsciiGrid& raster);
+
+/** The raster as a triangle mesh in ASCII PLY: one vertex per known sample at its cell centre
+ * (x, y, height) [m], two triangles per 2x2 block of known samples (one where exactly three are
+ * known). */
+std::string meshPlyText(const EsriAsciiGrid& raster);
+
+/** How encodePreviewPng() draws a layer. */
+struct PreviewStyle {
+    std::string title;  //!< e.g. "height [m]"
+    /** Continuous layers: OpenCV colormap (cv::COLORMAP_*), bar labelled with `valueFormat`. */
+    int colormap = 16;  // cv::COLORMAP_VIRIDIS
+    std::string valueFormat = "%.3f";
+    /** Categorical layers: the value of each category and its name; a legend of swatches replaces
+     * the colour bar. Samples with other values are drawn as unknown. */
+    std::vector<std::pair<int, std::string>> categories;
+};
+
+/** A PNG preview of a raster layer: north up, x and y axes with ticks in metres, a scale bar, a
+ * colour bar (or a categorical legend) and unknown cells in a grey that no colormap uses. */
+std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const PreviewStyle& style);
+
+/** The grey of unknown cells in encodePreviewPng() (R, G, B). */
+constexpr uint8_t kUnknownGrey[3] = {200, 200, 200};
+
+/** Writes encodeFloatTiff() to `path` and worldFileText() to PATH with extension .tfw, each
+ * through writeFileAtomically(); errors name the file. */
 void saveFloatTiff(const EsriAsciiGrid& raster, const std::string& path);
 
-/** Writes the raster as a triangle mesh in ASCII PLY: one vertex per known sample at its cell
- * centre (x, y, height) [m], two triangles per 2x2 block of known samples (one where exactly three
- * are known). Throws std::runtime_error naming the file if it cannot be written. */
+/** Writes meshPlyText() to `path` through writeFileAtomically(); errors name the file. */
 void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path);
 
 }  // namespace multibin

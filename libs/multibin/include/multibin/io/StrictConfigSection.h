@@ -18,12 +18,17 @@ namespace multibin {
  *
  * Use: one reader per section; each options struct reads its keys with read(); keys that belong
  * to MRPT itself are declared with allow(); then finish(). Keys absent from the section leave the
- * destination untouched (its default). All errors are std::invalid_argument. */
+ * destination untouched (its default). A key given twice in the section is an error (MRPT keeps
+ * the last one silently). All errors are std::invalid_argument naming the file (when the source
+ * is a CConfigFile), the section and the key. */
 class StrictConfigSection {
 public:
     StrictConfigSection(const mrpt::config::CConfigFileBase& source, std::string section);
 
     const std::string& section() const { return m_section; }
+    /** "ini file 'F', section 'S'" (the file when the source is a CConfigFile): the start of
+     * every error message, for callers that add their own (validate()). */
+    std::string where() const;
     bool has(const std::string& key) const;
 
     void read(const std::string& key, double& value);
@@ -75,6 +80,7 @@ private:
 
     const mrpt::config::CConfigFileBase& m_source;
     std::string m_section;
+    std::string m_file;  //!< empty unless the source is a file
     std::vector<std::string> m_keys;
     std::vector<std::string> m_values;
     std::set<std::string> m_used;

@@ -9,16 +9,14 @@
 
 namespace multibin {
 
-
-
 /** The visibility constraint, applied after one observation updated `grid` (the cells of its
  * current update cycle), seen from `sensor_m` in the map frame:
  *
  * - along the line of sight from the sensor to the highest point accepted in each updated cell,
  *   a cell that was not updated in this cycle and holds a bin above the line is stale: the line
  *   passed through where it claims a surface. If the bin is less certain than the updated cell's
- *   winning bin, it is removed; otherwise it loses `certaintyDecrement` per contradicting point
- *   (and is removed at 0);
+ *   surface (CellSurface: the certainty the map reports for that cell), it is removed; otherwise it
+ * loses `certaintyDecrement` per contradicting point (and is removed at 0);
  * - within an updated cell, a bin above everything measured in it now would have occluded those
  *   measurements: it loses `certaintyDecrement` per new point, so the next-best hypothesis wins.
  *

@@ -6,17 +6,9 @@
 
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
+#include "multibin/sensors/SensorStats.h"
 
 namespace multibin::sensors {
-
-/** What the depth model did with the points it was given. */
-struct DepthStats {
-    size_t points = 0;      //!< points seen
-    size_t notFinite = 0;   //!< NaN or infinite coordinates
-    size_t outOfRange = 0;  //!< range outside [min_range, max_range] (0 = no return)
-    size_t kept = 0;        //!< turned into points with covariance
-    DepthStats& operator+=(const DepthStats& o);
-};
 
 /** Sensor-frame covariance [m^2] of a structured-light depth point at `p_m` (sensor origin at 0):
  * sigma_axial(r)^2 d d^T + (sigma_lateral r)^2 (I - d d^T), with r = |p|, d = p / r, sigma_axial

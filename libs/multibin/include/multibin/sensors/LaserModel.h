@@ -11,20 +11,9 @@
 
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
+#include "multibin/sensors/SensorStats.h"
 
 namespace multibin::sensors {
-
-/** What the laser model did with the beams of the scans it was given. */
-struct LaserStats {
-    size_t beams = 0;         //!< beams seen
-    size_t noReturn = 0;      //!< validity false or range >= the scan's maxRange
-    size_t notFinite = 0;     //!< NaN or infinite range
-    size_t outOfRange = 0;    //!< outside the map's [min_range, max_range]
-    size_t lowIntensity = 0;  //!< restored intensity under the threshold within the check range
-    size_t mixedPixel = 0;    //!< mixed measurement at a depth discontinuity
-    size_t kept = 0;          //!< turned into points
-    LaserStats& operator+=(const LaserStats& o);
-};
 
 /** Restored intensity of eq 1 [-]: Ires = sqrt(I * 1023 / vAGC), I the raw intensity, vAGC the
  * AGC voltage (raw units). */

@@ -1,14 +1,18 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
-#include <mrpt/config/CConfigFileBase.h>
-
 #include <array>
 #include <map>
 #include <string>
 
-#include "multibin/io/StrictConfigSection.h"
 #include "multibin/sensors/RangeSigmaCurve.h"
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+namespace multibin {
+class StrictConfigSection;
+}
 
 namespace multibin::sensors {
 
@@ -55,7 +59,12 @@ struct StereoModelOptions {
      * `stereo_extrinsics_sigma = s_rx s_ry s_rz s_tx s_ty s_tz`). */
     std::array<double, 6> extrinsicsSigma{0.0005, 0.0005, 0.0005, 0.0005, 0.0005, 0.0005};
     double matchingSigma_px =
-        0.25;                 //!< matching noise per image [px] (key `stereo_matching_sigma`)
+        0.25;  //!< matching noise per image [px] (key `stereo_matching_sigma`)
+    /** A point cloud of a stereo rig (CObservationPointCloud with the stereo model) has no
+     * pixels: its covariance is eq 10 with matching noise only, for a rig of this focal length
+     * [px] and baseline [m] (keys `stereo_cloud_focal_length`, `stereo_cloud_baseline`). */
+    double cloudFocalLength_px = 500.0;
+    double cloudBaseline_m = 0.09;
     int subsample = 2;        //!< use every n-th pixel in u and v (key `stereo_subsample`)
     double minDepth_m = 0.2;  //!< nearer points are out of the horopter (key `stereo_min_depth`)
 
@@ -106,11 +115,45 @@ struct DepthModelOptions {
     }
 };
 
+/** Rotating or 2D lidar model: sigma_r(r) along the beam; across it r * sqrt(sigma_a^2 +
+ * delta^2 / 16), sigma_a the beam's angular sigma and delta its full divergence angle (the return
+ * comes from anywhere in the footprint, a disc of diameter delta r: per-axis variance
+ * (delta r)^2 / 16). Defaults: the VLP-16 figures (doc/sensor-models.md). */
+struct LidarModelOptions {
+    /** The sensor whose published figures gave the defaults (key `lidar_sensor`: vlp16, os1 or
+     * utm30lx; the keys below override them). */
+    std::string sensor = "vlp16";
+    RangeSigmaCurve rangeSigma{0.03, 0.0, 0.0};  //!< key `lidar_range_sigma_coeffs`
+    double angularSigma_rad = 0.001;             //!< key `lidar_angular_sigma` [rad]
+    double beamDivergence_rad = 0.003;           //!< key `lidar_beam_divergence` [rad]
+
+    /** The published figures of `name` (vlp16, os1, utm30lx); throws std::invalid_argument for
+     * another name. */
+    static LidarModelOptions forSensor(const std::string& name);
+    /** Standard deviation across the beam at range `range_m` [m]. */
+    double lateralSigma_m(double range_m) const;
+};
+
+/** The noise model a sensor's data get. */
+enum class SensorModelKind { laser, lidar, stereo, depth };
+/** "laser", "lidar", "stereo", "depth". */
+const char* sensorModelName(SensorModelKind kind);
+
 /** Every sensor-model option of CMultiBinElevationMap (ini section `..._insertOpts`). */
 struct SensorModelOptions {
     LaserModelOptions laser;
     StereoModelOptions stereo;
     DepthModelOptions depth;
+    LidarModelOptions lidar;
+    /** The model of each sensor label (key `sensor_models = LABEL:model[,LABEL:model...]`, model
+     * laser, lidar, stereo or depth). A label without an entry gets the default of its
+     * observation class: laser for CObservation2DRangeScan, stereo for CObservationStereoImages,
+     * depth for CObservation3DRangeScan and CObservationPointCloud, lidar for
+     * CObservationVelodyneScan and CObservationRotatingScan. */
+    std::map<std::string, SensorModelKind> modelByLabel;
+
+    /** The model of data labelled `label`: its entry in modelByLabel, else `classDefault`. */
+    SensorModelKind modelFor(const std::string& label, SensorModelKind classDefault) const;
 
     /** Reads the keys present in `s` (the others keep their value), then validate(). */
     void load(StrictConfigSection& s);

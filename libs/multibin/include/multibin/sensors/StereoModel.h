@@ -2,12 +2,19 @@
 #pragma once
 
 #include <mrpt/obs/CObservationStereoImages.h>
+#include <mrpt/obs/obs_frwds.h>
+
+namespace mrpt::obs {
+class CObservationPointCloud;  // in mrpt::maps, not in obs_frwds.h
+}
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
+#include "multibin/sensors/SensorStats.h"
 #include "multibin/sensors/StereoDisparity.h"
 
 namespace multibin::sensors {
@@ -103,5 +110,26 @@ private:
     std::vector<float> m_luu, m_luv, m_lvv;
     std::vector<double> m_rightVar;
 };
+
+/** Points with covariance of a stereo pair in the LEFT camera frame (MRPT camera frame): disparity
+ * from the observation's disparity image if present (see decodeDisparityImage()), else OpenCV
+ * StereoSGBM; halo and near-cluster filters; every `subsample`-th pixel; eqs 4-10 for the
+ * covariance, through `table`: the per-pixel table of this camera that the caller keeps between
+ * pairs, (re)built here when the calibration or the sigmas change. What was done with the pixels
+ * is added to `stats`. Throws std::invalid_argument naming the observation if it has neither a
+ * disparity image nor a right image, or if the image size differs from its calibration. */
+void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const StereoModelOptions& opts,
+                    double minRange_m, double maxRange_m,
+                    std::shared_ptr<const StereoCovarianceTable>& table, PointsWithCov& out,
+                    StereoStats& stats);
+
+/** Points of a point cloud made by a stereo rig (CObservationPointCloud with the stereo model), in
+ * its sensor frame. Without pixels or calibration, each point gets eq 10 for matching noise only,
+ * taking its range r as the depth: sigma along the ray r^2 sqrt(2) sigma_m / (f b), across it
+ * r sigma_m / f (sigma_m = opts.matchingSigma_px, f = opts.cloudFocalLength_px,
+ * b = opts.cloudBaseline_m). Counted in stats.pixels, notFinite, outOfRange and kept. */
+void stereoCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
+                         const StereoModelOptions& opts, double minRange_m, double maxRange_m,
+                         PointsWithCov& out, StereoStats& stats);
 
 }  // namespace multibin::sensors

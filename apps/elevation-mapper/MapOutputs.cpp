@@ -1,0 +1,256 @@
+/* Part of the multibin elevation-mapping library: the elevation-mapper program. */
+#include "MapOutputs.h"
+
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CSetOfObjects.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "ProgressBar.h"
+#include "multibin/io/ErrorMessage.h"
+#include "multibin/io/OutputFile.h"
+#include "multibin/io/RasterExport.h"
+
+namespace fs = std::filesystem;
+using mrpt::maps::CMultiBinElevationMap;
+
+namespace {
+
+struct Group {
+    const char* name;
+    bool OutputSelection::*flag;
+    const char* files;
+};
+const Group kGroups[] = {
+    {"map", &OutputSelection::map, "elevation_map.bin (the serialized map, gz)"},
+    {"tif", &OutputSelection::tif,
+     "elevation_height.tif + .tfw (float32 heights [m], NaN unknown, world file)"},
+    {"scene", &OutputSelection::scene, "elevation.3Dscene (3D view, opens in SceneViewer3D)"},
+    {"png", &OutputSelection::png,
+     "elevation_{height,sigma,source}.png (previews: axes [m], scale, legend)"},
+    {"asc", &OutputSelection::asc, "elevation_{height,sigma,certainty,source}.asc (ESRI ASCII)"},
+    {"ply", &OutputSelection::ply, "elevation.ply (triangle mesh [m])"},
+};
+
+const char* const kLayerNames[] = {"height", "sigma", "certainty", "source"};
+
+/** The serialized form of an object, gzip-compressed in memory (what CFileGZOutputStream writes
+ * and CFileGZInputStream reads), so the file is written whole by writeFileAtomically(). MRPT's
+ * compress_gz_data_block() goes through a temporary file whose write errors it ignores. */
+std::vector<uint8_t> gzSerialized(const mrpt::serialization::CSerializable& object) {
+    mrpt::io::CMemoryStream mem;
+    auto arch = mrpt::serialization::archiveFrom(mem);
+    arch << object;
+    z_stream z{};
+    // windowBits 15 + 16: a gzip header and trailer; level 1 as CFileGZOutputStream's default.
+    if (deflateInit2(&z, 1, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+        throw std::runtime_error("gzip compression failed to start");
+    const auto n = static_cast<uLong>(mem.getTotalBytesCount());
+    std::vector<uint8_t> gz(deflateBound(&z, n));
+    z.next_in = static_cast<Bytef*>(const_cast<void*>(mem.getRawBufferData()));
+    z.avail_in = static_cast<uInt>(n);
+    z.next_out = gz.data();
+    z.avail_out = static_cast<uInt>(gz.size());
+    const int rc = deflate(&z, Z_FINISH);
+    gz.resize(z.total_out);
+    deflateEnd(&z);
+    if (rc != Z_STREAM_END) throw std::runtime_error("gzip compression failed");
+    return gz;
+}
+
+}  // namespace
+
+std::string OutputSelection::help() {
+    std::string s;
+    for (const Group& g : kGroups) s += std::string("      ") + g.name + ": " + g.files + "\n";
+    return s;
+}
+
+OutputSelection OutputSelection::parse(const std::string& list) {
+    OutputSelection sel;
+    for (const Group& g : kGroups) sel.*g.flag = false;
+    std::istringstream is(list);
+    std::string item;
+    bool any = false;
+    while (std::getline(is, item, ',')) {
+        if (item.empty()) continue;
+        any = true;
+        if (item == "all") {
+            for (const Group& g : kGroups) sel.*g.flag = true;
+            continue;
+        }
+        bool known = false;
+        for (const Group& g : kGroups)
+            if (item == g.name) sel.*g.flag = known = true;
+        if (!known) {
+            std::string names;
+            for (const Group& g : kGroups) names += std::string(names.empty() ? "" : ", ") + g.name;
+            throw std::invalid_argument("--outputs: unknown output '" + item +
+                                        "' (known: " + names + ", all)");
+        }
+    }
+    if (!any) throw std::invalid_argument("--outputs: the list is empty");
+    return sel;
+}
+
+std::vector<std::string> OutputSelection::fileNames() const {
+    std::vector<std::string> f;
+    if (map) f.push_back("elevation_map.bin");
+    if (tif) f.insert(f.end(), {"elevation_height.tif", "elevation_height.tfw"});
+    if (scene) f.push_back("elevation.3Dscene");
+    if (png)
+        for (const char* l : {"height", "sigma", "source"})
+            f.push_back(std::string("elevation_") + l + ".png");
+    if (asc)
+        for (const char* l : kLayerNames) f.push_back(std::string("elevation_") + l + ".asc");
+    if (ply) f.push_back("elevation.ply");
+    return f;
+}
+
+OutputFolder::OutputFolder(const fs::path& dir,
+                           std::vector<std::pair<std::string, std::string>> inputs)
+    : m_dir(dir), m_inputs(std::move(inputs)) {
+    if (fs::exists(dir) && !fs::is_directory(dir))
+        throw std::invalid_argument("--out '" + dir.string() + "' exists and is not a folder");
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec)
+        throw std::runtime_error("cannot create the output folder '" + dir.string() +
+                                 "': " + ec.message());
+}
+
+void OutputFolder::checkNotAnInput(const std::string& name) const {
+    const bool prefix = !name.empty() && name.back() == '*';
+    const std::string stem = prefix ? name.substr(0, name.size() - 1) : name;
+    for (const auto& [what, input] : m_inputs) {
+        if (input.empty()) continue;
+        std::error_code ec;
+        const fs::path in(input);
+        bool clash = false;
+        if (prefix) {
+            const std::string base = in.filename().string();
+            clash = base.compare(0, stem.size(), stem) == 0 &&
+                    fs::equivalent(in.parent_path().empty() ? fs::path(".") : in.parent_path(),
+                                   m_dir, ec);
+        } else {
+            clash = fs::equivalent(in, m_dir / name, ec);
+        }
+        if (clash)
+            throw std::invalid_argument("the output '" + (m_dir / name).string() +
+                                        "' would overwrite the input " + what + " '" + input +
+                                        "': choose another --out folder or move the input");
+    }
+}
+
+void OutputFolder::write(const std::string& name, const std::vector<uint8_t>& bytes) const {
+    checkNotAnInput(name);
+    multibin::writeFileAtomically((m_dir / name).string(), bytes);
+}
+
+void OutputFolder::write(const std::string& name, const std::string& text) const {
+    checkNotAnInput(name);
+    multibin::writeFileAtomically((m_dir / name).string(), text);
+}
+
+void OutputFolder::writeWith(const std::string& name,
+                             const std::function<bool(const std::string&)>& writer) const {
+    checkNotAnInput(name);
+    multibin::writeFileAtomically((m_dir / name).string(), writer);
+}
+
+MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
+    using L = CMultiBinElevationMap::RasterLayer;
+    MapLayers m;
+    m.height = map.toRaster(L::Height);
+    const multibin::RasterBox box = multibin::knownBox(m.height, kMargin_cells);
+    m.height = multibin::cropRaster(m.height, box);
+    m.sigma = multibin::cropRaster(map.toRaster(L::Sigma), box);
+    m.certainty = multibin::cropRaster(map.toRaster(L::Certainty), box);
+    m.source = multibin::cropRaster(map.toRaster(L::Source), box);
+    return m;
+}
+
+void MapLayers::saveAsc(const OutputFolder& folder) const {
+    const multibin::EsriAsciiGrid* grids[] = {&height, &sigma, &certainty, &source};
+    for (int i = 0; i < 4; i++)
+        folder.writeWith(std::string("elevation_") + kLayerNames[i] + ".asc",
+                         [&](const std::string& path) {
+                             grids[i]->save(path);
+                             return true;
+                         });
+}
+
+std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const MapLayers& layers,
+                                         const OutputSelection& sel, const OutputFolder& folder) {
+    // Each step writes one or more files; the bar counts steps.
+    std::vector<std::pair<std::string, std::function<void()>>> steps;
+    if (sel.map)
+        steps.emplace_back("elevation_map.bin",
+                           [&] { folder.write("elevation_map.bin", gzSerialized(map)); });
+    if (sel.tif)
+        steps.emplace_back("elevation_height.tif", [&] {
+            folder.write("elevation_height.tif", multibin::encodeFloatTiff(layers.height));
+            folder.write("elevation_height.tfw", multibin::worldFileText(layers.height));
+        });
+    if (sel.scene)
+        steps.emplace_back("elevation.3Dscene", [&] {
+            mrpt::opengl::COpenGLScene scene;
+            auto obj = mrpt::opengl::CSetOfObjects::Create();
+            multibin::buildTerrainView(map, sel.sceneColouring, *obj);
+            scene.insert(obj);
+            // The first view: the whole map from above at an angle.
+            const auto& h = layers.height;
+            auto& camera = scene.getViewport("main")->getCamera();
+            camera.setPointingAt(0.5 * (h.xllcenter_m + h.xMax_m()),
+                                 0.5 * (h.yllcenter_m + h.yMax_m()), 0.0);
+            camera.setZoomDistance(
+                1.2 * std::max({h.xMax_m() - h.xllcenter_m, h.yMax_m() - h.yllcenter_m, 1.0}));
+            camera.setAzimuthDegrees(-60);
+            camera.setElevationDegrees(45);
+            folder.write("elevation.3Dscene", gzSerialized(scene));
+        });
+    if (sel.png) {
+        multibin::PreviewStyle h;
+        h.title = "height [m]";
+        h.colormap = cv::COLORMAP_VIRIDIS;
+        steps.emplace_back("elevation_height.png", [&folder, &layers, h] {
+            folder.write("elevation_height.png", multibin::encodePreviewPng(layers.height, h));
+        });
+        multibin::PreviewStyle s;
+        s.title = "sigma [m]";
+        s.colormap = cv::COLORMAP_INFERNO;
+        s.valueFormat = "%.4f";
+        steps.emplace_back("elevation_sigma.png", [&folder, &layers, s] {
+            folder.write("elevation_sigma.png", multibin::encodePreviewPng(layers.sigma, s));
+        });
+        multibin::PreviewStyle src;
+        src.title = "source of the height";
+        using HS = CMultiBinElevationMap::HeightSource;
+        src.categories = {{int(HS::Measured), "measured"},
+                          {int(HS::FilledMedian), "filled: median"},
+                          {int(HS::FilledSurface), "filled: surface"}};
+        steps.emplace_back("elevation_source.png", [&folder, &layers, src] {
+            folder.write("elevation_source.png", multibin::encodePreviewPng(layers.source, src));
+        });
+    }
+    if (sel.asc) steps.emplace_back("elevation_*.asc", [&] { layers.saveAsc(folder); });
+    if (sel.ply)
+        steps.emplace_back("elevation.ply", [&] {
+            folder.write("elevation.ply", multibin::meshPlyText(layers.height));
+        });
+
+    ProgressBar bar("writing");
+    for (size_t i = 0; i < steps.size(); i++) {
+        bar.update(double(i) / double(steps.size()), steps[i].first);
+        steps[i].second();
+    }
+    bar.finish("done");
+    return sel.fileNames();
+}

@@ -1,0 +1,73 @@
+/* Part of the multibin elevation-mapping library: the elevation-mapper program. */
+#pragma once
+
+#include <mrpt/maps/CMultiBinElevationMap.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/TerrainView.h"
+
+/** What elevation-mapper writes (--outputs): a comma-separated list of groups. */
+struct OutputSelection {
+    bool map = true;    //!< elevation_map.bin: the serialized map (gz)
+    bool tif = true;    //!< elevation_height.tif + .tfw: float32 heights [m] with a world file
+    bool scene = true;  //!< elevation.3Dscene: the 3D view (SceneViewer3D)
+    bool png = true;    //!< elevation_{height,sigma,source}.png: previews with legends
+    bool asc = false;   //!< elevation_{height,sigma,certainty,source}.asc: ESRI ASCII rasters
+    bool ply = false;   //!< elevation.ply: triangle mesh [m]
+    /** What colours the scene (--scene-colour). */
+    multibin::SceneColouring sceneColouring = multibin::SceneColouring::Height;
+
+    static constexpr const char* kDefault = "map,tif,scene,png";
+    /** One line per group for --help. */
+    static std::string help();
+    /** Parses "map,tif,asc" or "all"; throws std::invalid_argument naming an unknown group. */
+    static OutputSelection parse(const std::string& list);
+    /** The file names the selection writes. */
+    std::vector<std::string> fileNames() const;
+};
+
+/** The run's output folder. Every file is checked against the run's inputs (an input is never
+ * overwritten) and written whole through a temporary file and a rename (a full disk leaves no
+ * truncated file); every error names its file. */
+class OutputFolder {
+public:
+    /** inputs: (what, path), e.g. ("--ground-truth", "gt.asc"). Creates the folder. */
+    OutputFolder(const std::filesystem::path& dir,
+                 std::vector<std::pair<std::string, std::string>> inputs);
+    const std::filesystem::path& dir() const { return m_dir; }
+    /** Throws std::invalid_argument if writing `name` (a file name, or a prefix ending in '*')
+     * would overwrite one of the inputs. Called for every planned file before mapping starts. */
+    void checkNotAnInput(const std::string& name) const;
+    void write(const std::string& name, const std::vector<uint8_t>& bytes) const;
+    void write(const std::string& name, const std::string& text) const;
+    /** For writers that take a path: writer(temporaryPath) returns false or throws on failure. */
+    void writeWith(const std::string& name,
+                   const std::function<bool(const std::string& path)>& writer) const;
+
+private:
+    std::filesystem::path m_dir;
+    std::vector<std::pair<std::string, std::string>> m_inputs;
+};
+
+/** The map's layers as rasters over the known area: the bounding box of its known cells plus
+ * a margin, the same box for every layer. Empty rasters for a map with no known cell. */
+struct MapLayers {
+    multibin::EsriAsciiGrid height, sigma, certainty, source;
+    static constexpr int kMargin_cells = 5;
+    static MapLayers of(const mrpt::maps::CMultiBinElevationMap& map);
+    /** Writes elevation_{height,sigma,certainty,source}.asc into `dir` (any folder). */
+    void saveAsc(const OutputFolder& folder) const;
+};
+
+/** Writes the selected outputs of `map` (filled already) into the folder, with a progress bar on
+ * a terminal. Returns the names of the files written. */
+std::vector<std::string> writeMapOutputs(const mrpt::maps::CMultiBinElevationMap& map,
+                                         const MapLayers& layers, const OutputSelection& selection,
+                                         const OutputFolder& folder);

@@ -1,0 +1,36 @@
+/* Part of the multibin elevation-mapping library: the elevation-mapper program. */
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+/** Bounds the memory that reading one file may request. MRPT's deserializers allocate what a
+ * file declares (a count of objects, beams, points) before reading the data, so a 31-byte file
+ * can ask for 16 GB. While a ReadBudget is alive on a thread, the allocations of that thread may
+ * add up to its limit (frees are not subtracted, so the sum bounds the peak); a request beyond
+ * it is refused: malloc, calloc, realloc and memalign return null (operator
+ * new then throws std::bad_alloc), posix_memalign and aligned_alloc throw std::bad_alloc (MRPT's
+ * aligned allocator does not check for null). The allocation functions are replaced in every
+ * program that links this file (RawlogSourceGuard.cpp); under ASan they forward to ASan's, under
+ * other allocator-replacing sanitizers (TSan, MSan) the guard is off. */
+class ReadBudget {
+public:
+    /** The limit for `bytesLeft` bytes still to read: kFixedBytes + kPerByte * bytesLeft. */
+    static constexpr uint64_t kFixedBytes = uint64_t(64) << 20;
+    static constexpr uint64_t kPerByte = 16;
+    static uint64_t limitFor(uint64_t bytesLeft);
+
+    explicit ReadBudget(uint64_t limitBytes);
+    ~ReadBudget();
+    ReadBudget(const ReadBudget&) = delete;
+    ReadBudget& operator=(const ReadBudget&) = delete;
+
+    /** The largest total (requests so far plus the refused one) refused since construction
+     * (0: none). */
+    static uint64_t largestRefused();
+    /** Whether this build enforces the limit (false under TSan and MSan). */
+    static bool enforced();
+
+private:
+    uint64_t m_previous;
+};

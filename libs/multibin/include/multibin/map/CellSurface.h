@@ -1,0 +1,48 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include "multibin/map/BinGrid.h"
+#include "multibin/map/MapTypes.h"
+
+namespace multibin {
+
+/** The surface estimate of one cell: what "the cell's height" means for every layer and every
+ * query of the map (height, sigma, certainty; getHeight, dem_get_z, getElevation, rasters).
+ *
+ * The cell's winning bin (most certain, then least variance), fused (eq 15, information form)
+ * with the neighbouring bins (index +-1, +-2, ... while contiguous) whose heights agree with it
+ * within 3 sigma: a surface whose height lies near a bin boundary spreads its points over two
+ * bins, each of which then holds a truncated, biased share; they are one hypothesis, not two.
+ * Bins that disagree stay alternative hypotheses. */
+struct CellSurface {
+    double height_m = 0;
+    double variance_m2 = 0;         //!< with the floor, and the relief if asked for [m^2]
+    double certainty = 0;           //!< the certainty of the bins merged into the surface
+    int firstBin = 0, lastBin = 0;  //!< the bin indices merged into the surface
+};
+
+/** The surface of cell (ix, iy) of `grid`; false if it holds no certain bin (or lies outside
+ * the window). */
+bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& params,
+                 CellSurface& out);
+/** The same for the cell containing (x_m, y_m). */
+inline bool cellSurface(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& params,
+                        CellSurface& out) {
+    return cellSurface(grid, grid.cellIndex(x_m), grid.cellIndex(y_m), params, out);
+}
+
+/** Adds the relief of the cell to its variance [m^2]: the map gives one height per cell, the
+ * points sample parts of it, and over a cell of side s on a slope g the heights spread with
+ * variance (g s)^2 / 12 (uniform over the cell), g from the neighbours' surfaces; and the spread
+ * of the cell's certain bins outside the surface (a step inside the cell). */
+void addReliefVariance(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& params,
+                       CellSurface& cell);
+
+/** The map's surface at (x_m, y_m): the surface of `grid`'s cell, with its relief variance if
+ * `reliefSigma`; with a dual grid (`local` not null) combined with the local grid's: agreeing
+ * estimates fused by inverse variance (their data are disjoint), else the more certain one.
+ * False if neither grid has a surface there. */
+bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
+               const BinUpdateParams& params, bool reliefSigma, CellSurface& out);
+
+}  // namespace multibin

@@ -1,0 +1,311 @@
+/* The elevation-mapper program as a user runs it: --help, --section, the per-class report and the
+ * non-zero exit of a run that fuses nothing, rasters bounded by the known area, --outputs, and
+ * output safety (no input overwritten, no truncated file on a full disk, errors name files). */
+#include <gtest/gtest.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+
+#include "multibin/io/EsriAsciiGrid.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratchDir(const std::string& name) {
+    const fs::path d = fs::path(MULTIBIN_BINARY_DIR) / "test_elevation_mapper" / name;
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+std::string readAll(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+struct RunResult {
+    int exitCode;
+    std::string out, err;
+};
+
+/** Runs elevation-mapper with `args` (a shell command line fragment) in `dir`; `prefix` goes
+ * before the program (e.g. "ulimit -f 16;"). */
+RunResult runMapper(const fs::path& dir, const std::string& args, const std::string& prefix = "") {
+    const std::string cmd = prefix + " " + ELEVATION_MAPPER_EXE + " " + args + " > " +
+                            (dir / "stdout.txt").string() + " 2> " + (dir / "stderr.txt").string() +
+                            " < /dev/null";
+    const int status = std::system(("/bin/sh -c '" + cmd + "'").c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(dir / "stdout.txt"),
+            readAll(dir / "stderr.txt")};
+}
+
+void writeRawlog(const fs::path& path,
+                 const std::vector<mrpt::serialization::CSerializable::Ptr>& e) {
+    mrpt::io::CFileGZOutputStream f(path.string());
+    auto arch = mrpt::serialization::archiveFrom(f);
+    for (const auto& o : e) arch << *o;
+}
+
+/** A rawlog of one small depth-like point cloud: `side` x `side` points 1 cm apart on the floor
+ * (z = -0.3 m) 1 m ahead of the robot at the origin. */
+void writePatchRawlog(const fs::path& path, int side = 10) {
+    auto cloud = mrpt::obs::CObservationPointCloud::Create();
+    auto pts = mrpt::maps::CSimplePointsMap::Create();
+    for (int i = 0; i < side; i++)
+        for (int j = 0; j < side; j++) pts->insertPoint(1.0f + 0.01f * i, 0.01f * j, -0.3f);
+    cloud->pointcloud = pts;
+    cloud->sensorLabel = "CLOUD";
+    writeRawlog(path, {cloud});
+}
+
+/** An ini with the map in `section`; `creation` adds keys to its creation options. */
+void writeIni(const fs::path& path, const std::string& section = "MappingApplication",
+              const std::string& creation = "") {
+    std::ofstream f(path);
+    f << "[" << section << "]\nmultiBinElevationMap_count = 1\n[" << section
+      << "_multiBinElevationMap_00_creationOpts]\nresolution = 0.02\n"
+      << creation << "\n";
+}
+
+std::set<std::string> filesIn(const fs::path& dir) {
+    std::set<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+    return names;
+}
+
+size_t lines(const std::string& s) { return size_t(std::count(s.begin(), s.end(), '\n')); }
+
+}  // namespace
+
+// --help names every option the parser takes, and the default of each that has one.
+TEST(ElevationMapperCli, HelpListsEveryOptionWithItsDefault) {
+    const fs::path d = scratchDir("help");
+    const RunResult r = runMapper(d, "--help");
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    for (const char* flag :
+         {"--config", "--section", "-s,", "--rawlog", "--simplemap", "--out", "--outputs",
+          "--ground-truth", "--with-mrf", "--profile", "--eval-area", "--no-plots", "--help"})
+        EXPECT_NE(r.out.find(flag), std::string::npos) << flag << " missing from --help";
+    for (const char* def : {"default: MappingApplication", "default: elevation-mapper-out",
+                            "default: map,tif,scene,png"})
+        EXPECT_NE(r.out.find(def), std::string::npos) << def << " missing from --help";
+    for (const char* group : {"map:", "tif:", "scene:", "png:", "asc:", "ply:"})
+        EXPECT_NE(r.out.find(group), std::string::npos) << group << " missing from --help";
+}
+
+// --section picks the ini section, as observations2map's -s does.
+TEST(ElevationMapperCli, SectionChoosesTheIniSection) {
+    const fs::path d = scratchDir("section");
+    writePatchRawlog(d / "patch.rawlog");
+    writeIni(d / "maps.ini", "MyMaps");
+    const std::string common =
+        "--config " + (d / "maps.ini").string() + " --rawlog " + (d / "patch.rawlog").string();
+    const RunResult def = runMapper(d, common + " --out " + (d / "a").string());
+    EXPECT_EQ(def.exitCode, 1);
+    EXPECT_NE(def.err.find("[MappingApplication]"), std::string::npos) << def.err;
+    EXPECT_NE(def.err.find("--section"), std::string::npos) << def.err;
+    const RunResult s = runMapper(d, common + " -s MyMaps --out " + (d / "b").string());
+    EXPECT_EQ(s.exitCode, 0) << s.err;
+    const RunResult l = runMapper(d, common + " --section MyMaps --out " + (d / "c").string());
+    EXPECT_EQ(l.exitCode, 0) << l.err;
+    EXPECT_TRUE(fs::exists(d / "c" / "elevation_map.bin"));
+}
+
+// A rawlog holding only odometry (actions and CObservationOdometry) fuses nothing: exit 1 and one
+// line that names the rawlog and says why (the unsupported class), no outputs.
+TEST(ElevationMapperCli, NoPointFusedIsAnErrorThatSaysWhy) {
+    const fs::path d = scratchDir("odometry_only");
+    std::vector<mrpt::serialization::CSerializable::Ptr> entries;
+    for (int k = 0; k < 5; k++) {
+        auto acts = mrpt::obs::CActionCollection::Create();
+        mrpt::obs::CActionRobotMovement2D move;
+        move.computeFromOdometry(mrpt::poses::CPose2D(0.1, 0, 0),
+                                 mrpt::obs::CActionRobotMovement2D::TMotionModelOptions());
+        acts->insert(move);
+        entries.push_back(acts);
+        auto sf = mrpt::obs::CSensoryFrame::Create();
+        auto odo = mrpt::obs::CObservationOdometry::Create();
+        odo->odometry = mrpt::poses::CPose2D(0.1 * k, 0, 0);
+        sf->insert(odo);
+        entries.push_back(sf);
+    }
+    writeRawlog(d / "odometry.rawlog", entries);
+    writeIni(d / "maps.ini");
+    const RunResult r =
+        runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
+                         (d / "odometry.rawlog").string() + " --out " + (d / "out").string());
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("odometry.rawlog"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("no point fused"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("CObservationOdometry: 5 unsupported"), std::string::npos) << r.err;
+    // The per-class report on stdout names the class too.
+    EXPECT_NE(r.out.find("CObservationOdometry: 5 skipped: unsupported class"), std::string::npos)
+        << r.out;
+    EXPECT_FALSE(fs::exists(d / "out" / "elevation_map.bin"));
+}
+
+// The report counts per class what was used and what was skipped by label.
+TEST(ElevationMapperCli, ReportCountsUsedAndSkippedByLabelPerClass) {
+    const fs::path d = scratchDir("report");
+    writePatchRawlog(d / "patch.rawlog");
+    writeIni(d / "maps.ini");
+    const RunResult used =
+        runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
+                         (d / "patch.rawlog").string() + " --out " + (d / "out").string());
+    ASSERT_EQ(used.exitCode, 0) << used.err;
+    EXPECT_NE(used.out.find("CObservationPointCloud: 1 used (100 points fused, 0 rejected)"),
+              std::string::npos)
+        << used.out;
+
+    std::ofstream(d / "maps.ini", std::ios::app)
+        << "[MappingApplication_multiBinElevationMap_00_insertOpts]\nsensor_labels = LIDAR\n";
+    const RunResult skipped =
+        runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
+                         (d / "patch.rawlog").string() + " --out " + (d / "out2").string());
+    EXPECT_EQ(skipped.exitCode, 1);
+    EXPECT_NE(skipped.out.find("CObservationPointCloud: 1 skipped by label"), std::string::npos)
+        << skipped.out;
+    EXPECT_NE(skipped.err.find("skipped by sensor_labels"), std::string::npos) << skipped.err;
+}
+
+// A 10 x 10 cm patch in a 40 x 40 m window (2000 x 2000 cells): the rasters cover the patch and
+// a margin, not the window, so every output together stays small.
+TEST(ElevationMapperOutputs, SparseMapRastersCoverTheKnownAreaOnly) {
+    const fs::path d = scratchDir("sparse");
+    writePatchRawlog(d / "patch.rawlog");
+    writeIni(d / "maps.ini", "MappingApplication",
+             "grow = false\nmin_x = -20\nmax_x = 20\nmin_y = -20\nmax_y = 20\n");
+    const RunResult r = runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
+                                         (d / "patch.rawlog").string() + " --outputs all --out " +
+                                         (d / "out").string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto g = multibin::EsriAsciiGrid::load((d / "out" / "elevation_height.asc").string());
+    // The patch spans 5-6 cells of 2 cm; 5 cells of margin on each side; filling may add a few.
+    EXPECT_LE(g.cols(), 30);
+    EXPECT_LE(g.rows(), 30);
+    uintmax_t total = 0;
+    for (const auto& e : fs::directory_iterator(d / "out")) total += fs::file_size(e.path());
+    EXPECT_LT(total, 1u << 20) << "bytes written: " << total;
+}
+
+// --outputs chooses the files: the default set, a single group, and an unknown group named.
+TEST(ElevationMapperOutputs, OutputsChoosesWhatIsWritten) {
+    const fs::path d = scratchDir("outputs");
+    writePatchRawlog(d / "patch.rawlog");
+    writeIni(d / "maps.ini");
+    const std::string common =
+        "--config " + (d / "maps.ini").string() + " --rawlog " + (d / "patch.rawlog").string();
+    ASSERT_EQ(runMapper(d, common + " --out " + (d / "def").string()).exitCode, 0);
+    EXPECT_EQ(
+        filesIn(d / "def"),
+        (std::set<std::string>{"elevation_map.bin", "elevation_height.tif", "elevation_height.tfw",
+                               "elevation.3Dscene", "elevation_height.png", "elevation_sigma.png",
+                               "elevation_source.png"}));
+    ASSERT_EQ(runMapper(d, common + " --outputs asc,ply --out " + (d / "asc").string()).exitCode,
+              0);
+    EXPECT_EQ(filesIn(d / "asc"),
+              (std::set<std::string>{"elevation_height.asc", "elevation_sigma.asc",
+                                     "elevation_certainty.asc", "elevation_source.asc",
+                                     "elevation.ply"}));
+    const RunResult bad =
+        runMapper(d, common + " --outputs map,geotiff --out " + (d / "bad").string());
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("'geotiff'"), std::string::npos) << bad.err;
+
+    // The serialized map loads back as the map that was written.
+    mrpt::io::CFileGZInputStream in((d / "def" / "elevation_map.bin").string());
+    mrpt::maps::CMultiBinElevationMap map;
+    mrpt::serialization::archiveFrom(in) >> map;
+    EXPECT_EQ(map.insertStats().accepted, 0u);  // statistics are not serialized
+    double h = 0, s = 0;
+    EXPECT_TRUE(map.getHeight(1.05, 0.05, h, s));
+    EXPECT_NEAR(h, -0.3, 0.01);
+}
+
+// An input at the path of an output is an error naming both, before anything is written, and the
+// input is left as it was: ini, rawlog and ground truth.
+TEST(ElevationMapperOutputs, NeverOverwritesAnInput) {
+    const fs::path d = scratchDir("inputs");
+    const fs::path out = d / "out";
+    fs::create_directories(out);
+    writePatchRawlog(out / "elevation.ply");  // a rawlog where the mesh would go
+    writeIni(d / "maps.ini");
+    const std::string rawlogBytes = readAll(out / "elevation.ply");
+    RunResult r =
+        runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
+                         (out / "elevation.ply").string() + " --outputs all --out " + out.string());
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("would overwrite the input --rawlog"), std::string::npos) << r.err;
+    EXPECT_EQ(readAll(out / "elevation.ply"), rawlogBytes);
+    EXPECT_EQ(filesIn(out), (std::set<std::string>{"elevation.ply"}));
+
+    writeIni(out / "elevation_map.bin");  // an ini where the map would go
+    writePatchRawlog(d / "patch.rawlog");
+    const std::string iniBytes = readAll(out / "elevation_map.bin");
+    r = runMapper(d, "--config " + (out / "elevation_map.bin").string() + " --rawlog " +
+                         (d / "patch.rawlog").string() + " --out " + out.string());
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("would overwrite the input --config"), std::string::npos) << r.err;
+    EXPECT_EQ(readAll(out / "elevation_map.bin"), iniBytes);
+
+    // A ground truth where the evaluation writes its truth raster.
+    multibin::EsriAsciiGrid gt;
+    gt.cellsize_m = 0.02;
+    gt.xllcenter_m = 0.9;
+    gt.yllcenter_m = -0.1;
+    gt.heights_m.setConstant(20, 20, -0.3f);
+    gt.save((out / "eval_truth.asc").string());
+    const std::string gtBytes = readAll(out / "eval_truth.asc");
+    r = runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
+                         (d / "patch.rawlog").string() + " --ground-truth " +
+                         (out / "eval_truth.asc").string() + " --no-plots --out " + out.string());
+    EXPECT_EQ(r.exitCode, 1);
+    EXPECT_NE(r.err.find("would overwrite the input --ground-truth"), std::string::npos) << r.err;
+    EXPECT_EQ(readAll(out / "eval_truth.asc"), gtBytes);
+}
+
+// A full disk (here: a file size limit, ulimit -f) fails with an error naming the file it could
+// not write, and leaves no truncated file: each file is the previous complete one or absent, and
+// no temporary file remains.
+TEST(ElevationMapperOutputs, FullDiskLeavesNoTruncatedFile) {
+    const fs::path d = scratchDir("full_disk");
+    writePatchRawlog(d / "patch.rawlog", 40);
+    writeIni(d / "maps.ini");
+    const std::string args = "--config " + (d / "maps.ini").string() + " --rawlog " +
+                             (d / "patch.rawlog").string() + " --outputs all --out " +
+                             (d / "out").string();
+    ASSERT_EQ(runMapper(d, args).exitCode, 0);
+    std::map<std::string, std::string> complete;
+    for (const auto& name : filesIn(d / "out")) complete[name] = readAll(d / "out" / name);
+    size_t largest = 0;
+    for (const auto& [name, bytes] : complete) largest = std::max(largest, bytes.size());
+    ASSERT_GT(largest, 2048u);
+
+    // dash counts ulimit -f in 512-byte blocks: 2 blocks stops every file over 1 KiB.
+    const RunResult r = runMapper(d, args, "trap \"\" XFSZ; ulimit -f 2;");
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find((d / "out").string()), std::string::npos) << r.err;
+    for (const auto& name : filesIn(d / "out")) {
+        EXPECT_EQ(name.find(".partial"), std::string::npos) << "temporary file left: " << name;
+        if (complete.count(name))
+            EXPECT_TRUE(readAll(d / "out" / name) == complete[name]) << name << " is not complete";
+    }
+}

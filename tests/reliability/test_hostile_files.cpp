@@ -1,0 +1,258 @@
+/* Hostile rawlogs and simplemaps (issue 16.1): entries that are null or of the wrong class, and
+ * files that declare far more objects or beams than they hold. elevation-mapper must give exit
+ * code 1 and one line naming the file and the entry, within a second, and read every memory-bomb
+ * under a 1 GB address-space limit. */
+#include <gtest/gtest.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CActionRobotMovement3D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose3D.h>
+#include <mrpt/poses/CPose3DPDFGaussian.h>
+#include <mrpt/poses/CPosePDFGaussian.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <limits>
+
+#include "reliability_helpers.h"
+
+#ifdef ELEVATION_MAPPER_EXE
+namespace fs = std::filesystem;
+using namespace reliability;
+
+namespace {
+using Bytes = std::string;
+
+fs::path scratchDir(const std::string& name) {
+    const fs::path d = fs::path(MULTIBIN_BINARY_DIR) / "test_reliability" / name;
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+std::string readAll(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+template <typename T>
+Bytes bytesOf(const T& obj) {
+    mrpt::io::CMemoryStream mem;
+    auto arch = mrpt::serialization::archiveFrom(mem);
+    arch << obj;
+    return Bytes(static_cast<const char*>(mem.getRawBufferData()), mem.getTotalBytesCount());
+}
+
+/** `whole` with the first occurrence of `part` replaced by `with`. */
+Bytes spliced(const Bytes& whole, const Bytes& part, const Bytes& with) {
+    const size_t at = whole.find(part);
+    EXPECT_NE(at, Bytes::npos);
+    return whole.substr(0, at) + with + whole.substr(at + part.size());
+}
+
+/** `whole` with the 4-byte little-endian `from` after `after` set to `to`, cut `keep` bytes
+ * after it (the declared data is missing, as in a hostile file). */
+Bytes declaring(const Bytes& whole, const std::string& after, uint32_t from, uint32_t to,
+                size_t keep) {
+    const size_t a = whole.find(after);
+    EXPECT_NE(a, Bytes::npos);
+    Bytes f(4, '\0'), t(4, '\0');
+    std::memcpy(f.data(), &from, 4);
+    std::memcpy(t.data(), &to, 4);
+    const size_t at = whole.find(f, a);
+    EXPECT_NE(at, Bytes::npos);
+    return whole.substr(0, at) + t + whole.substr(at + 4, keep);
+}
+
+mrpt::obs::CObservation2DRangeScan::Ptr scan(size_t beams) {
+    auto s = floorScan(beams);
+    s->sensorLabel = "LASER";
+    return s;
+}
+
+Bytes sensoryFrameWith(const mrpt::obs::CObservation::Ptr& obs) {
+    mrpt::obs::CSensoryFrame sf;
+    sf.insert(obs);
+    return bytesOf(sf);
+}
+
+Bytes nullObject() { return bytesOf(mrpt::serialization::CSerializable::Ptr()); }
+Bytes poseObject() { return bytesOf(mrpt::poses::CPose3D(1, 2, 3, 0, 0, 0)); }
+
+struct RunResult {
+    int exitCode;
+    std::string stderrText;
+    double seconds;
+};
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MULTIBIN_TEST_ASAN 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__) || defined(MULTIBIN_TEST_ASAN)
+// ASan reserves terabytes of shadow address space: no address-space limit there (the read
+// budget works the same, through ASan's allocator).
+const std::string kLimit = "";
+#else
+const std::string kLimit = "ulimit -v 1048576; ";  // 1 GB address space
+#endif
+
+/** elevation-mapper with the shipped walk.ini on `input`, under a 1 GB address-space limit. */
+RunResult runMapper(const std::string& flag, const fs::path& input, const fs::path& dir) {
+    const fs::path err = dir / "stderr.txt";
+    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " +
+                            (fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini").string() +
+                            " " + flag + " " + input.string() + " --no-plots --out " +
+                            (dir / "out").string() + " > " + (dir / "stdout.txt").string() +
+                            " 2> " + err.string() + " < /dev/null";
+    const auto t0 = std::chrono::steady_clock::now();
+    const int status = std::system(cmd.c_str());
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(err), s};
+}
+
+/** Exit 1, one line naming the file and containing `what` (the entry and the problem). */
+void expectOneLineError(const RunResult& r, const fs::path& file, const std::string& what) {
+    EXPECT_EQ(r.exitCode, 1) << r.stderrText;
+    EXPECT_EQ(std::count(r.stderrText.begin(), r.stderrText.end(), '\n'), 1) << r.stderrText;
+    EXPECT_NE(r.stderrText.find(file.filename().string()), std::string::npos) << r.stderrText;
+    EXPECT_NE(r.stderrText.find(what), std::string::npos) << r.stderrText;
+}
+
+void write(const fs::path& p, const Bytes& b) { std::ofstream(p, std::ios::binary) << b; }
+}  // namespace
+
+// A sensory frame whose observation slot holds a null object, or an object of another class
+// (MRPT reads it as a null observation): SIGSEGV before.
+TEST(HostileFiles, NullOrWrongClassEntriesInASensoryFrameAreOneLineErrors) {
+    const fs::path dir = scratchDir("hostile_null");
+    const auto obs = scan(50);
+    const Bytes good = sensoryFrameWith(obs);
+    const Bytes obsBytes = bytesOf(mrpt::obs::CObservation::Ptr(obs));
+    for (const auto& [name, with] : {std::pair{"null", nullObject()}, {"pose", poseObject()}}) {
+        const fs::path f = dir / (std::string(name) + ".rawlog");
+        write(f, good + spliced(good, obsBytes, with));
+        expectOneLineError(runMapper("--rawlog", f, dir), f, "entry 1 (a sensory frame)");
+    }
+    // A null entry at the top level, and a null action in an action collection.
+    const fs::path top = dir / "top.rawlog";
+    write(top, good + nullObject());
+    expectOneLineError(runMapper("--rawlog", top, dir), top, "entry 1 is empty");
+}
+
+// Odometry: a null 2D pose change, and a NaN one (used as the robot pose before).
+TEST(HostileFiles, NullOrNonFiniteOdometryIsAnError) {
+    const fs::path dir = scratchDir("hostile_odometry");
+    mrpt::obs::CActionRobotMovement2D move;
+    mrpt::obs::CActionRobotMovement2D::TMotionModelOptions opts;
+    move.computeFromOdometry(mrpt::poses::CPose2D(0.1, 0, 0), opts);
+    mrpt::obs::CActionCollection acts;
+    acts.insert(move);
+    const Bytes good = bytesOf(acts) + sensoryFrameWith(scan(50));
+    move.computeFromOdometry(mrpt::poses::CPose2D(std::numeric_limits<double>::quiet_NaN(), 0, 0),
+                             opts);
+    mrpt::obs::CActionCollection nanActs;
+    nanActs.insert(move);
+    const fs::path nan = dir / "nan.rawlog";
+    write(nan, good + bytesOf(nanActs) + sensoryFrameWith(scan(50)));
+    expectOneLineError(runMapper("--rawlog", nan, dir), nan, "entry 2 (an action collection)");
+    mrpt::obs::CActionRobotMovement3D move3;
+    move3.poseChange.mean =
+        mrpt::poses::CPose3D(0, std::numeric_limits<double>::infinity(), 0, 0, 0, 0);
+    mrpt::obs::CActionCollection infActs;
+    infActs.insert(move3);
+    const fs::path inf = dir / "inf.rawlog";
+    write(inf, good + bytesOf(infActs) + sensoryFrameWith(scan(50)));
+    expectOneLineError(runMapper("--rawlog", inf, dir), inf, "the odometry is not finite");
+}
+
+// Keyframes with a null pose, a null sensory frame, a null observation: MRPT's height grids
+// and the map's simplemap helper dereferenced them.
+TEST(HostileFiles, NullEntriesInASimplemapAreOneLineErrors) {
+    const fs::path dir = scratchDir("hostile_simplemap");
+    const auto obs = scan(50);
+    auto sf = mrpt::obs::CSensoryFrame::Create();
+    sf->insert(obs);
+    mrpt::maps::CSimpleMap sm;
+    sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), sf);
+    const Bytes good = bytesOf(sm);
+    const Bytes pose =
+        bytesOf(mrpt::poses::CPose3DPDF::Ptr(mrpt::poses::CPose3DPDFGaussian::Create(posePdf())));
+    const Bytes sfBytes = bytesOf(mrpt::obs::CSensoryFrame::Ptr(sf));
+    const Bytes obsBytes = bytesOf(mrpt::obs::CObservation::Ptr(obs));
+    const std::vector<std::tuple<std::string, Bytes, std::string>> cases = {
+        {"nullpose", spliced(good, pose, nullObject()), "keyframe 0 has no pose"},
+        {"wrongpose", spliced(good, pose, poseObject()), "keyframe 0 has no pose"},
+        {"nullsf", spliced(good, sfBytes, nullObject()), "keyframe 0 has no sensory frame"},
+        {"nullobs", spliced(good, obsBytes, nullObject()), "keyframe 0: observation 0"}};
+    for (const auto& [name, bytes, what] : cases) {
+        const fs::path f = dir / (name + ".simplemap");
+        write(f, bytes);
+        expectOneLineError(runMapper("--simplemap", f, dir), f, what);
+    }
+}
+
+// Memory bombs: a sensory frame declaring 2^30 observations (16 GB of pointers), a scan
+// declaring 2^31 beams (8 GB of ranges), a simplemap declaring 2^30 keyframes, in files of a
+// few hundred bytes. Each is read under a 1 GB address-space limit and refused before the
+// allocation, naming the file and the entry, within a second.
+TEST(HostileFiles, FilesDeclaringMoreThanTheyHoldAreRefusedUnderAOneGigabyteLimit) {
+    const fs::path dir = scratchDir("hostile_bombs");
+    const auto obs = scan(12345);
+    const Bytes frame = sensoryFrameWith(scan(3));
+    const Bytes frameBomb = declaring(frame, "CSensoryFrame", 1, 1u << 30, 0);
+    // 2^26 observations: MRPT's deque takes them in 512-byte blocks (1 GB in all).
+    const Bytes blockBomb = declaring(frame, "CSensoryFrame", 1, 1u << 26, 0);
+    const Bytes beamBomb =
+        declaring(sensoryFrameWith(obs), "CObservation2DRangeScan", 12345, 1u << 31, 16);
+    mrpt::maps::CSimpleMap sm;
+    auto sf = mrpt::obs::CSensoryFrame::Create();
+    sf->insert(scan(50));
+    sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), sf);
+    const Bytes smBomb = declaring(bytesOf(sm), "CSimpleMap", 1, 1u << 30, 0);
+    const std::vector<std::tuple<std::string, std::string, Bytes, std::string>> cases = {
+        {"frames.rawlog", "--rawlog", frame + frameBomb, "entry 1 declares more data"},
+        {"blocks.rawlog", "--rawlog", frame + blockBomb, "entry 1 declares more data"},
+        {"beams.rawlog", "--rawlog", frame + beamBomb, "entry 1 declares more data"},
+        {"keyframes.simplemap", "--simplemap", smBomb, "declares more data"}};
+    for (const auto& [name, flag, bytes, what] : cases) {
+        SCOPED_TRACE(name + " (" + std::to_string(bytes.size()) + " bytes)");
+        EXPECT_LT(bytes.size(), 600u);
+        const fs::path f = dir / name;
+        write(f, bytes);
+        const RunResult r = runMapper(flag, f, dir);
+        expectOneLineError(r, f, what);
+        EXPECT_LT(r.seconds, 5.0) << "startup included; the refusal itself is immediate";
+    }
+    // Control: the shipped walk maps under the same limit.
+    const fs::path walk = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog";
+    EXPECT_EQ(runMapper("--rawlog", walk, dir).exitCode, 0);
+}
+
+TEST(HostileFiles, ADirectoryGivenAsTheRawlogOrTheIniIsAOneLineError) {
+    const fs::path dir = scratchDir("hostile_dir");
+    fs::create_directories(dir / "a.rawlog");
+    expectOneLineError(runMapper("--rawlog", dir / "a.rawlog", dir), dir / "a.rawlog",
+                       "is a directory");
+    fs::create_directories(dir / "a.ini");
+    const fs::path err = dir / "stderr.txt";
+    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " +
+                            (dir / "a.ini").string() + " --rawlog " +
+                            (fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog").string() +
+                            " --no-plots --out " + (dir / "out").string() + " > /dev/null 2> " +
+                            err.string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    expectOneLineError({WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(err), 0},
+                       dir / "a.ini", "is a directory");
+}
+#endif

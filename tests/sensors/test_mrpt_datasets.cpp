@@ -1,0 +1,239 @@
+/* MRPT's own recorded datasets (Debian package mrpt-common, MRPT_DATASETS_DIR) through the map:
+ * the VLP-16 scan, the rotating scans and the RGB-D frame. */
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationPointCloud.h>
+#include <mrpt/obs/CObservationRotatingScan.h>
+#include <mrpt/obs/CObservationVelodyneScan.h>
+#include <mrpt/obs/CRawlog.h>
+#include <mrpt/obs/CSensoryFrame.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include "multibin/sensors/SensorDispatch.h"
+
+using namespace multibin::sensors;
+
+namespace {
+/** The observations of a rawlog of MRPT's datasets folder (fails the test if it is missing: the
+ * set-up installs mrpt-common). */
+std::vector<mrpt::obs::CObservation::Ptr> datasetObservations(const std::string& name) {
+    mrpt::obs::CRawlog rawlog;
+    const std::string path = std::string(MRPT_DATASETS_DIR) + "/" + name;
+    EXPECT_TRUE(rawlog.loadFromRawLogFile(path)) << path << " (Debian package mrpt-common)";
+    std::vector<mrpt::obs::CObservation::Ptr> out;
+    for (size_t i = 0; i < rawlog.size(); i++) {
+        if (rawlog.getType(i) == mrpt::obs::CRawlog::etObservation)
+            out.push_back(rawlog.getAsObservation(i));
+        else if (rawlog.getType(i) == mrpt::obs::CRawlog::etSensoryFrame)
+            for (const auto& o : *rawlog.getAsObservations(i)) out.push_back(o);
+    }
+    for (auto& o : out) o->load();
+    return out;
+}
+
+/** A nearly exact robot pose at the origin (1 mm, 1 mrad). */
+mrpt::poses::CPose3DPDFGaussian originPose() {
+    mrpt::poses::CPose3DPDFGaussian pdf;
+    for (int i = 0; i < 6; i++) pdf.cov(i, i) = 1e-6;
+    return pdf;
+}
+
+/** Every cell of the map with a measured height has a finite height and sigma; returns how many
+ * cells are measured. */
+size_t expectFiniteCells(const mrpt::maps::CMultiBinElevationMap& map) {
+    const auto layout = map.toRaster(mrpt::maps::CMultiBinElevationMap::RasterLayer::Source);
+    size_t measured = 0;
+    for (int row = 0; row < layout.rows(); row++)
+        for (int col = 0; col < layout.cols(); col++) {
+            const double x = layout.xllcenter_m + col * layout.cellsize_m;
+            const double y = layout.yllcenter_m + row * layout.cellsize_m;
+            double h = 0, s = 0;
+            if (!map.getHeight(x, y, h, s)) continue;
+            measured++;
+            EXPECT_TRUE(std::isfinite(h) && std::isfinite(s) && s > 0)
+                << "cell at (" << x << ", " << y << "): height " << h << ", sigma " << s;
+        }
+    return measured;
+}
+}  // namespace
+
+// The VLP-16 scan: MRPT's CSimplePointsMap takes 11 305 points from it and so must the map (it
+// was refused before: 0 points). Its floor, the largest near-horizontal plane of MRPT's own
+// points, must come out of the map at the height MRPT gives it: both use MRPT's calibrated point
+// generation and the same sensor pose, so any offset would be a frame or decoding error of ours.
+// Every raw return must be a fused point or a counted rejection (none lost silently), and no cell
+// may hold a NaN.
+TEST(MrptDatasets, Vlp16ScanFloorIsMrptsPlaneAndEveryReturnIsAccountedFor) {
+    const auto obs = datasetObservations("test_velodyne_VLP16.rawlog");
+    ASSERT_EQ(obs.size(), 1u);
+    const auto velodyne = std::dynamic_pointer_cast<mrpt::obs::CObservationVelodyneScan>(obs[0]);
+    ASSERT_TRUE(velodyne);
+
+    // MRPT's points and the floor plane n.p = d (RANSAC, inliers within 5 cm, |n_z| > 0.8).
+    mrpt::maps::CSimplePointsMap mrptPoints;
+    mrptPoints.insertObservation(*velodyne);
+    ASSERT_EQ(mrptPoints.size(), 11305u);
+    std::vector<Eigen::Vector3d> P;
+    for (size_t i = 0; i < mrptPoints.size(); i++) {
+        float x, y, z;
+        mrptPoints.getPoint(i, x, y, z);
+        P.emplace_back(x, y, z);
+    }
+    std::mt19937 rng(1);
+    std::uniform_int_distribution<size_t> pick(0, P.size() - 1);
+    size_t bestInliers = 0;
+    Eigen::Vector3d n(0, 0, 1);
+    double d = 0;
+    for (int it = 0; it < 3000; it++) {
+        const Eigen::Vector3d a = P[pick(rng)], b = P[pick(rng)], c = P[pick(rng)];
+        Eigen::Vector3d m = (b - a).cross(c - a);
+        if (m.norm() < 1e-9) continue;
+        m = m.normalized() * (m.z() < 0 ? -1.0 : 1.0);
+        if (m.z() < 0.8) continue;
+        size_t inliers = 0;
+        for (const auto& p : P) inliers += std::abs(m.dot(p) - m.dot(a)) < 0.05;
+        if (inliers > bestInliers) bestInliers = inliers, n = m, d = m.dot(a);
+    }
+    ASSERT_GT(bestInliers, 1000u);
+    auto floorZ = [&](double x, double y) { return (d - n.x() * x - n.y() * y) / n.z(); };
+
+    mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
+    c.resolution_m = 0.25;
+    c.max_size_m = 80.0;
+    mrpt::maps::CMultiBinElevationMap map(c);
+    map.insertionOptions.max_range_m = 130.0;
+    map.insertionOptions.fill.enabled = false;
+    ASSERT_TRUE(map.insertObservation(*velodyne, originPose()));
+
+    // Accounting: 75 packets x 12 blocks x 32 channels, each counted once by the model, and each
+    // kept point fused or rejected by the map for a named reason.
+    const LidarStats& ls = map.sensorModelStats().lidar;
+    EXPECT_EQ(ls.returns, 75u * 12u * 32u);
+    EXPECT_EQ(ls.returns, ls.noReturn + ls.notDecoded + ls.notFinite + ls.outOfRange + ls.kept);
+    EXPECT_EQ(ls.kept, 11305u);  // what MRPT's CSimplePointsMap takes
+    const multibin::InsertStats& is = map.insertStats();
+    EXPECT_EQ(is.outOfRange, ls.noReturn + ls.notDecoded + ls.outOfRange);
+    EXPECT_EQ(is.notFinite, ls.notFinite);
+    EXPECT_EQ(is.accepted + is.rejected() - is.outOfRange - is.notFinite, ls.kept);
+    EXPECT_GT(is.accepted, 10000u);
+
+    // The floor: each cell holding at least 3 of MRPT's floor inliers, and no point of MRPT's
+    // more than 0.3 m above the plane (a cell with a wall or an object in it reports that), has
+    // its height on the plane within 3 sigma of the cell plus the plane's own spread (the 5 cm
+    // inlier band) and its relief across the cell (slope x half a diagonal).
+    std::map<std::pair<int, int>, std::pair<int, bool>> cells;  // inliers, clutter
+    const double res = c.resolution_m;
+    for (const auto& p : P) {
+        auto& cell = cells[{int(std::floor(p.x() / res)), int(std::floor(p.y() / res))}];
+        const double above = p.z() - floorZ(p.x(), p.y());
+        if (std::abs(above) < 0.05) cell.first++;
+        if (above > 0.3) cell.second = true;
+    }
+    const double relief = std::hypot(n.x(), n.y()) / n.z() * res * M_SQRT1_2;
+    size_t floorCells = 0, onPlane = 0;
+    double sumOffset = 0;
+    for (const auto& [ij, v] : cells) {
+        if (v.first < 3 || v.second) continue;
+        const double x = (ij.first + 0.5) * res, y = (ij.second + 0.5) * res;
+        double h = 0, s = 0;
+        if (!map.getHeight(x, y, h, s)) continue;
+        floorCells++;
+        const double offset = h - floorZ(x, y);
+        sumOffset += offset;
+        onPlane += std::abs(offset) <= 3 * s + 0.05 + relief;
+    }
+    std::printf(
+        "  floor plane n = (%.4f %.4f %.4f), %zu MRPT inliers; %zu floor cells, %zu on the "
+        "plane, mean offset %.4f m\n",
+        n.x(), n.y(), n.z(), bestInliers, floorCells, onPlane, sumOffset / floorCells);
+    ASSERT_GT(floorCells, 30u);
+    EXPECT_GE(double(onPlane), 0.95 * double(floorCells));
+    EXPECT_LT(std::abs(sumOffset / double(floorCells)), 0.02);
+    EXPECT_GT(expectFiniteCells(map), 500u);
+}
+
+// MRPT 2.5's CObservationRotatingScan stores no beam elevations (no calibration, no point
+// directions), so the VLP-16 rotating scan cannot be turned into points by anyone: MRPT's own
+// CSimplePointsMap takes 0 points from it. The map must say so, naming the observation, instead
+// of mapping nothing in silence. The single-row rotating scan (a 2D scanner) has its geometry and
+// must map every echo.
+TEST(MrptDatasets, RotatingScansMapWhenTheyHaveGeometryAndAreRefusedByNameOtherwise) {
+    const auto velo = datasetObservations("rot_scan_velodyne.rawlog");
+    ASSERT_EQ(velo.size(), 1u);
+    mrpt::maps::CMultiBinElevationMap map;
+    map.insertionOptions.fill.enabled = false;
+    try {
+        map.insertObservation(*velo[0], originPose());
+        FAIL() << "a 16-row rotating scan was accepted without beam geometry";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("CObservationRotatingScan"), std::string::npos);
+    }
+
+    const auto planar = datasetObservations("rot_scan_2d.rawlog");
+    ASSERT_EQ(planar.size(), 1u);
+    const auto rot = std::dynamic_pointer_cast<mrpt::obs::CObservationRotatingScan>(planar[0]);
+    ASSERT_TRUE(rot);
+    size_t echoes = 0;
+    for (int i = 0; i < rot->columnCount; i++) echoes += rot->rangeImage(0, i) != 0;
+    map.insertionOptions.max_range_m = 80.0;
+    map.insertObservation(*rot, originPose());
+    const LidarStats& ls = map.sensorModelStats().lidar;
+    EXPECT_EQ(ls.returns, size_t(rot->columnCount));
+    EXPECT_EQ(ls.noReturn + ls.notFinite, size_t(rot->columnCount) - echoes);
+    EXPECT_EQ(ls.kept + ls.outOfRange, echoes);
+    EXPECT_GT(ls.kept, 0u);
+    expectFiniteCells(map);
+}
+
+// The RGB-D frame of MRPT's tests as a point cloud: by default (no label entry) it gets the depth
+// camera model, as every CObservationPointCloud did before; with `sensor_models = LABEL:lidar` the
+// same points get the lidar's sigma along the ray instead, and both maps hold only finite cells.
+TEST(MrptDatasets, RgbdFramePointCloudGetsTheModelOfItsLabel) {
+    const auto obs = datasetObservations("tests_rgbd.rawlog");
+    mrpt::obs::CObservation3DRangeScan::Ptr depth;
+    for (const auto& o : obs)
+        if (auto d = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(o)) depth = d;
+    ASSERT_TRUE(depth);
+    mrpt::obs::CObservationPointCloud cloud;
+    cloud.sensorLabel = depth->sensorLabel;
+    cloud.sensorPose = depth->sensorPose;
+    auto pts = mrpt::maps::CSimplePointsMap::Create();
+    mrpt::obs::T3DPointsProjectionParams pp;
+    pp.takeIntoAccountSensorPoseOnRobot = false;
+    depth->unprojectInto(*pts, pp);
+    cloud.pointcloud = pts;
+    ASSERT_GT(pts->size(), 1000u);
+
+    for (const std::string model : {"", "lidar"}) {
+        mrpt::config::CConfigFileMemory ini(
+            "[s]\nsensor_models = " +
+            (model.empty() ? std::string() : cloud.sensorLabel + ":" + model) + "\n");
+        mrpt::maps::CMultiBinElevationMap map;
+        map.insertionOptions.loadFromConfigFile(ini, "s");
+        map.insertionOptions.max_range_m = 6.0;
+        map.insertionOptions.fill.enabled = false;
+        const SensorModelOptions& opts = map.insertionOptions.sensors;
+        SensorModelState state;
+        SensorPoints sp;
+        ASSERT_TRUE(observationToSensorPoints(cloud, originPose(), opts, 0.02, 6.0, state, sp));
+        ASSERT_GT(sp.points.size(), 1000u);
+        for (size_t i = 0; i < sp.points.size(); i += 97) {
+            const auto& p = sp.points[i];
+            const double r = p.point_m.cast<double>().norm();
+            const Eigen::Vector3d d = p.point_m.cast<double>() / r;
+            const double along = std::sqrt(d.dot(p.cov_m2.toMatrix() * d));
+            const double expected =
+                model.empty() ? opts.depth.axialSigma_m(r) : opts.lidar.rangeSigma(r);
+            ASSERT_NEAR(along, expected, 1e-5) << "model '" << model << "', point " << i;
+        }
+        EXPECT_TRUE(map.insertObservation(cloud, originPose()));
+        EXPECT_GT(expectFiniteCells(map), 100u);
+    }
+}
