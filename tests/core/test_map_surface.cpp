@@ -3,6 +3,11 @@
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
 #include <cmath>
+#include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/BinGrid.h"
+
+#include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/BinGrid.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 

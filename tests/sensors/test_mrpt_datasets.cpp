@@ -16,6 +16,7 @@
 #include <random>
 #include <string>
 
+#include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin::sensors;

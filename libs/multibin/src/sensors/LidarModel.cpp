@@ -17,7 +17,10 @@ namespace multibin::sensors {
 
 namespace {
 auto lidarSigmas(const LidarModelOptions& opts) {
-    return [&opts](double r) { return std::pair{opts.rangeSigma(r), opts.lateralSigma_m(r)}; };
+    const double lateralPerRange = opts.lateralSigma_m(1.0);  // lateral sigma is linear in range
+    return [&opts, lateralPerRange](double r) {
+        return std::pair{opts.rangeSigma(r), lateralPerRange * r};
+    };
 }
 
 /** A beam of a scan in the sensor's xy plane: no return, NaN, or a point. */

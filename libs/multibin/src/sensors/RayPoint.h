@@ -13,11 +13,11 @@ namespace multibin::sensors {
  * axial_m^2 d d^T + lateral_m^2 (I - d d^T), d = p / |p|. The depth, lidar and stereo-cloud
  * models differ only in their two sigmas. */
 inline SymmetricCov3 rayCovariance(const Eigen::Vector3f& p_m, double axial_m, double lateral_m) {
+    // = (axial^2 - lateral^2) d d^T + lateral^2 I: six entries, no 3x3 temporaries.
     const Eigen::Vector3d d = p_m.cast<double>() / p_m.cast<double>().norm();
-    const Eigen::Matrix3d C =
-        axial_m * axial_m * d * d.transpose() +
-        lateral_m * lateral_m * (Eigen::Matrix3d::Identity() - d * d.transpose());
-    return SymmetricCov3::fromMatrix(C);
+    const double l2 = lateral_m * lateral_m, k = axial_m * axial_m - l2;
+    return {float(k * d.x() * d.x() + l2), float(k * d.x() * d.y()), float(k * d.x() * d.z()),
+            float(k * d.y() * d.y() + l2), float(k * d.y() * d.z()), float(k * d.z() * d.z() + l2)};
 }
 
 enum class RayPointFate { kept, notFinite, outOfRange };
