@@ -180,45 +180,6 @@ TEST(SensorErrors, LaserPitchErrorIsCastButNotWritten) {
     EXPECT_GT(checked, 30);
 }
 
-// Laser mixed pixels with the independent setting (every depth edge over 15 mm): twice the
-// mixed beams of the 0.5 chance at the same edges, each between foreground and background (the
-// shape itself is LaserSim.MixedPixelsLieBetweenForegroundAndBackground).
-TEST(SensorErrors, LaserMixedPixelAtEveryEdge) {
-    Eigen::MatrixXf h = Eigen::MatrixXf::Zero(201, 201);  // x, y in [-1, 1]
-    for (int r = 0; r < 201; ++r)
-        for (int k = 0; k < 201; ++k) {
-            const double x = -1 + 0.01 * k, y = -1 + 0.01 * r;
-            if (x > 0.1 && x < 0.5 && y > -0.1 && y < 0.1) h(r, k) = 0.1f;
-        }
-    const Terrain t = Terrain::fromSamples(h, -1, -1, 0.01);
-    const SurfaceTexture tex(t, 1, 0);
-    auto count = [&](double p) {
-        LaserConfig cfg;
-        cfg.mixedProbability = p;
-        cfg.mixedJump_m = 0.015;
-        const LaserSim laser(cfg, t, tex, 1);
-        std::mt19937_64 rng(4);
-        std::vector<BeamTruth> truth;
-        size_t mixed = 0;
-        for (int s = 0; s < 40; ++s) {
-            const auto scan = laser.scan(mrpt::poses::CPose3D(-0.2 + 0.01 * s, 0, 0, 0, 0, 0),
-                                         syntheticStamp(0), rng, &truth);
-            for (int k = 1; k + 1 < 683; ++k) {
-                if (!truth[k].mixed) continue;
-                ++mixed;
-                const double lo = std::min({truth[k - 1].trueRange_m, truth[k + 1].trueRange_m});
-                const double hi = std::max({truth[k - 1].trueRange_m, truth[k + 1].trueRange_m});
-                EXPECT_GT(scan->getScanRange(k), std::min(lo, truth[k].trueRange_m) - 0.02);
-                EXPECT_LT(scan->getScanRange(k), std::max(hi, truth[k].trueRange_m) + 0.02);
-            }
-        }
-        return mixed;
-    };
-    const size_t all = count(1.0), half = count(0.5);
-    ASSERT_GT(all, 20u);
-    EXPECT_NEAR(double(half) / all, 0.5, 0.15) << half << " of " << all;
-}
-
 namespace {
 /** Textured flat ground: 6 x 6 flat boards of 0.6 m. */
 Terrain texturedPlane() {
@@ -275,9 +236,7 @@ TEST(SensorErrors, StereoStudentTailsAndOutliers) {
 // Mixed pixels at depth edges: in front of a 0.15 m block, pixels next to a disparity jump over
 // 2 px match a blend of both sides with the stated chance, and their disparity lies between.
 TEST(SensorErrors, StereoMixedPixelsBlendBothSidesOfAnEdge) {
-    auto low = sim_test::flatBoard(61, 0.01, 0.0), high = sim_test::flatBoard(61, 0.01, 0.15);
-    const Terrain t =
-        Terrain::fromBoards({low, low, low, low, high, low, low, low, low}, 3, 3, 0.0);
+    const Terrain t = sim_test::raisedCentreBoard();
     const SurfaceTexture tex(t, 4, 0);
     StereoConfig cfg;
     cfg.mixedProbability = 0.5;

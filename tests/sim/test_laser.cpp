@@ -111,18 +111,13 @@ TEST(LaserSim, DarkSurfacesDropOutAndRestoredIntensityIsLow) {
     EXPECT_EQ(dropouts, darkHits);
 }
 
-// A box 0.1 m high occludes the floor behind it: where a scan line jumps from the box top to the
-// floor, some far beams return a range strictly between the two surfaces.
-TEST(LaserSim, MixedPixelsLieBetweenForegroundAndBackground) {
-    Eigen::MatrixXf h = Eigen::MatrixXf::Zero(201, 201);  // x, y in [-1, 1]
-    for (int r = 0; r < 201; ++r)
-        for (int k = 0; k < 201; ++k) {
-            const double x = -1 + 0.01 * k, y = -1 + 0.01 * r;
-            if (x > 0.1 && x < 0.5 && y > -0.1 && y < 0.1) h(r, k) = 0.1f;
-        }
-    const Terrain t = Terrain::fromSamples(h, -1, -1, 0.01);
+namespace {
+/** Scans across a 0.1 m box on the floor; checks that every mixed beam lies between the foreground
+ * and the background (within 10 % of the jump from either, 2 cm of noise) at a jump over
+ * cfg.mixedJump_m, and returns how many there were. */
+size_t mixedPixelsAcrossABox(const LaserConfig& cfg) {
+    const Terrain t = sim_test::boxOnFloor();
     const SurfaceTexture tex(t, 1, 0);
-    LaserConfig cfg;
     const LaserSim laser(cfg, t, tex, 1);
     std::mt19937_64 rng(4);
     std::vector<BeamTruth> truth;
@@ -143,5 +138,25 @@ TEST(LaserSim, MixedPixelsLieBetweenForegroundAndBackground) {
             EXPECT_GT(hi - lo, cfg.mixedJump_m);
         }
     }
-    EXPECT_GT(mixed, 5u);
+    return mixed;
+}
+}  // namespace
+
+// A box 0.1 m high occludes the floor behind it: where a scan line jumps from the box top to the
+// floor, some far beams return a range strictly between the two surfaces.
+TEST(LaserSim, MixedPixelsLieBetweenForegroundAndBackground) {
+    EXPECT_GT(mixedPixelsAcrossABox(LaserConfig()), 5u);
+}
+
+// The independent setting (--laser-mixed 1,0.015: every depth edge over 15 mm): mixed beams of
+// the same shape, twice as many as with a 0.5 chance at the same edges.
+TEST(SensorErrors, LaserMixedPixelAtEveryEdge) {
+    LaserConfig cfg;
+    cfg.mixedJump_m = 0.015;
+    cfg.mixedProbability = 1.0;
+    const size_t all = mixedPixelsAcrossABox(cfg);
+    cfg.mixedProbability = 0.5;
+    const size_t half = mixedPixelsAcrossABox(cfg);
+    ASSERT_GT(all, 20u);
+    EXPECT_NEAR(double(half) / all, 0.5, 0.15) << half << " of " << all;
 }

@@ -142,9 +142,7 @@ TEST(StereoSim, DisparityImageNoiseAndTexturelessBlobs) {
 // width, and only there.
 TEST(StereoSim, HalosFattenTheForegroundAtDepthEdges) {
     // Textured ground with a 0.15 m high textured block in front of the camera.
-    auto low = sim_test::flatBoard(61, 0.01, 0.0), high = sim_test::flatBoard(61, 0.01, 0.15);
-    const Terrain t =
-        Terrain::fromBoards({low, low, low, low, high, low, low, low, low}, 3, 3, 0.0);
+    const Terrain t = sim_test::raisedCentreBoard();
     const SurfaceTexture tex(t, 4, 0);
     StereoConfig cfg;
     cfg.blobsPerFrame = 0;
