@@ -647,7 +647,7 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
     a.movingRimCheck = false;
     a.modelAveraging = false;
     mrpt::config::CConfigFileMemory ini;
-    a.saveToConfigFile(ini, "insertOpts");
+    a.write(ini, "insertOpts");
     FillOptions b;
     b.loadFromConfigFile(ini, "insertOpts");
     EXPECT_EQ(b.enabled, false);

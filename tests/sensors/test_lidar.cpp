@@ -93,7 +93,7 @@ SensorModelOptions loadOptions(const std::string& body) {
     mrpt::config::CConfigFileMemory ini("[s]\n" + body);
     StrictConfigSection s(ini, "s");
     SensorModelOptions o;
-    o.load(s);
+    o.read(s);
     s.finish();
     return o;
 }
@@ -229,10 +229,10 @@ TEST(SensorModels, LidarAndModelKeysRoundTrip) {
     EXPECT_DOUBLE_EQ(o.lidar.beamDivergence_rad,
                      LidarModelOptions::forSensor("os1").beamDivergence_rad);
     mrpt::config::CConfigFileMemory saved;
-    o.save(saved, "s");
+    o.write(saved, "s");
     StrictConfigSection s(saved, "s");
     SensorModelOptions back;
-    back.load(s);
+    back.read(s);
     s.finish();
     EXPECT_EQ(back.lidar.sensor, "os1");
     EXPECT_DOUBLE_EQ(back.lidar.angularSigma_rad, 0.0004);

@@ -13,7 +13,7 @@ SensorModelOptions load(const std::string& body) {
     mrpt::config::CConfigFileMemory ini("[s]\n" + body);
     multibin::StrictConfigSection s(ini, "s");
     SensorModelOptions o;
-    o.load(s);
+    o.read(s);
     s.finish();
     return o;
 }

@@ -125,8 +125,7 @@ void FillOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& source
     s.finish();
 }
 
-void FillOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
-                                   const std::string& section) const {
+void FillOptions::write(mrpt::config::CConfigFileBase& c, const std::string& section) const {
     visitKeys(*this, KeyWriter{c, section});
 }
 

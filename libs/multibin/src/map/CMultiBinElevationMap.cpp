@@ -232,13 +232,11 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
                                         {"hot", mrpt::img::cmHOT},
                                         {"grayscale", mrpt::img::cmGRAYSCALE}});
     s.read("color_by_sigma", color_by_sigma);
-    s.read("visibility_constraint", visibility.enabled);
-    s.read("visibility_margin_m", "visibility_margin", visibility.margin_m);
-    s.read("visibility_certainty_decrement", visibility.certaintyDecrement);
+    visibility.read(s);
     s.read("dem_return_filled", dem_return_filled);
     s.read("relief_sigma", relief_sigma);
     fill.read(s);
-    sensors.load(s);
+    sensors.read(s);
     s.finish();
     validateIn(s, *this);
 }
@@ -266,13 +264,11 @@ void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CC
     c.write(section, "global_sensor_labels", globalLabels);
     c.write(section, "colormap", std::string(colormapName(colormap)));
     c.write(section, "color_by_sigma", color_by_sigma);
-    c.write(section, "visibility_constraint", visibility.enabled);
-    c.write(section, "visibility_margin_m", visibility.margin_m);
-    c.write(section, "visibility_certainty_decrement", visibility.certaintyDecrement);
+    visibility.write(c, section);
     c.write(section, "dem_return_filled", dem_return_filled);
     c.write(section, "relief_sigma", relief_sigma);
-    fill.saveToConfigFile(c, section);
-    sensors.save(c, section);
+    fill.write(c, section);
+    sensors.write(c, section);
 }
 
 void CMultiBinElevationMap::TInsertionOptions::validate() const {
@@ -295,10 +291,7 @@ void CMultiBinElevationMap::TInsertionOptions::validate() const {
     if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt_s", "must be >= 0 [s]");
     if (!(range_sigma_m > 0) || !finite(range_sigma_m))
         bad("range_sigma_m", "must be positive and finite [m]");
-    if (!(visibility.margin_m >= 0) || !finite(visibility.margin_m))
-        bad("visibility_margin_m", "must be >= 0 and finite [m]");
-    if (!(visibility.certaintyDecrement > 0) || !finite(visibility.certaintyDecrement))
-        bad("visibility_certainty_decrement", "must be positive and finite");
+    visibility.validate();
     fill.validate();
     if (!(min_range_m >= 0 && max_range_m > min_range_m))
         bad("min_range_m/max_range_m", "need 0 <= min_range_m < max_range_m");

@@ -1,5 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/map/VisibilityConstraint.h"
+#include <mrpt/config/CConfigFileBase.h>
+#include "multibin/io/StrictConfigSection.h"
 
 #include "multibin/map/CellSurface.h"
 
@@ -8,6 +10,29 @@
 #include <limits>
 
 namespace multibin {
+
+void VisibilityParams::read(StrictConfigSection& s) {
+    s.read("visibility_constraint", enabled);
+    s.read("visibility_margin_m", "visibility_margin", margin_m);
+    s.read("visibility_certainty_decrement", certaintyDecrement);
+}
+
+void VisibilityParams::write(mrpt::config::CConfigFileBase& c, const std::string& section) const {
+    c.write(section, "visibility_constraint", enabled);
+    c.write(section, "visibility_margin_m", margin_m);
+    c.write(section, "visibility_certainty_decrement", certaintyDecrement);
+}
+
+void VisibilityParams::validate() const {
+    auto bad = [](const std::string& key, const std::string& what) {
+        throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key +
+                                    "': " + what);
+    };
+    if (!(margin_m >= 0) || !std::isfinite(margin_m))
+        bad("visibility_margin_m", "must be >= 0 and finite [m]");
+    if (!(certaintyDecrement > 0) || !std::isfinite(certaintyDecrement))
+        bad("visibility_certainty_decrement", "must be positive and finite");
+}
 
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
                                           const VisibilityParams& vis,

@@ -124,7 +124,7 @@ int StereoModelOptions::numDisparitiesFor(int width_px) const {
     return std::clamp(width_px / 4 / 16 * 16, 16, 256);
 }
 
-void SensorModelOptions::load(StrictConfigSection& s) {
+void SensorModelOptions::read(StrictConfigSection& s) {
     // Laser
     if (s.has("laser_range_sigma_coeffs")) {
         std::vector<double> c;
@@ -194,7 +194,7 @@ void SensorModelOptions::load(StrictConfigSection& s) {
     validate();
 }
 
-void SensorModelOptions::save(mrpt::config::CConfigFileBase& c, const std::string& sec) const {
+void SensorModelOptions::write(mrpt::config::CConfigFileBase& c, const std::string& sec) const {
     const RangeSigmaCurve& r = laser.rangeSigma;
     c.write(sec, "laser_range_sigma_coeffs",
             joined(std::array<double, 3>{r.c0_m, r.c1, r.c2_per_m}));

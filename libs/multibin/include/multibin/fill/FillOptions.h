@@ -155,7 +155,7 @@ struct FillOptions {
     void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                             const std::string& section);
     /** Writes every `fill_*` key to `section`. */
-    void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const;
+    void write(mrpt::config::CConfigFileBase& target, const std::string& section) const;
     /** Throws std::invalid_argument naming the ini key of the first bad value. */
     void validate() const;
 };

@@ -4,8 +4,15 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
 
 namespace multibin {
+
+class StrictConfigSection;
 
 /** Parameters of the per-point bin update (eqs 13-15). */
 struct BinUpdateParams {
@@ -49,6 +56,14 @@ struct VisibilityParams {
      * the default equal to the certainty increment, a moved object is forgotten as fast as the
      * new surface is learnt. */
     float certaintyDecrement = 1.0f;
+
+    /** The options protocol of every option struct of the library (map, fill, sensors,
+     * visibility): read its keys from a strict ini section, write them, validate (throws
+     * std::invalid_argument naming the key). Keys: visibility_constraint,
+     * visibility_margin_m (alias visibility_margin), visibility_certainty_decrement. */
+    void read(StrictConfigSection& section);
+    void write(mrpt::config::CConfigFileBase& target, const std::string& section) const;
+    void validate() const;
 };
 
 /** What one application of the constraint did. */

@@ -156,8 +156,8 @@ struct SensorModelOptions {
     SensorModelKind modelFor(const std::string& label, SensorModelKind classDefault) const;
 
     /** Reads the keys present in `s` (the others keep their value), then validate(). */
-    void load(StrictConfigSection& s);
-    void save(mrpt::config::CConfigFileBase& target, const std::string& section) const;
+    void read(StrictConfigSection& s);
+    void write(mrpt::config::CConfigFileBase& target, const std::string& section) const;
     /** Throws std::invalid_argument naming the key of the first bad value. */
     void validate() const;
 };
