@@ -90,35 +90,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const int byHi = BinGrid::blockOf(std::min(iyHi + 1, w.iy0 + w.ny - 1));
         if (bxHi >= bxLo && byHi >= byLo &&
             double(bxHi - bxLo + 1) * double(byHi - byLo + 1) <= double(1 << 18)) {
-            tableX0 = bxLo;
-            tableY0 = byLo;
-            tableNx = unsigned(bxHi - bxLo + 1);
-            tableNy = unsigned(byHi - byLo + 1);
-            regionBound.resize(size_t(tableNx) * tableNy);
-            const bool sensorNear = std::abs(sensor_m.x() * invCell) < kNoClamp &&
-                                    std::abs(sensor_m.y() * invCell) < kNoClamp;
-            sensorBx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
-            sensorBy = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
-            if (sensorNear)
-                ringBound.assign(
-                    size_t(std::max({std::abs(bxLo - sensorBx), std::abs(bxHi - sensorBx),
-                                     std::abs(byLo - sensorBy), std::abs(byHi - sensorBy)})) +
-                        1,
-                    -std::numeric_limits<float>::infinity());
             float bound_m = -std::numeric_limits<float>::infinity();
             for (int by = byLo; by <= byHi; by++)
-                for (int bx = bxLo; bx <= bxHi; bx++) {
-                    const float b = grid.blockMaxHeight_m(bx, by);
-                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = b;
-                    bound_m = std::max(bound_m, b);
-                    if (!ringBound.empty()) {
-                        float& r = ringBound[size_t(
-                            std::max(std::abs(bx - sensorBx), std::abs(by - sensorBy)))];
-                        r = std::max(r, b);
-                    }
-                }
-            for (size_t j = 1; j < ringBound.size(); j++)
-                ringBound[j] = std::max(ringBound[j], ringBound[j - 1]);
+                for (int bx = bxLo; bx <= bxHi; bx++)
+                    bound_m = std::max(bound_m, grid.blockMaxHeight_m(bx, by));
             // Every sample lies in this region: its bound caps what a ray can meet.
             stopHeight =
                 std::min(stopHeight,
@@ -134,6 +109,35 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 return stats;
             }
+            // Rays to walk: the region's tables (a second pass, which the common case above
+            // never needs).
+            tableX0 = bxLo;
+            tableY0 = byLo;
+            tableNx = unsigned(bxHi - bxLo + 1);
+            tableNy = unsigned(byHi - byLo + 1);
+            regionBound.resize(size_t(tableNx) * tableNy);
+            const bool sensorNear = std::abs(sensor_m.x() * invCell) < kNoClamp &&
+                                    std::abs(sensor_m.y() * invCell) < kNoClamp;
+            sensorBx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
+            sensorBy = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
+            if (sensorNear)
+                ringBound.assign(
+                    size_t(std::max({std::abs(bxLo - sensorBx), std::abs(bxHi - sensorBx),
+                                     std::abs(byLo - sensorBy), std::abs(byHi - sensorBy)})) +
+                        1,
+                    -std::numeric_limits<float>::infinity());
+            for (int by = byLo; by <= byHi; by++)
+                for (int bx = bxLo; bx <= bxHi; bx++) {
+                    const float b = grid.blockMaxHeight_m(bx, by);
+                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = b;
+                    if (!ringBound.empty()) {
+                        float& r = ringBound[size_t(
+                            std::max(std::abs(bx - sensorBx), std::abs(by - sensorBy)))];
+                        r = std::max(r, b);
+                    }
+                }
+            for (size_t j = 1; j < ringBound.size(); j++)
+                ringBound[j] = std::max(ringBound[j], ringBound[j - 1]);
         }
     }
 
