@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace multibin {
 
@@ -80,6 +81,21 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     // box can hold a bin above that height by more than the smallest conflict margin, nothing
     // conflicts (a floor seen from above: most laser scans). Only the rays are counted.
     const std::vector<BinGrid::UpdatedCell>& updated = grid.updatedCells();
+    // The region's block bounds copied into a dense table (exact copies; up to 1 MB): the walks
+    // below look them up there, without the block table's wrap-around and tags.
+    std::vector<float> regionBound;
+    int tableX0 = 0, tableY0 = 0;
+    unsigned tableNx = 0, tableNy = 0;
+    auto blockBound = [&](int bx, int by) {
+        const unsigned sx = unsigned(bx - tableX0), sy = unsigned(by - tableY0);
+        return sx < tableNx && sy < tableNy ? regionBound[sx + sy * tableNx]
+                                            : grid.blockMaxHeight_m(bx, by);
+    };
+    // ringBound[j]: the highest bound of a table block within j blocks (Chebyshev) of the
+    // sensor's block. The rest of a ray, within r of the sensor, lies in such blocks: a walk
+    // ends where the rest of its ray passes above them all.
+    std::vector<float> ringBound;
+    int sensorBx = 0, sensorBy = 0;
     if (!updated.empty()) {
         int ixLo = grid.cellIndex(sensor_m.x()), ixHi = ixLo;
         int iyLo = grid.cellIndex(sensor_m.y()), iyHi = iyLo;
@@ -97,7 +113,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const int bxHi = BinGrid::blockOf(std::min(ixHi + 1, w.ix0 + w.nx - 1));
         const int byLo = BinGrid::blockOf(std::max(iyLo - 1, w.iy0));
         const int byHi = BinGrid::blockOf(std::min(iyHi + 1, w.iy0 + w.ny - 1));
-        if ((bxHi - bxLo + 1) * (byHi - byLo + 1) <= 1024) {
+        if (bxHi >= bxLo && byHi >= byLo &&
+            double(bxHi - bxLo + 1) * double(byHi - byLo + 1) <= double(1 << 18)) {
             float bound_m = -std::numeric_limits<float>::infinity();
             for (int by = byLo; by <= byHi; by++)
                 for (int bx = bxLo; bx <= bxHi; bx++)
@@ -117,8 +134,44 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 return stats;
             }
+            // Rays to walk: the region's tables (a second pass, which the common case above
+            // never needs).
+            tableX0 = bxLo;
+            tableY0 = byLo;
+            tableNx = unsigned(bxHi - bxLo + 1);
+            tableNy = unsigned(byHi - byLo + 1);
+            regionBound.resize(size_t(tableNx) * tableNy);
+            const bool sensorNear = std::abs(sensor_m.x() * invCell) < kNoClamp &&
+                                    std::abs(sensor_m.y() * invCell) < kNoClamp;
+            sensorBx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
+            sensorBy = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
+            if (sensorNear)
+                ringBound.assign(
+                    size_t(std::max({std::abs(bxLo - sensorBx), std::abs(bxHi - sensorBx),
+                                     std::abs(byLo - sensorBy), std::abs(byHi - sensorBy)})) +
+                        1,
+                    -std::numeric_limits<float>::infinity());
+            for (int by = byLo; by <= byHi; by++)
+                for (int bx = bxLo; bx <= bxHi; bx++) {
+                    const float b = grid.blockMaxHeight_m(bx, by);
+                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = b;
+                    if (!ringBound.empty()) {
+                        float& r = ringBound[size_t(
+                            std::max(std::abs(bx - sensorBx), std::abs(by - sensorBy)))];
+                        r = std::max(r, b);
+                    }
+                }
+            for (size_t j = 1; j < ringBound.size(); j++)
+                ringBound[j] = std::max(ringBound[j], ringBound[j - 1]);
         }
     }
+
+    // The sample distances along a ray, as the walk accumulates them (d += step, not k step,
+    // whose rounding differs): the same for every ray, so computed once, as far as a ray needs.
+    std::vector<double> sampleAt{0.0, step};
+    // Per ray: the stretches [from, to] of distance over block columns that may hold a
+    // conflicting bin, in walking order; samples elsewhere are skipped (see below).
+    std::vector<std::pair<double, double>> stretches;
 
     for (const BinGrid::UpdatedCell& u : updated) {
         const double tz = u.maxHeight_m;
@@ -139,8 +192,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         };
 
         // Bins of the updated cell above all that was measured in it now.
-        if (blockMayConflict(grid.blockMaxHeight_m(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
-                             tz)) {
+        if (blockMayConflict(blockBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)), tz)) {
             target();
             grid.editBins(u.ix, u.iy, [&](Bin& b) {
                 if (!conflicts(b, tz)) return true;
@@ -164,6 +216,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         // the ray's lowest height there. `reach` ends the last stretch of the ray below some
         // block's bound: no sample beyond it can meet a conflicting bin.
         double reach = 0;
+        stretches.clear();
         {
             const bool xMajor = std::abs(dx) >= std::abs(dy);
             const double da0 = xMajor ? dx : dy, db0 = xMajor ? dy : dx;
@@ -183,6 +236,16 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 const double startZ_m = tz + aSlope * (da - kSlack_m) - kSlack_m;
                 // Past here the samples stop: the ray clears the highest stored bin (below).
                 if (aSlope > 0 && startZ_m - aRise > stopHeight) break;
+                if (!ringBound.empty()) {
+                    // The rest of the ray: no lower than its ends, within (length - da) of the
+                    // sensor, so over blocks at most j away (a cell and a block spare).
+                    const double j = (length - da + 2 * cell) * invBlock + 2;
+                    const float restBound_m =
+                        j < double(ringBound.size() - 1) ? ringBound[size_t(j)] : ringBound.back();
+                    const double restLowest_m =
+                        std::min(startZ_m, tz + aSlope * (length + kSlack_m) - kSlack_m);
+                    if (!blockMayConflict(restBound_m, restLowest_m)) break;
+                }
                 const double exit = ((da0 > 0 ? ka + 1 : ka) * block_m - a0) * invUa;
                 const double db = std::min(exit, length);
                 const double bLo = b0 + ub * (ub > 0 ? da - kSlack_m : db + kSlack_m) - kSlack_m;
@@ -191,11 +254,16 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 for (int kb = BinGrid::floorToInt(bLo * invBlock),
                          kbEnd = BinGrid::floorToInt(bHi * invBlock);
                      kb <= kbEnd; kb++)
-                    bound_m = std::max(bound_m, xMajor ? grid.blockMaxHeight_m(ka, kb)
-                                                       : grid.blockMaxHeight_m(kb, ka));
+                    bound_m = std::max(bound_m, xMajor ? blockBound(ka, kb) : blockBound(kb, ka));
                 const double lowest_m =
                     aSlope > 0 ? startZ_m : tz + aSlope * (db + kSlack_m) - kSlack_m;
-                if (blockMayConflict(bound_m, lowest_m + aRise)) reach = db + kSlack_m;
+                if (blockMayConflict(bound_m, lowest_m + aRise)) {
+                    reach = db + kSlack_m;
+                    if (!stretches.empty() && stretches.back().second >= da - kSlack_m)
+                        stretches.back().second = reach;  // joins the previous column's
+                    else
+                        stretches.emplace_back(da - kSlack_m, reach);
+                }
                 da = exit;
             }
         }
@@ -226,35 +294,59 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         };
         clipAxis(tx, ux, w.ix0, w.nx);
         clipAxis(ty, uy, w.iy0, w.ny);
+        // Only the samples within the stretches, each taken exactly as the full walk takes it:
+        // a sample outside them lies over blocks whose bound is too low to conflict, so it edits
+        // nothing, and it lies in another cell than the next sample taken (cells of a column
+        // that cannot conflict, or, within the slack of a column edge, a cell the block test
+        // below rejects as the full walk's would): the one-test-per-cell rule is kept.
+        const double last = std::min(walk, reach);
+        while (sampleAt.back() < last) sampleAt.push_back(sampleAt.back() + step);
         int lastIx = u.ix, lastIy = u.iy;
-        for (double d = step; d < walk; d += step) {
-            if (d > reach) break;
-            const double rayZ = tz + slope * d;
-            if (slope > 0 && rayZ - inCellRise > stopHeight) break;
-            const int ix = cellOf(tx + ux * d);
-            const int iy = cellOf(ty + uy * d);
-            if (ix == lastIx && iy == lastIy) continue;
-            lastIx = ix;
-            lastIy = iy;
-            const double rayHigh = rayZ + inCellRise;
-            // The block bound first: a small table, and most cells stop here.
-            if (!blockMayConflict(grid.blockMaxHeight_m(BinGrid::blockOf(ix), BinGrid::blockOf(iy)),
-                                  rayHigh))
-                continue;
-            if (!w.contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
-            stats.cellsVisited++;
-            grid.editBins(ix, iy, [&](Bin& b) {
-                if (!conflicts(b, rayHigh)) return true;
-                if (b.certainty < target()) {
+        size_t k = 1;
+        bool done = false;
+        for (const auto& [from, to] : stretches) {
+            // sampleAt[k] is k step to within far less than a step: start two samples early.
+            const double guess = std::floor(from / step) - 2;
+            if (guess > double(k)) k = size_t(guess);
+            for (; k < sampleAt.size(); k++) {
+                const double d = sampleAt[k];
+                if (d < from) continue;
+                if (!(d < walk) || d > reach) {
+                    done = true;
+                    break;
+                }
+                if (d > to) break;
+                const double rayZ = tz + slope * d;
+                if (slope > 0 && rayZ - inCellRise > stopHeight) {
+                    done = true;
+                    break;
+                }
+                const int ix = cellOf(tx + ux * d);
+                const int iy = cellOf(ty + uy * d);
+                if (ix == lastIx && iy == lastIy) continue;
+                lastIx = ix;
+                lastIy = iy;
+                const double rayHigh = rayZ + inCellRise;
+                // The block bound first: a small table, and most cells stop here.
+                if (!blockMayConflict(blockBound(BinGrid::blockOf(ix), BinGrid::blockOf(iy)),
+                                      rayHigh))
+                    continue;
+                if (!w.contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
+                stats.cellsVisited++;
+                grid.editBins(ix, iy, [&](Bin& b) {
+                    if (!conflicts(b, rayHigh)) return true;
+                    if (b.certainty < target()) {
+                        stats.binsRemoved++;
+                        return false;
+                    }
+                    b.certainty -= decrement;
+                    stats.binsWeakened++;
+                    if (b.certainty > 0) return true;
                     stats.binsRemoved++;
                     return false;
-                }
-                b.certainty -= decrement;
-                stats.binsWeakened++;
-                if (b.certainty > 0) return true;
-                stats.binsRemoved++;
-                return false;
-            });
+                });
+            }
+            if (done) break;
         }
     }
     return stats;

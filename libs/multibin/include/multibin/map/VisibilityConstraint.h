@@ -23,9 +23,12 @@ namespace multibin {
  * Heights can therefore go down as well as up. The rays are sampled every half cell from the
  * updated cell back towards the sensor. BinGrid's block height bounds (BinGrid::blockMaxHeight_m)
  * decide where a bin can conflict at all: a ray is walked only as far as the last block it
- * passes too low over, a cell is tested only if its block's bound lies above the ray by the
- * smallest conflict margin, and an update whose whole region (the blocks between the sensor and
- * the updated cells) lies below every line of sight costs no walk at all. The bins edited are
+ * passes too low over, and only over the block columns it passes too low over (its other
+ * samples are skipped, the rest taken at the same distances), a ray's sweep of block columns
+ * ends where the rest of the ray passes above every block that near the sensor, a cell is tested
+ * only if its block's bound lies above the ray by the smallest conflict margin, and an update
+ * whose whole region (the blocks between the sensor and the updated cells) lies below every line
+ * of sight costs no walk at all. The bins edited are
  * exactly those of a walk to the highest bin stored anywhere; the cost grows with the distinct
  * updated cells, not with the points, and with the relief near the lines of sight. */
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
