@@ -75,6 +75,12 @@ namespace mrpt::maps {
  * \endcode
  * Unknown keys and malformed values are errors that name the section and the key.
  *
+ * Threads: one writer and any number of concurrent readers may share a map. Every public entry
+ * point takes a reader-writer lock (insertions, recenter(), dem_update_map() and clear() write;
+ * queries, rasters, images and the 3D view read). The accessors that return references into the
+ * map (grid(), lastFill(), insertStats(), ...) and the public option structs are not covered: use
+ * them from the writer thread or while no one writes. See doc/reliability.md.
+ *
  * Observation likelihood is not implemented: canComputeObservationLikelihood() returns false.
  */
 class CMultiBinElevationMap : public CMetricMap, public CHeightGridMap2D_Base {
@@ -198,7 +204,7 @@ public:
     multibin::BinUpdateParams binUpdateParams() const;
     /** Where a height comes from (getElevation()): the library's one source enum. */
     using HeightSource = multibin::HeightSource;
-    /** Height [m] and sigma [m] at (x, y): measured (the winning bin, as getHeight()) or, with
+    /** Height [m] and sigma [m] at (x, y): measured (the cell surface, as getHeight()) or, with
      * includeFilled, the result of the last gap filling (dem_update_map()) for a cell that is
      * still unobserved. Filled cells keep certainty 0. */
     HeightSource getElevation(double x_m, double y_m, double& height_m, double& sigma_m,
@@ -208,7 +214,8 @@ public:
     /** The last gap filling's result over the grid window it was run on. */
     const multibin::fill::FillResult& lastFill() const;
 
-    /** Height [m] and sigma [m] at (x, y) from the winning bin; false if unobserved. With the
+    /** Height [m] and sigma [m] at (x, y) from the cell surface (its winning bin merged with the
+     * adjacent bins that agree with it, multibin/map/CellSurface.h); false if unobserved. With the
      * dual grid, where both grids know the place and agree within 3 sigma, their independent
      * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
@@ -228,7 +235,7 @@ public:
     enum class RasterLayer {
         Height,     //!< [m]
         Sigma,      //!< [m]
-        Certainty,  //!< winning bin's certainty c [-]; 0 for filled cells
+        Certainty,  //!< certainty c of the cell surface's bins [-]; 0 for filled cells
         Source      //!< HeightSource as a number: 1 measured, 2 median-filled, 3 surface-filled
     };
     /** One layer over the grid window as a raster, NaN where unknown; row 0 is the southernmost
@@ -260,7 +267,8 @@ public:
     /** Writes PREFIX_height.png and PREFIX_sigma.png (colour images, north up); ESRI ASCII
      * rasters PREFIX_height.asc, PREFIX_sigma.asc [m], PREFIX_certainty.asc and
      * PREFIX_source.asc (see RasterLayer); PREFIX_height.tif (float32 TIFF with a .tfw world
-     * file); PREFIX.ply (triangle mesh [m]) and PREFIX.3Dscene. */
+     * file); PREFIX.ply (triangle mesh [m]) and PREFIX.3Dscene. The rasters cover the known
+     * cells plus 5 cells, not the whole window. */
     void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
     float compute3DMatchingRatio(const mrpt::maps::CMetricMap* otherMap,
                                  const mrpt::poses::CPose3D& otherMapPose,

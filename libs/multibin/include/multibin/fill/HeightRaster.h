@@ -8,7 +8,7 @@
 
 namespace multibin::fill {
 
-/** The input of gap filling: the winning bin of every cell of an elevation grid, as plain rows.
+/** The input of gap filling: the surface of every cell of an elevation grid, as plain rows.
  *
  * The geometry is a multibin::Lattice: cell (ix, iy), column ix and row iy of the lattice, is
  * stored at lattice.index(ix, iy) = iy * nx + ix. A cell is *measured* when certainty > 0 and its
