@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationPointCloud.h>
@@ -237,4 +238,45 @@ TEST(MrptDatasets, RgbdFramePointCloudGetsTheModelOfItsLabel) {
         EXPECT_TRUE(map.insertObservation(cloud, originPose()));
         EXPECT_GT(expectFiniteCells(map), 100u);
     }
+}
+
+// MRPT's icp-slam map of the Malaga CS faculty building: its keyframes carry an all-zero 6x6
+// covariance (icp-slam's poses are exact by construction). An exact pose is not an error: the
+// points must be fused as with a near-exact (1 mm) pose, none rejected as "covariance", and every
+// reading fused or counted by reason. Before exact poses were accepted, every point of this map
+// was rejected as "covariance" and the map stayed empty.
+TEST(MrptDatasets, IcpSlamSimplemapWithExactPosesIsMapped) {
+    const std::string path =
+        std::string(MRPT_DATASETS_DIR) + "/malaga-cs-fac-building.simplemap.gz";
+    mrpt::maps::CSimpleMap simplemap;
+    ASSERT_TRUE(simplemap.loadFromFile(path)) << path << " (Debian package mrpt-common)";
+    ASSERT_GT(simplemap.size(), 10u);
+    size_t exactKeyframes = 0;
+    for (const auto& kf : simplemap) {
+        const auto [cov, mean] = kf.pose->getCovarianceAndMean();
+        exactKeyframes += cov.asEigen().cwiseAbs().maxCoeff() == 0.0;
+    }
+    EXPECT_EQ(exactKeyframes, simplemap.size()) << "the dataset's keyframes are exact poses";
+
+    // The same keyframes with a 1 mm / 1 mrad covariance: the reference count.
+    mrpt::maps::CSimpleMap nearExact = simplemap;
+    for (auto& kf : nearExact) {
+        auto pdf = mrpt::poses::CPose3DPDFGaussian::Create();
+        pdf->mean = kf.pose->getMeanVal();
+        for (int i = 0; i < 6; i++) pdf->cov(i, i) = 1e-6;
+        kf.pose = pdf;
+    }
+    mrpt::maps::CMultiBinElevationMap::TCreationOptions creation;
+    creation.resolution_m = 0.1;  // a building floor: 10 cm cells
+    mrpt::maps::CMultiBinElevationMap exact(creation), reference(creation);
+    exact.insertSimpleMapWithPosePdfs(simplemap);
+    reference.insertSimpleMapWithPosePdfs(nearExact);
+
+    const multibin::InsertStats& s = exact.insertStats();
+    EXPECT_EQ(s.badCovariance, 0u);
+    EXPECT_EQ(s.notFinite, 0u);
+    EXPECT_GT(s.accepted, 1000u);
+    EXPECT_GE(double(s.accepted), 0.99 * double(reference.insertStats().accepted))
+        << "exact " << s.accepted << ", 1 mm " << reference.insertStats().accepted;
+    EXPECT_GT(expectFiniteCells(exact), 100u);
 }

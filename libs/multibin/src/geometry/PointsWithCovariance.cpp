@@ -1,21 +1,28 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/geometry/PointsWithCovariance.h"
 
+#include <cmath>
+
 namespace multibin {
 
 bool isSingularCovariance(const SymmetricCov3& c) {
-    // Rounding: float entries carry a relative error of 6e-8, so a singular covariance can show
-    // minors of -1e-7 of their scale; 1e-5 leaves room. The absolute terms cover entries that
-    // rounded to zero (variances below (1e-12 m)^2 are exact for any purpose).
-    constexpr double kRel = 1e-5, kAbs2 = 1e-48, kAbs3 = 1e-72;
+    // Rounding: a covariance rotated into the map frame in single precision carries errors of
+    // about 1e-7 of its largest entry in every entry, so an exactly singular one (an exact pose,
+    // a range-only sensor) can show a variance or minor slightly below zero, by that much of its
+    // scale (the trace t), not of its own size. 1e-6 t, 1e-5 t^2 and 1e-5 t^3 leave room; an
+    // indefinite covariance (a negative variance, |correlation| > 1) misses them by far.
+    constexpr double kVar = 1e-6, kMinor = 1e-5;
     const double xx = c.xx, xy = c.xy, xz = c.xz, yy = c.yy, yz = c.yz, zz = c.zz;
-    if (!(xx >= 0 && yy >= 0 && zz >= 0)) return false;  // also NaN
+    const double t = xx + yy + zz;
+    if (!(t >= 0) || !std::isfinite(t) || !std::isfinite(xy) || !std::isfinite(xz) ||
+        !std::isfinite(yz))
+        return false;  // also NaN
+    if (!(xx >= -kVar * t && yy >= -kVar * t && zz >= -kVar * t)) return false;
+    const double t2 = t * t, t3 = t2 * t;
     const double mxy = xx * yy - xy * xy, mxz = xx * zz - xz * xz, myz = yy * zz - yz * yz;
-    if (!(mxy >= -kRel * xx * yy - kAbs2 && mxz >= -kRel * xx * zz - kAbs2 &&
-          myz >= -kRel * yy * zz - kAbs2))
-        return false;
+    if (!(mxy >= -kMinor * t2 && mxz >= -kMinor * t2 && myz >= -kMinor * t2)) return false;
     const double det = xx * myz - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
-    return det >= -kRel * xx * yy * zz - kAbs3;
+    return det >= -kMinor * t3;
 }
 
 }  // namespace multibin
