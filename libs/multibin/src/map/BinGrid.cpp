@@ -6,19 +6,15 @@
 #include <stdexcept>
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/util/Counters.h"
 
 namespace multibin {
 
 InsertStats& InsertStats::operator+=(const InsertStats& o) {
-    accepted += o.accepted;
-    outOfRange += o.outOfRange;
-    notFinite += o.notFinite;
-    badCovariance += o.badCovariance;
-    outsideMap += o.outsideMap;
-    outsideBinRange += o.outsideBinRange;
-    tooUncertain += o.tooUncertain;
-    continuityRejected += o.continuityRejected;
-    return *this;
+    return util::addMembers(*this, o, &InsertStats::accepted, &InsertStats::outOfRange,
+                            &InsertStats::notFinite, &InsertStats::badCovariance,
+                            &InsertStats::outsideMap, &InsertStats::outsideBinRange,
+                            &InsertStats::tooUncertain, &InsertStats::continuityRejected);
 }
 
 BinGrid::BinGrid(double cellSize_m) : BinStore(cellSize_m) { m_index.reset(window()); }

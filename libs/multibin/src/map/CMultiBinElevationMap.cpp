@@ -119,22 +119,37 @@ const char* colormapName(mrpt::img::TColormap c) {
 // ---------------------------------------------------------------------------------------------
 // Options
 // ---------------------------------------------------------------------------------------------
+namespace {
+/** Calls visit(key, oldName, member) for every key of `o` (a TCreationOptions or a const one;
+ * oldName is the documented alias from before the unit suffix, or empty): the one list of keys
+ * that load and save share, in the order save writes them. */
+template <class Options, class Visit>
+void visitCreationKeys(Options& o, Visit&& visit) {
+    visit("resolution_m", "resolution", o.resolution_m);
+    visit("bin_height_m", "bin_height", o.bin_height_m);
+    visit("grow", "", o.grow);
+    visit("max_size_m", "", o.max_size_m);
+    visit("min_x_m", "min_x", o.min_x);
+    visit("max_x_m", "max_x", o.max_x);
+    visit("min_y_m", "min_y", o.min_y);
+    visit("max_y_m", "max_y", o.max_y);
+    visit("dual_grid", "", o.dual_grid);
+    visit("local_size_m", "", o.local_size_m);
+    visit("local_resolution_m", "local_resolution", o.local_resolution_m);
+    visit("global_size_m", "", o.global_size_m);
+    visit("global_resolution_m", "global_resolution", o.global_resolution_m);
+}
+}  // namespace
+
 void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
     multibin::StrictConfigSection s(source, section);
-    s.read("resolution_m", "resolution", resolution_m);
-    s.read("bin_height_m", "bin_height", bin_height_m);
-    s.read("grow", grow);
-    s.read("max_size_m", max_size_m);
-    s.read("min_x_m", "min_x", min_x);
-    s.read("max_x_m", "max_x", max_x);
-    s.read("min_y_m", "min_y", min_y);
-    s.read("max_y_m", "max_y", max_y);
-    s.read("dual_grid", dual_grid);
-    s.read("local_size_m", local_size_m);
-    s.read("local_resolution_m", "local_resolution", local_resolution_m);
-    s.read("global_size_m", global_size_m);
-    s.read("global_resolution_m", "global_resolution", global_resolution_m);
+    visitCreationKeys(*this, [&](const char* key, const std::string& oldName, auto& value) {
+        if (oldName.empty())
+            s.read(key, value);
+        else
+            s.read(key, oldName, value);
+    });
     s.allow(kGenericMapKeys);
     s.finish();
     validateIn(s, *this);
@@ -142,19 +157,9 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
 
 void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                                                const std::string& section) const {
-    c.write(section, "resolution_m", resolution_m);
-    c.write(section, "bin_height_m", bin_height_m);
-    c.write(section, "grow", grow);
-    c.write(section, "max_size_m", max_size_m);
-    c.write(section, "min_x_m", min_x);
-    c.write(section, "max_x_m", max_x);
-    c.write(section, "min_y_m", min_y);
-    c.write(section, "max_y_m", max_y);
-    c.write(section, "dual_grid", dual_grid);
-    c.write(section, "local_size_m", local_size_m);
-    c.write(section, "local_resolution_m", local_resolution_m);
-    c.write(section, "global_size_m", global_size_m);
-    c.write(section, "global_resolution_m", global_resolution_m);
+    visitCreationKeys(*this, [&](const char* key, const std::string&, const auto& value) {
+        c.write(section, key, value);
+    });
 }
 
 namespace {

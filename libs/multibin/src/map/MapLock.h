@@ -22,56 +22,48 @@ public:
     MapLock(const MapLock&) {}
     MapLock& operator=(const MapLock&) { return *this; }
 
-    /** Held for reading for its lifetime (unless this thread holds the lock already). */
-    class Shared {
+    /** Held for its lifetime, for writing when Exclusive, else for reading (unless this thread
+     * holds the lock already; for writing, a read held here is a bug). */
+    template <bool Exclusive>
+    class Guard {
     public:
-        explicit Shared(const MapLock& l) : m_lock(l), m_taken(!l.heldHere(false)) {
-            if (m_taken) {
-                // Writers first: glibc's rwlock prefers readers, and two readers that query
-                // back to back would starve the mapping thread.
-                while (l.m_writersWaiting.load(std::memory_order_acquire) > 0)
-                    std::this_thread::yield();
-                l.m_mutex.lock_shared();
-                held().emplace_back(&l, false);
-            }
+        explicit Guard(const MapLock& l) : m_lock(l), m_taken(!l.heldHere(Exclusive)) {
+            if (m_taken) l.acquire(Exclusive);
         }
-        ~Shared() {
-            if (!m_taken) return;
-            forget(m_lock);
-            m_lock.m_mutex.unlock_shared();
+        ~Guard() {
+            if (m_taken) m_lock.release(Exclusive);
         }
-        Shared(const Shared&) = delete;
-        Shared& operator=(const Shared&) = delete;
+        Guard(const Guard&) = delete;
+        Guard& operator=(const Guard&) = delete;
 
     private:
         const MapLock& m_lock;
         bool m_taken;
     };
-    /** Held for writing for its lifetime (unless this thread holds it for writing already). */
-    class Exclusive {
-    public:
-        explicit Exclusive(const MapLock& l) : m_lock(l), m_taken(!l.heldHere(true)) {
-            if (m_taken) {
-                l.m_writersWaiting.fetch_add(1, std::memory_order_acq_rel);
-                l.m_mutex.lock();
-                l.m_writersWaiting.fetch_sub(1, std::memory_order_acq_rel);
-                held().emplace_back(&l, true);
-            }
-        }
-        ~Exclusive() {
-            if (!m_taken) return;
-            forget(m_lock);
-            m_lock.m_mutex.unlock();
-        }
-        Exclusive(const Exclusive&) = delete;
-        Exclusive& operator=(const Exclusive&) = delete;
-
-    private:
-        const MapLock& m_lock;
-        bool m_taken;
-    };
+    using Shared = Guard<false>;
+    using Exclusive = Guard<true>;
 
 private:
+    void acquire(bool exclusive) const {
+        if (exclusive) {
+            m_writersWaiting.fetch_add(1, std::memory_order_acq_rel);
+            m_mutex.lock();
+            m_writersWaiting.fetch_sub(1, std::memory_order_acq_rel);
+        } else {
+            // Writers first: glibc's rwlock prefers readers, and two readers that query
+            // back to back would starve the mapping thread.
+            while (m_writersWaiting.load(std::memory_order_acquire) > 0) std::this_thread::yield();
+            m_mutex.lock_shared();
+        }
+        held().emplace_back(this, exclusive);
+    }
+    void release(bool exclusive) const {
+        forget(*this);
+        if (exclusive)
+            m_mutex.unlock();
+        else
+            m_mutex.unlock_shared();
+    }
     using Held = std::vector<std::pair<const MapLock*, bool>>;  // lock, exclusive
     static Held& held() {
         thread_local Held h;

@@ -1,58 +1,37 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/SensorStats.h"
+#include "multibin/util/Counters.h"
 
 namespace multibin::sensors {
 
 LaserStats& LaserStats::operator+=(const LaserStats& o) {
-    beams += o.beams;
-    noReturn += o.noReturn;
-    notFinite += o.notFinite;
-    outOfRange += o.outOfRange;
-    lowIntensity += o.lowIntensity;
-    mixedPixel += o.mixedPixel;
-    kept += o.kept;
-    return *this;
+    return util::addMembers(*this, o, &LaserStats::beams, &LaserStats::noReturn,
+                            &LaserStats::notFinite, &LaserStats::outOfRange,
+                            &LaserStats::lowIntensity, &LaserStats::mixedPixel, &LaserStats::kept);
 }
 
 StereoStats& StereoStats::operator+=(const StereoStats& o) {
-    pairs += o.pairs;
-    tableBuilds += o.tableBuilds;
-    pixels += o.pixels;
-    notFinite += o.notFinite;
-    noDisparity += o.noDisparity;
-    halo += o.halo;
-    nearCluster += o.nearCluster;
-    tooNear += o.tooNear;
-    outOfRange += o.outOfRange;
-    kept += o.kept;
-    return *this;
+    return util::addMembers(*this, o, &StereoStats::pairs, &StereoStats::tableBuilds,
+                            &StereoStats::pixels, &StereoStats::notFinite,
+                            &StereoStats::noDisparity, &StereoStats::halo,
+                            &StereoStats::nearCluster, &StereoStats::tooNear,
+                            &StereoStats::outOfRange, &StereoStats::kept);
 }
 
 DepthStats& DepthStats::operator+=(const DepthStats& o) {
-    points += o.points;
-    notFinite += o.notFinite;
-    outOfRange += o.outOfRange;
-    kept += o.kept;
-    return *this;
+    return util::addMembers(*this, o, &DepthStats::points, &DepthStats::notFinite,
+                            &DepthStats::outOfRange, &DepthStats::kept);
 }
 
 LidarStats& LidarStats::operator+=(const LidarStats& o) {
-    scans += o.scans;
-    returns += o.returns;
-    noReturn += o.noReturn;
-    notDecoded += o.notDecoded;
-    notFinite += o.notFinite;
-    outOfRange += o.outOfRange;
-    kept += o.kept;
-    return *this;
+    return util::addMembers(*this, o, &LidarStats::scans, &LidarStats::returns,
+                            &LidarStats::noReturn, &LidarStats::notDecoded, &LidarStats::notFinite,
+                            &LidarStats::outOfRange, &LidarStats::kept);
 }
 
 SensorModelStats& SensorModelStats::operator+=(const SensorModelStats& o) {
-    laser += o.laser;
-    stereo += o.stereo;
-    depth += o.depth;
-    lidar += o.lidar;
-    return *this;
+    return util::addMembers(*this, o, &SensorModelStats::laser, &SensorModelStats::stereo,
+                            &SensorModelStats::depth, &SensorModelStats::lidar);
 }
 
 size_t SensorModelStats::outOfRange() const {
