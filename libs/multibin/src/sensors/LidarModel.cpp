@@ -7,6 +7,8 @@
 #include <mrpt/obs/CObservationVelodyneScan.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -78,8 +80,12 @@ void velodyneScanToPoints(const mrpt::obs::CObservationVelodyneScan& scan,
     size_t echoes = 0;
     for (const auto& packet : scan.scan_packets)
         for (const auto& block : packet.blocks)
-            for (const auto& ret : block.laser_returns) {
+            for (const auto& packed : block.laser_returns) {
                 stats.returns++;
+                // MRPT's accessor binds a uint16_t reference to a field of a packed struct, which
+                // is misaligned in the packet (undefined behaviour): read an aligned copy.
+                alignas(alignof(uint16_t)) mrpt::obs::CObservationVelodyneScan::laser_return_t ret;
+                std::memcpy(&ret, &packed, sizeof ret);
                 if (ret.distance() == 0)
                     stats.noReturn++;
                 else
