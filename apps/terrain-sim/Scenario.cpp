@@ -64,7 +64,7 @@ std::string mapperIni(const ScenarioConfig& cfg) {
       << "stereo_right_intrinsics_sigma = " << joinSigmas(s.intrinsicsSigma.data(), 9) << "\n"
       << "# Right camera relative to the left: rx ry rz [rad] tx ty tz [m]\n"
       << "stereo_extrinsics_sigma = " << joinSigmas(s.extrinsicsSigma.data(), 6) << "\n"
-      << "stereo_matching_sigma = " << s.matchingSigma_px << "\n";
+      << "stereo_matching_sigma_px = " << s.matchingSigma_px << "\n";
     return o.str();
 }
 

@@ -668,7 +668,7 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
 
     // Keys shared with the map's own section: the caller's strict reader owns finish().
     mrpt::config::CConfigFileMemory shared;
-    shared.write("s", "fill_median_window", 3);
+    shared.write("s", "fill_median_window_cells", 3);
     shared.write("s", "certainty_increment", 1.0);
     multibin::StrictConfigSection sec(shared, "s");
     FillOptions c;
@@ -687,8 +687,8 @@ TEST(FillOptions, IniRoundTripAndStrictErrors) {
             EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
         }
     };
-    expectError("fill_median_window", "4");
-    expectError("fill_median_window", "five");
+    expectError("fill_median_window_cells", "4");
+    expectError("fill_median_window_cells", "five");
     expectError("fill_sigma_model", "bayes");
     expectError("fill_model_criterion", "cv");
     expectError("fill_max_gap_cells", "0");

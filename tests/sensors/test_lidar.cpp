@@ -223,7 +223,7 @@ TEST(SensorModels, UnknownOrMismatchedModelIsAnErrorNamingTheKey) {
 TEST(SensorModels, LidarAndModelKeysRoundTrip) {
     SensorModelOptions o = loadOptions(
         "lidar_sensor = os1\nlidar_angular_sigma = 0.0004\nsensor_models = A:lidar,B:stereo\n"
-        "stereo_cloud_focal_length = 700\nstereo_cloud_baseline = 0.12\n");
+        "stereo_cloud_focal_length_px = 700\nstereo_cloud_baseline = 0.12\n");
     EXPECT_EQ(o.lidar.sensor, "os1");
     EXPECT_DOUBLE_EQ(o.lidar.angularSigma_rad, 0.0004);  // the key overrides the preset
     EXPECT_DOUBLE_EQ(o.lidar.beamDivergence_rad,

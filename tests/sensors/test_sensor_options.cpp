@@ -26,9 +26,9 @@ TEST(SensorOptions, ReadsContractKeys) {
         "stereo_left_intrinsics_sigma = 1 2 3 4 0.1 0.2 0.3 0.4 0.5\n"
         "stereo_right_intrinsics_sigma = 1 1 1 1 0 0 0 0 0\n"
         "stereo_extrinsics_sigma = 0.001 0.002 0.003 0.004 0.005 0.006\n"
-        "stereo_matching_sigma = 0.3\n"
+        "stereo_matching_sigma_px = 0.3\n"
         "stereo_sgbm_num_disparities = 64\n"
-        "depth_axial_sigma_quadratic = 0.003\n");
+        "depth_axial_sigma_quadratic_per_m = 0.003\n");
     EXPECT_DOUBLE_EQ(o.laser.agcByLabel.at("LASER"), 512);
     EXPECT_DOUBLE_EQ(o.laser.agcByLabel.at("LASER2"), 300);
     EXPECT_DOUBLE_EQ(o.laser.rangeSigma(1.0), 0.001 + 0.004 + 0.0005);
@@ -64,7 +64,7 @@ TEST(SensorOptions, BadValuesNameTheKey) {
     fails("stereo_sgbm_num_disparities = -16\n", "stereo_sgbm_num_disparities");
     fails("stereo_sgbm_block_size = 4\n", "stereo_sgbm_block_size");
     fails("stereo_sgbm_mode = fast\n", "stereo_sgbm_mode");
-    fails("depth_lateral_sigma = 0\n", "depth_lateral_sigma");
+    fails("depth_lateral_sigma_rad = 0\n", "depth_lateral_sigma_rad");
     fails("laser_continuity_pose_correlation = 1.5\n", "laser_continuity_pose_correlation");
 }
 

@@ -192,7 +192,7 @@ TEST(TerrainSimScenario, RawlogAndSimplemapFollowTheContract) {
     const std::string ini = readBytes((d / "w.ini").string());
     for (const char* key : {"[MappingApplication]", "laser_agc = LASER:512",
                             "stereo_left_intrinsics_sigma", "stereo_right_intrinsics_sigma",
-                            "stereo_extrinsics_sigma", "stereo_matching_sigma = 0.25"})
+                            "stereo_extrinsics_sigma", "stereo_matching_sigma_px = 0.25"})
         EXPECT_NE(ini.find(key), std::string::npos) << key;
 }
 

@@ -11,10 +11,14 @@
 #include <stdexcept>
 #include <utility>
 
-#include "multibin/io/StrictConfigSection.h"
+#include "multibin/io/OptionKeys.h"
 #include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
+using multibin::atLeast;
+using multibin::finite;
+using multibin::OptionNames;
+using multibin::positive;
 
 // "multiBinElevationMap" is the name used in CMultiMetricMap ini files
 // (multiBinElevationMap_count).
@@ -102,54 +106,60 @@ void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::st
     }
 }
 
-const char* colormapName(mrpt::img::TColormap c) {
-    switch (c) {
-        case mrpt::img::cmGRAYSCALE:
-            return "grayscale";
-        case mrpt::img::cmJET:
-            return "jet";
-        case mrpt::img::cmHOT:
-            return "hot";
-        default:
-            return "jet";
-    }
-}
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
 // Options
 // ---------------------------------------------------------------------------------------------
 namespace {
-/** Calls visit(key, oldName, member) for every key of `o` (a TCreationOptions or a const one;
- * oldName is the documented alias from before the unit suffix, or empty): the one list of keys
- * that load and save share, in the order save writes them. */
+/** The creation keys of `o` (a TCreationOptions or a const one), in the order they are written,
+ * for the options protocol (multibin/io/OptionKeys.h). */
 template <class Options, class Visit>
 void visitCreationKeys(Options& o, Visit&& visit) {
-    visit("resolution_m", "resolution", o.resolution_m);
-    visit("bin_height_m", "bin_height", o.bin_height_m);
-    visit("grow", "", o.grow);
-    visit("max_size_m", "", o.max_size_m);
-    visit("min_x_m", "min_x", o.min_x);
-    visit("max_x_m", "max_x", o.max_x);
-    visit("min_y_m", "min_y", o.min_y);
-    visit("max_y_m", "max_y", o.max_y);
-    visit("dual_grid", "", o.dual_grid);
-    visit("local_size_m", "", o.local_size_m);
-    visit("local_resolution_m", "local_resolution", o.local_resolution_m);
-    visit("global_size_m", "", o.global_size_m);
-    visit("global_resolution_m", "global_resolution", o.global_resolution_m);
+    visit({"resolution_m", "resolution"}, o.resolution_m, positive("m"));
+    visit({"bin_height_m", "bin_height"}, o.bin_height_m, positive("m"));
+    visit("grow", o.grow);
+    visit("max_size_m", o.max_size_m, positive("m"));
+    visit({"min_x_m", "min_x"}, o.min_x, finite("m"));
+    visit({"max_x_m", "max_x"}, o.max_x, finite("m"));
+    visit({"min_y_m", "min_y"}, o.min_y, finite("m"));
+    visit({"max_y_m", "max_y"}, o.max_y, finite("m"));
+    visit("dual_grid", o.dual_grid);
+    visit("local_size_m", o.local_size_m, positive("m"));
+    visit({"local_resolution_m", "local_resolution"}, o.local_resolution_m, positive("m"));
+    visit("global_size_m", o.global_size_m, positive("m"));
+    visit({"global_resolution_m", "global_resolution"}, o.global_resolution_m, positive("m"));
+}
+
+const OptionNames<mrpt::img::TColormap> kColormaps{
+    {"jet", mrpt::img::cmJET}, {"hot", mrpt::img::cmHOT}, {"grayscale", mrpt::img::cmGRAYSCALE}};
+
+/** The insertion keys of `o` (a TInsertionOptions or a const one) with those of its visibility,
+ * fill and sensor-model parts, in the order they are written. */
+template <class Options, class Visit>
+void visitInsertionKeys(Options& o, Visit&& visit) {
+    visit("certainty_increment", o.certainty_increment, positive());
+    visit({"max_elevation_uncertainty_m", "max_elevation_uncertainty"},
+          o.max_elevation_uncertainty_m, positive("m"));
+    visit({"height_sigma_floor_m", "height_sigma_floor"}, o.height_sigma_floor_m, atLeast(0, "m"));
+    visit("default_pose_sigmas", o.default_pose_sigmas, atLeast(0));
+    visit({"robot_pose_max_dt_s", "robot_pose_max_dt"}, o.robot_pose_max_dt_s, atLeast(0, "s"));
+    visit({"range_sigma_m", "range_sigma"}, o.range_sigma_m, positive("m"));
+    visit({"min_range_m", "min_range"}, o.min_range_m, atLeast(0, "m"));
+    visit({"max_range_m", "max_range"}, o.max_range_m, positive("m"));
+    visit("sensor_labels", o.sensor_labels);
+    visit("global_sensor_labels", o.global_sensor_labels);
+    visit("colormap", o.colormap, kColormaps);
+    visit("color_by_sigma", o.color_by_sigma);
+    visit("dem_return_filled", o.dem_return_filled);
+    visit("relief_sigma", o.relief_sigma);
 }
 }  // namespace
 
 void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
     multibin::StrictConfigSection s(source, section);
-    visitCreationKeys(*this, [&](const char* key, const std::string& oldName, auto& value) {
-        if (oldName.empty())
-            s.read(key, value);
-        else
-            s.read(key, oldName, value);
-    });
+    visitCreationKeys(*this, multibin::OptionReader{s});
     s.allow(kGenericMapKeys);
     s.finish();
     validateIn(s, *this);
@@ -157,9 +167,7 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
 
 void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                                                const std::string& section) const {
-    visitCreationKeys(*this, [&](const char* key, const std::string&, const auto& value) {
-        c.write(section, key, value);
-    });
+    visitCreationKeys(*this, multibin::OptionWriter{c, section});
 }
 
 namespace {
@@ -168,20 +176,15 @@ constexpr double kMaxCellIndex = 1 << 30;
 }  // namespace
 
 void CMultiBinElevationMap::TCreationOptions::validate() const {
-    auto bad = [](const std::string& key, const std::string& what) {
-        throw std::invalid_argument("CMultiBinElevationMap creation option '" + key + "': " + what);
+    const multibin::OptionChecker check("CMultiBinElevationMap creation option");
+    visitCreationKeys(*this, check);
+    const auto bad = [&](const std::string& key, const std::string& what) {
+        check.fail(key, what);
     };
-    if (!(resolution_m > 0) || !std::isfinite(resolution_m))
-        bad("resolution_m", "must be a positive cell size [m]");
-    if (!(bin_height_m > 0) || !std::isfinite(bin_height_m))
-        bad("bin_height_m", "must be a positive bin height [m]");
-    if (!(max_size_m > 0) || !std::isfinite(max_size_m))
-        bad("max_size_m", "must be a positive size [m]");
     for (const auto& [key, v] : {std::pair{"min_x_m", min_x},
                                  {"max_x_m", max_x},
                                  {"min_y_m", min_y},
                                  {"max_y_m", max_y}}) {
-        if (!std::isfinite(v)) bad(key, "must be finite [m]");
         // Cell indices are int: an extent far from the origin would overflow them.
         if (std::abs(v / resolution_m) > kMaxCellIndex) {
             std::ostringstream os;
@@ -192,11 +195,6 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
     }
     if (max_x < min_x || max_y < min_y)
         bad("min_x_m/max_x_m/min_y_m/max_y_m", "max must not be below min");
-    for (const auto& [key, v] : {std::pair{"local_size_m", local_size_m},
-                                 {"local_resolution_m", local_resolution_m},
-                                 {"global_size_m", global_size_m},
-                                 {"global_resolution_m", global_resolution_m}})
-        if (!(v > 0) || !std::isfinite(v)) bad(key, "must be positive [m]");
     if (!grow && (max_x <= min_x || max_y <= min_y))
         bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
     // Refuse before allocating: every cell of a grid's window takes a slot of BinGrid (12 bytes:
@@ -222,24 +220,8 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
 void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
     multibin::StrictConfigSection s(source, section);
-    s.read("certainty_increment", certainty_increment);
-    s.read("max_elevation_uncertainty_m", "max_elevation_uncertainty", max_elevation_uncertainty_m);
-    s.read("height_sigma_floor_m", "height_sigma_floor", height_sigma_floor_m);
-    s.read("default_pose_sigmas", default_pose_sigmas, 6);
-    s.read("robot_pose_max_dt_s", "robot_pose_max_dt", robot_pose_max_dt_s);
-    s.read("range_sigma_m", "range_sigma", range_sigma_m);
-    s.read("min_range_m", "min_range", min_range_m);
-    s.read("max_range_m", "max_range", max_range_m);
-    s.read("sensor_labels", sensor_labels);
-    s.read("global_sensor_labels", global_sensor_labels);
-    s.readChoice<mrpt::img::TColormap>("colormap", colormap,
-                                       {{"jet", mrpt::img::cmJET},
-                                        {"hot", mrpt::img::cmHOT},
-                                        {"grayscale", mrpt::img::cmGRAYSCALE}});
-    s.read("color_by_sigma", color_by_sigma);
+    visitInsertionKeys(*this, multibin::OptionReader{s});
     visibility.read(s);
-    s.read("dem_return_filled", dem_return_filled);
-    s.read("relief_sigma", relief_sigma);
     fill.read(s);
     sensors.read(s);
     s.finish();
@@ -248,58 +230,22 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
 
 void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                                                 const std::string& section) const {
-    c.write(section, "certainty_increment", certainty_increment);
-    c.write(section, "max_elevation_uncertainty_m", max_elevation_uncertainty_m);
-    c.write(section, "height_sigma_floor_m", height_sigma_floor_m);
-    std::ostringstream sig;
-    sig.precision(17);
-    for (size_t i = 0; i < default_pose_sigmas.size(); i++)
-        sig << (i ? " " : "") << default_pose_sigmas[i];
-    c.write(section, "default_pose_sigmas", sig.str());
-    c.write(section, "robot_pose_max_dt_s", robot_pose_max_dt_s);
-    c.write(section, "range_sigma_m", range_sigma_m);
-    c.write(section, "min_range_m", min_range_m);
-    c.write(section, "max_range_m", max_range_m);
-    std::string labels;
-    for (const auto& l : sensor_labels) labels += (labels.empty() ? "" : ",") + l;
-    c.write(section, "sensor_labels", labels);
-    std::string globalLabels;
-    for (const auto& l : global_sensor_labels)
-        globalLabels += (globalLabels.empty() ? "" : ",") + l;
-    c.write(section, "global_sensor_labels", globalLabels);
-    c.write(section, "colormap", std::string(colormapName(colormap)));
-    c.write(section, "color_by_sigma", color_by_sigma);
+    visitInsertionKeys(*this, multibin::OptionWriter{c, section});
     visibility.write(c, section);
-    c.write(section, "dem_return_filled", dem_return_filled);
-    c.write(section, "relief_sigma", relief_sigma);
     fill.write(c, section);
     sensors.write(c, section);
 }
 
 void CMultiBinElevationMap::TInsertionOptions::validate() const {
-    auto bad = [](const std::string& key, const std::string& what) {
-        throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key +
-                                    "': " + what);
-    };
-    const auto finite = [](double v) { return std::isfinite(v); };
-    if (!(certainty_increment > 0) || !finite(certainty_increment))
-        bad("certainty_increment", "must be positive and finite");
-    if (!(max_elevation_uncertainty_m > 0) || !finite(max_elevation_uncertainty_m))
-        bad("max_elevation_uncertainty_m", "must be positive and finite [m]");
-    if (!(height_sigma_floor_m >= 0) || !finite(height_sigma_floor_m))
-        bad("height_sigma_floor_m", "must be >= 0 and finite [m]");
+    const multibin::OptionChecker check("CMultiBinElevationMap insertion option");
     if (default_pose_sigmas.size() != 6)
-        bad("default_pose_sigmas",
-            "needs 6 values, has " + std::to_string(default_pose_sigmas.size()));
-    for (double v : default_pose_sigmas)
-        if (!(v >= 0) || !finite(v)) bad("default_pose_sigmas", "values must be >= 0 and finite");
-    if (!(robot_pose_max_dt_s >= 0)) bad("robot_pose_max_dt_s", "must be >= 0 [s]");
-    if (!(range_sigma_m > 0) || !finite(range_sigma_m))
-        bad("range_sigma_m", "must be positive and finite [m]");
+        check.fail("default_pose_sigmas",
+                   "needs 6 values, has " + std::to_string(default_pose_sigmas.size()));
+    visitInsertionKeys(*this, check);
     visibility.validate();
     fill.validate();
-    if (!(min_range_m >= 0 && max_range_m > min_range_m))
-        bad("min_range_m/max_range_m", "need 0 <= min_range_m < max_range_m");
+    if (!(max_range_m > min_range_m))
+        check.fail("min_range_m/max_range_m", "need 0 <= min_range_m < max_range_m");
     sensors.validate();
 }
 

@@ -1,8 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/map/VisibilityConstraint.h"
 #include <mrpt/config/CConfigFileBase.h>
-#include "multibin/io/StrictConfigSection.h"
 
+#include "multibin/io/OptionKeys.h"
 #include "multibin/map/CellSurface.h"
 
 #include <algorithm>
@@ -12,27 +12,25 @@
 
 namespace multibin {
 
-void VisibilityParams::read(StrictConfigSection& s) {
-    s.read("visibility_constraint", enabled);
-    s.read("visibility_margin_m", "visibility_margin", margin_m);
-    s.read("visibility_certainty_decrement", certaintyDecrement);
+namespace {
+/** The visibility keys of `o` (a VisibilityParams or a const one), for the options protocol
+ * (multibin/io/OptionKeys.h). */
+template <class Params, class Visit>
+void visitKeys(Params& o, Visit&& visit) {
+    visit("visibility_constraint", o.enabled);
+    visit({"visibility_margin_m", "visibility_margin"}, o.margin_m, atLeast(0, "m"));
+    visit("visibility_certainty_decrement", o.certaintyDecrement, positive());
 }
+}  // namespace
+
+void VisibilityParams::read(StrictConfigSection& s) { visitKeys(*this, OptionReader{s}); }
 
 void VisibilityParams::write(mrpt::config::CConfigFileBase& c, const std::string& section) const {
-    c.write(section, "visibility_constraint", enabled);
-    c.write(section, "visibility_margin_m", margin_m);
-    c.write(section, "visibility_certainty_decrement", certaintyDecrement);
+    visitKeys(*this, OptionWriter{c, section});
 }
 
 void VisibilityParams::validate() const {
-    auto bad = [](const std::string& key, const std::string& what) {
-        throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key +
-                                    "': " + what);
-    };
-    if (!(margin_m >= 0) || !std::isfinite(margin_m))
-        bad("visibility_margin_m", "must be >= 0 and finite [m]");
-    if (!(certaintyDecrement > 0) || !std::isfinite(certaintyDecrement))
-        bad("visibility_certainty_decrement", "must be positive and finite");
+    visitKeys(*this, OptionChecker("CMultiBinElevationMap insertion option"));
 }
 
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,

@@ -4,37 +4,19 @@
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
-#include "multibin/io/StrictConfigSection.h"
+#include "multibin/io/OptionKeys.h"
 
 namespace multibin::sensors {
 
 namespace {
-template <size_t N>
-void readArray(StrictConfigSection& s, const std::string& key, std::array<double, N>& a) {
-    if (!s.has(key)) return;
-    std::vector<double> v;
-    s.read(key, v, N);
-    for (size_t i = 0; i < N; i++) a[i] = v[i];
-}
-
-template <typename Seq>
-std::string joined(const Seq& v) {
-    std::ostringstream os;
-    os.precision(17);
-    bool first = true;
-    for (double x : v) {
-        os << (first ? "" : " ") << x;
-        first = false;
-    }
-    return os.str();
-}
-
 /** Parses `LABEL:value[,LABEL:value...]` into a map, each value through `parse(label, value)`,
  * which fails the key itself for a bad value. */
 template <typename T, typename Parse>
@@ -62,6 +44,9 @@ std::map<std::string, double> parseAgc(StrictConfigSection& s, const std::string
         return v;
     });
 }
+
+const OptionNames<std::string> kSgbmModes{
+    {"sgbm", "sgbm"}, {"hh", "hh"}, {"sgbm_3way", "sgbm_3way"}, {"hh4", "hh4"}};
 
 constexpr std::pair<const char*, SensorModelKind> kModelNames[] = {
     {"laser", SensorModelKind::laser},
@@ -124,199 +109,171 @@ int StereoModelOptions::numDisparitiesFor(int width_px) const {
     return std::clamp(width_px / 4 / 16 * 16, 16, 256);
 }
 
-void SensorModelOptions::read(StrictConfigSection& s) {
+namespace {
+/** A range-sigma curve as the key `key` reads and writes it: "c0 c1 c2". */
+auto curveOption(RangeSigmaCurve& curve) {
+    return customOption(
+        [&curve](StrictConfigSection& s, const std::string& key) {
+            std::vector<double> c;
+            s.read(key, c, 3);
+            curve = RangeSigmaCurve{c[0], c[1], c[2]};
+        },
+        [] { return std::string(); });
+}
+std::string curveText(const RangeSigmaCurve& c) {
+    return OptionWriter::joined(std::array<double, 3>{c.c0_m, c.c1, c.c2_per_m}, " ");
+}
+template <class T, class Name>
+std::string labelMapText(const std::map<std::string, T>& m, const Name& name) {
+    std::vector<std::string> items;
+    for (const auto& [label, v] : m) items.push_back(label + ':' + name(v));
+    return OptionWriter::joined(items, ",");
+}
+bool curveHolds(const RangeSigmaCurve& r) {
+    return r.c0_m >= 0 && r.c1 >= 0 && r.c2_per_m >= 0 && r.c0_m + r.c1 + r.c2_per_m > 0;
+}
+
+/** The sensor-model keys of `o` (a SensorModelOptions or a const one), for the options protocol
+ * (multibin/io/OptionKeys.h). Keys with a syntax of their own (curves, label maps, the lidar
+ * preset) are custom options: `parse` for reading (unused when writing a const one) and
+ * `format` for writing. The lidar preset comes before the lidar keys that override it. */
+template <class Options, class Visit>
+void visitKeys(Options& o, Visit&& visit) {
+    constexpr bool reading = !std::is_const_v<Options>;
+    auto& laser = o.laser;
+    auto& stereo = o.stereo;
+    auto& lidar = o.lidar;
+    auto& depth = o.depth;
+    const auto custom = [&](const char* key, auto parse, auto format) {
+        visit(key, customOption(parse, format));
+    };
     // Laser
-    if (s.has("laser_range_sigma_coeffs")) {
-        std::vector<double> c;
-        s.read("laser_range_sigma_coeffs", c, 3);
-        laser.rangeSigma = RangeSigmaCurve{c[0], c[1], c[2]};
-    }
-    if (s.has("laser_agc")) laser.agcByLabel = parseAgc(s, "laser_agc");
-    s.read("laser_min_restored_intensity", laser.minRestoredIntensity);
-    s.read("laser_intensity_check_range", laser.intensityCheckRange_m);
-    s.read("laser_mixed_pixel_filter", laser.mixedPixelFilter);
-    s.read("laser_mixed_pixel_jump", laser.mixedPixelJump_m);
-    s.read("laser_mixed_pixel_max_beams", laser.mixedPixelMaxBeams);
-    s.read("laser_continuity", laser.continuity);
-    s.read("laser_continuity_sigmas", laser.continuitySigmas);
-    s.read("laser_continuity_pose_correlation", laser.continuityPoseCorrelation);
-    s.read("laser_continuity_allowance", laser.continuityAllowance_m);
-    s.read("laser_continuity_max_dt", laser.continuityMaxDt_s);
+    custom(
+        "laser_range_sigma_coeffs",
+        [&](StrictConfigSection& s, const std::string& key) {
+            if constexpr (reading) curveOption(laser.rangeSigma).parse(s, key);
+        },
+        [&] { return curveText(laser.rangeSigma); });
+    custom(
+        "laser_agc",
+        [&](StrictConfigSection& s, const std::string& key) {
+            if constexpr (reading) laser.agcByLabel = parseAgc(s, key);
+        },
+        [&] {
+            return labelMapText(laser.agcByLabel, [](double v) {
+                return OptionWriter::joined(std::array<double, 1>{v}, "");
+            });
+        });
+    visit("laser_min_restored_intensity", laser.minRestoredIntensity, atLeast(0));
+    visit({"laser_intensity_check_range_m", "laser_intensity_check_range"},
+          laser.intensityCheckRange_m, atLeast(0, "m"));
+    visit("laser_mixed_pixel_filter", laser.mixedPixelFilter);
+    visit({"laser_mixed_pixel_jump_m", "laser_mixed_pixel_jump"}, laser.mixedPixelJump_m,
+          positive("m"));
+    visit("laser_mixed_pixel_max_beams", laser.mixedPixelMaxBeams, atLeast(1));
+    visit("laser_continuity", laser.continuity);
+    visit("laser_continuity_sigmas", laser.continuitySigmas, positive());
+    visit("laser_continuity_pose_correlation", laser.continuityPoseCorrelation, between(0, 1));
+    visit({"laser_continuity_allowance_m", "laser_continuity_allowance"},
+          laser.continuityAllowance_m, atLeast(0, "m"));
+    visit({"laser_continuity_max_dt_s", "laser_continuity_max_dt"}, laser.continuityMaxDt_s,
+          positive("s"));
     // Stereo
-    readArray(s, "stereo_left_intrinsics_sigma", stereo.leftIntrinsicsSigma);
-    readArray(s, "stereo_right_intrinsics_sigma", stereo.rightIntrinsicsSigma);
-    readArray(s, "stereo_extrinsics_sigma", stereo.extrinsicsSigma);
-    s.read("stereo_matching_sigma", stereo.matchingSigma_px);
-    s.read("stereo_subsample", stereo.subsample);
-    s.read("stereo_min_depth", stereo.minDepth_m);
-    s.read("stereo_sgbm_min_disparity", stereo.sgbmMinDisparity);
-    s.read("stereo_sgbm_num_disparities", stereo.sgbmNumDisparities);
-    s.read("stereo_sgbm_block_size", stereo.sgbmBlockSize);
-    s.read("stereo_sgbm_p1", stereo.sgbmP1);
-    s.read("stereo_sgbm_p2", stereo.sgbmP2);
-    s.read("stereo_sgbm_disp12_max_diff", stereo.sgbmDisp12MaxDiff);
-    s.read("stereo_sgbm_uniqueness_ratio", stereo.sgbmUniquenessRatio);
-    s.read("stereo_sgbm_speckle_window_size", stereo.sgbmSpeckleWindowSize);
-    s.read("stereo_sgbm_speckle_range", stereo.sgbmSpeckleRange);
-    s.read("stereo_sgbm_mode", stereo.sgbmMode);
-    s.read("stereo_halo_filter", stereo.haloFilter);
-    s.read("stereo_halo_jump", stereo.haloJump_px);
-    s.read("stereo_halo_radius", stereo.haloRadius_px);
-    s.read("stereo_near_cluster_filter", stereo.nearClusterFilter);
-    s.read("stereo_near_cluster_max_area", stereo.nearClusterMaxArea_px);
-    s.read("stereo_near_cluster_step", stereo.nearClusterStep_px);
-    s.read("stereo_near_cluster_jump", stereo.nearClusterJump_px);
-    s.read("stereo_cloud_focal_length", stereo.cloudFocalLength_px);
-    s.read("stereo_cloud_baseline", stereo.cloudBaseline_m);
+    visit("stereo_left_intrinsics_sigma", stereo.leftIntrinsicsSigma, atLeast(0));
+    visit("stereo_right_intrinsics_sigma", stereo.rightIntrinsicsSigma, atLeast(0));
+    visit("stereo_extrinsics_sigma", stereo.extrinsicsSigma, atLeast(0));
+    visit({"stereo_matching_sigma_px", "stereo_matching_sigma"}, stereo.matchingSigma_px,
+          atLeast(0, "px"));
+    visit("stereo_subsample", stereo.subsample, atLeast(1, "px"));
+    visit({"stereo_min_depth_m", "stereo_min_depth"}, stereo.minDepth_m, atLeast(0, "m"));
+    visit("stereo_sgbm_min_disparity", stereo.sgbmMinDisparity);
+    visit("stereo_sgbm_num_disparities", stereo.sgbmNumDisparities, atLeast(0));
+    visit("stereo_sgbm_block_size", stereo.sgbmBlockSize, oddBetween(1, 255));
+    visit("stereo_sgbm_p1", stereo.sgbmP1, atLeast(0));
+    visit("stereo_sgbm_p2", stereo.sgbmP2, atLeast(0));
+    visit("stereo_sgbm_disp12_max_diff", stereo.sgbmDisp12MaxDiff);
+    visit("stereo_sgbm_uniqueness_ratio", stereo.sgbmUniquenessRatio, atLeast(0));
+    visit("stereo_sgbm_speckle_window_size", stereo.sgbmSpeckleWindowSize, atLeast(0));
+    visit("stereo_sgbm_speckle_range", stereo.sgbmSpeckleRange, atLeast(0));
+    visit("stereo_sgbm_mode", stereo.sgbmMode, kSgbmModes);
+    visit("stereo_halo_filter", stereo.haloFilter);
+    visit({"stereo_halo_jump_px", "stereo_halo_jump"}, stereo.haloJump_px, positive("px"));
+    visit({"stereo_halo_radius_px", "stereo_halo_radius"}, stereo.haloRadius_px, atLeast(1, "px"));
+    visit("stereo_near_cluster_filter", stereo.nearClusterFilter);
+    visit({"stereo_near_cluster_max_area_px", "stereo_near_cluster_max_area"},
+          stereo.nearClusterMaxArea_px, atLeast(1, "px"));
+    visit({"stereo_near_cluster_step_px", "stereo_near_cluster_step"}, stereo.nearClusterStep_px,
+          positive("px"));
+    visit({"stereo_near_cluster_jump_px", "stereo_near_cluster_jump"}, stereo.nearClusterJump_px,
+          positive("px"));
+    visit({"stereo_cloud_focal_length_px", "stereo_cloud_focal_length"}, stereo.cloudFocalLength_px,
+          positive("px"));
+    visit({"stereo_cloud_baseline_m", "stereo_cloud_baseline"}, stereo.cloudBaseline_m,
+          positive("m"));
     // Lidar: the sensor's published figures first, then the keys that override them
-    if (s.has("lidar_sensor")) {
-        std::string name;
-        s.read("lidar_sensor", name);
-        try {
-            lidar = LidarModelOptions::forSensor(name);
-        } catch (const std::invalid_argument& e) {
-            s.fail("lidar_sensor", e.what());
-        }
-    }
-    if (s.has("lidar_range_sigma_coeffs")) {
-        std::vector<double> c;
-        s.read("lidar_range_sigma_coeffs", c, 3);
-        lidar.rangeSigma = RangeSigmaCurve{c[0], c[1], c[2]};
-    }
-    s.read("lidar_angular_sigma", lidar.angularSigma_rad);
-    s.read("lidar_beam_divergence", lidar.beamDivergence_rad);
-    if (s.has("sensor_models")) modelByLabel = parseModels(s, "sensor_models");
+    custom(
+        "lidar_sensor",
+        [&](StrictConfigSection& s, const std::string& key) {
+            if constexpr (reading) {
+                std::string name;
+                s.read(key, name);
+                try {
+                    lidar = LidarModelOptions::forSensor(name);
+                } catch (const std::invalid_argument& e) {
+                    s.fail(key, e.what());
+                }
+            }
+        },
+        [&] { return lidar.sensor; });
+    custom(
+        "lidar_range_sigma_coeffs",
+        [&](StrictConfigSection& s, const std::string& key) {
+            if constexpr (reading) curveOption(lidar.rangeSigma).parse(s, key);
+        },
+        [&] { return curveText(lidar.rangeSigma); });
+    visit({"lidar_angular_sigma_rad", "lidar_angular_sigma"}, lidar.angularSigma_rad,
+          atLeast(0, "rad"));
+    visit({"lidar_beam_divergence_rad", "lidar_beam_divergence"}, lidar.beamDivergence_rad,
+          atLeast(0, "rad"));
+    custom(
+        "sensor_models",
+        [&](StrictConfigSection& s, const std::string& key) {
+            if constexpr (reading) o.modelByLabel = parseModels(s, key);
+        },
+        [&] { return labelMapText(o.modelByLabel, sensorModelName); });
     // Depth camera
-    s.read("depth_axial_sigma", depth.axialSigma0_m);
-    s.read("depth_axial_sigma_quadratic", depth.axialSigmaQuadratic_per_m);
-    s.read("depth_axial_offset", depth.axialOffset_m);
-    s.read("depth_lateral_sigma", depth.lateralSigma_rad);
+    visit({"depth_axial_sigma_m", "depth_axial_sigma"}, depth.axialSigma0_m, positive("m"));
+    visit({"depth_axial_sigma_quadratic_per_m", "depth_axial_sigma_quadratic"},
+          depth.axialSigmaQuadratic_per_m, atLeast(0, "1/m"));
+    visit({"depth_axial_offset_m", "depth_axial_offset"}, depth.axialOffset_m, atLeast(0, "m"));
+    visit({"depth_lateral_sigma_rad", "depth_lateral_sigma"}, depth.lateralSigma_rad,
+          positive("rad"));
+}
+}  // namespace
+
+void SensorModelOptions::read(StrictConfigSection& s) {
+    visitKeys(*this, OptionReader{s});
     validate();
 }
 
 void SensorModelOptions::write(mrpt::config::CConfigFileBase& c, const std::string& sec) const {
-    const RangeSigmaCurve& r = laser.rangeSigma;
-    c.write(sec, "laser_range_sigma_coeffs",
-            joined(std::array<double, 3>{r.c0_m, r.c1, r.c2_per_m}));
-    std::string agc;
-    for (const auto& [label, v] : laser.agcByLabel) {
-        std::ostringstream os;
-        os.precision(17);
-        os << label << ':' << v;
-        agc += (agc.empty() ? "" : ",") + os.str();
-    }
-    c.write(sec, "laser_agc", agc);
-    c.write(sec, "laser_min_restored_intensity", laser.minRestoredIntensity);
-    c.write(sec, "laser_intensity_check_range", laser.intensityCheckRange_m);
-    c.write(sec, "laser_mixed_pixel_filter", laser.mixedPixelFilter);
-    c.write(sec, "laser_mixed_pixel_jump", laser.mixedPixelJump_m);
-    c.write(sec, "laser_mixed_pixel_max_beams", laser.mixedPixelMaxBeams);
-    c.write(sec, "laser_continuity", laser.continuity);
-    c.write(sec, "laser_continuity_sigmas", laser.continuitySigmas);
-    c.write(sec, "laser_continuity_pose_correlation", laser.continuityPoseCorrelation);
-    c.write(sec, "laser_continuity_allowance", laser.continuityAllowance_m);
-    c.write(sec, "laser_continuity_max_dt", laser.continuityMaxDt_s);
-    c.write(sec, "stereo_left_intrinsics_sigma", joined(stereo.leftIntrinsicsSigma));
-    c.write(sec, "stereo_right_intrinsics_sigma", joined(stereo.rightIntrinsicsSigma));
-    c.write(sec, "stereo_extrinsics_sigma", joined(stereo.extrinsicsSigma));
-    c.write(sec, "stereo_matching_sigma", stereo.matchingSigma_px);
-    c.write(sec, "stereo_subsample", stereo.subsample);
-    c.write(sec, "stereo_min_depth", stereo.minDepth_m);
-    c.write(sec, "stereo_sgbm_min_disparity", stereo.sgbmMinDisparity);
-    c.write(sec, "stereo_sgbm_num_disparities", stereo.sgbmNumDisparities);
-    c.write(sec, "stereo_sgbm_block_size", stereo.sgbmBlockSize);
-    c.write(sec, "stereo_sgbm_p1", stereo.sgbmP1);
-    c.write(sec, "stereo_sgbm_p2", stereo.sgbmP2);
-    c.write(sec, "stereo_sgbm_disp12_max_diff", stereo.sgbmDisp12MaxDiff);
-    c.write(sec, "stereo_sgbm_uniqueness_ratio", stereo.sgbmUniquenessRatio);
-    c.write(sec, "stereo_sgbm_speckle_window_size", stereo.sgbmSpeckleWindowSize);
-    c.write(sec, "stereo_sgbm_speckle_range", stereo.sgbmSpeckleRange);
-    c.write(sec, "stereo_sgbm_mode", stereo.sgbmMode);
-    c.write(sec, "stereo_halo_filter", stereo.haloFilter);
-    c.write(sec, "stereo_halo_jump", stereo.haloJump_px);
-    c.write(sec, "stereo_halo_radius", stereo.haloRadius_px);
-    c.write(sec, "stereo_near_cluster_filter", stereo.nearClusterFilter);
-    c.write(sec, "stereo_near_cluster_max_area", stereo.nearClusterMaxArea_px);
-    c.write(sec, "stereo_near_cluster_step", stereo.nearClusterStep_px);
-    c.write(sec, "stereo_near_cluster_jump", stereo.nearClusterJump_px);
-    c.write(sec, "stereo_cloud_focal_length", stereo.cloudFocalLength_px);
-    c.write(sec, "stereo_cloud_baseline", stereo.cloudBaseline_m);
-    c.write(sec, "lidar_sensor", lidar.sensor);
-    const RangeSigmaCurve& lr = lidar.rangeSigma;
-    c.write(sec, "lidar_range_sigma_coeffs",
-            joined(std::array<double, 3>{lr.c0_m, lr.c1, lr.c2_per_m}));
-    c.write(sec, "lidar_angular_sigma", lidar.angularSigma_rad);
-    c.write(sec, "lidar_beam_divergence", lidar.beamDivergence_rad);
-    std::string models;
-    for (const auto& [label, kind] : modelByLabel)
-        models += (models.empty() ? "" : ",") + label + ':' + sensorModelName(kind);
-    c.write(sec, "sensor_models", models);
-    c.write(sec, "depth_axial_sigma", depth.axialSigma0_m);
-    c.write(sec, "depth_axial_sigma_quadratic", depth.axialSigmaQuadratic_per_m);
-    c.write(sec, "depth_axial_offset", depth.axialOffset_m);
-    c.write(sec, "depth_lateral_sigma", depth.lateralSigma_rad);
+    visitKeys(*this, OptionWriter{c, sec});
 }
 
 void SensorModelOptions::validate() const {
-    auto bad = [](const std::string& key, const std::string& what) {
-        throw std::invalid_argument("CMultiBinElevationMap insertion option '" + key +
-                                    "': " + what);
-    };
-    const RangeSigmaCurve& r = laser.rangeSigma;
-    if (!(r.c0_m >= 0 && r.c1 >= 0 && r.c2_per_m >= 0 && r.c0_m + r.c1 + r.c2_per_m > 0))
-        bad("laser_range_sigma_coeffs", "need c0, c1, c2 >= 0, not all zero");
+    const OptionChecker check("CMultiBinElevationMap insertion option");
+    visitKeys(*this, check);
+    if (!curveHolds(laser.rangeSigma))
+        check.fail("laser_range_sigma_coeffs", "need c0, c1, c2 >= 0, not all zero");
+    if (!curveHolds(lidar.rangeSigma))
+        check.fail("lidar_range_sigma_coeffs", "need c0, c1, c2 >= 0, not all zero");
     for (const auto& [label, v] : laser.agcByLabel)
-        if (!(v > 0)) bad("laser_agc", "AGC voltage of '" + label + "' must be positive");
-    if (!(laser.minRestoredIntensity >= 0)) bad("laser_min_restored_intensity", "must be >= 0");
-    if (!(laser.intensityCheckRange_m >= 0)) bad("laser_intensity_check_range", "must be >= 0 [m]");
-    if (!(laser.mixedPixelJump_m > 0)) bad("laser_mixed_pixel_jump", "must be positive [m]");
-    if (laser.mixedPixelMaxBeams < 1) bad("laser_mixed_pixel_max_beams", "must be >= 1");
-    if (!(laser.continuitySigmas > 0)) bad("laser_continuity_sigmas", "must be positive");
-    if (!(laser.continuityPoseCorrelation >= 0 && laser.continuityPoseCorrelation <= 1))
-        bad("laser_continuity_pose_correlation", "must be in [0, 1]");
-    if (!(laser.continuityAllowance_m >= 0)) bad("laser_continuity_allowance", "must be >= 0 [m]");
-    if (!(laser.continuityMaxDt_s > 0)) bad("laser_continuity_max_dt", "must be positive [s]");
-    for (const auto& [key, a] :
-         {std::pair{"stereo_left_intrinsics_sigma", stereo.leftIntrinsicsSigma},
-          {"stereo_right_intrinsics_sigma", stereo.rightIntrinsicsSigma}})
-        for (double v : a)
-            if (!(v >= 0)) bad(key, "standard deviations must be >= 0");
-    for (double v : stereo.extrinsicsSigma)
-        if (!(v >= 0)) bad("stereo_extrinsics_sigma", "standard deviations must be >= 0");
-    if (!(stereo.matchingSigma_px >= 0)) bad("stereo_matching_sigma", "must be >= 0 [px]");
-    if (stereo.subsample < 1) bad("stereo_subsample", "must be >= 1 [px]");
-    if (!(stereo.minDepth_m >= 0)) bad("stereo_min_depth", "must be >= 0 [m]");
-    if (stereo.sgbmNumDisparities < 0 || stereo.sgbmNumDisparities % 16 != 0)
-        bad("stereo_sgbm_num_disparities", "must be 0 (automatic) or a positive multiple of 16");
-    if (stereo.sgbmBlockSize < 1 || stereo.sgbmBlockSize % 2 == 0)
-        bad("stereo_sgbm_block_size", "must be odd and >= 1");
-    if (stereo.sgbmP1 < 0 || stereo.sgbmP2 < 0) bad("stereo_sgbm_p1/p2", "must be >= 0");
+        if (!(v > 0)) check.fail("laser_agc", "AGC voltage of '" + label + "' must be positive");
+    if (stereo.sgbmNumDisparities % 16 != 0)
+        check.fail("stereo_sgbm_num_disparities",
+                   "must be 0 (automatic) or a positive multiple of 16");
     if (stereo.sgbmP1 > 0 && stereo.sgbmP2 > 0 && stereo.sgbmP2 <= stereo.sgbmP1)
-        bad("stereo_sgbm_p2", "must be larger than stereo_sgbm_p1");
-    if (stereo.sgbmMode != "sgbm" && stereo.sgbmMode != "hh" && stereo.sgbmMode != "sgbm_3way" &&
-        stereo.sgbmMode != "hh4")
-        bad("stereo_sgbm_mode",
-            "expected sgbm, hh, sgbm_3way or hh4, got '" + stereo.sgbmMode + "'");
-    if (stereo.sgbmUniquenessRatio < 0) bad("stereo_sgbm_uniqueness_ratio", "must be >= 0");
-    if (stereo.sgbmSpeckleWindowSize < 0) bad("stereo_sgbm_speckle_window_size", "must be >= 0");
-    if (stereo.sgbmSpeckleRange < 0) bad("stereo_sgbm_speckle_range", "must be >= 0");
-    if (!(stereo.haloJump_px > 0)) bad("stereo_halo_jump", "must be positive [px]");
-    if (stereo.haloRadius_px < 1) bad("stereo_halo_radius", "must be >= 1 [px]");
-    if (stereo.nearClusterMaxArea_px < 1) bad("stereo_near_cluster_max_area", "must be >= 1 [px]");
-    if (!(stereo.nearClusterStep_px > 0)) bad("stereo_near_cluster_step", "must be positive [px]");
-    if (!(stereo.nearClusterJump_px > 0)) bad("stereo_near_cluster_jump", "must be positive [px]");
-    if (!(stereo.cloudFocalLength_px > 0))
-        bad("stereo_cloud_focal_length", "must be positive [px]");
-    if (!(stereo.cloudBaseline_m > 0)) bad("stereo_cloud_baseline", "must be positive [m]");
-    const RangeSigmaCurve& lr = lidar.rangeSigma;
-    if (!(lr.c0_m >= 0 && lr.c1 >= 0 && lr.c2_per_m >= 0 && lr.c0_m + lr.c1 + lr.c2_per_m > 0))
-        bad("lidar_range_sigma_coeffs", "need c0, c1, c2 >= 0, not all zero");
-    if (!(lidar.angularSigma_rad >= 0)) bad("lidar_angular_sigma", "must be >= 0 [rad]");
-    if (!(lidar.beamDivergence_rad >= 0)) bad("lidar_beam_divergence", "must be >= 0 [rad]");
-    if (!(depth.axialSigma0_m > 0)) bad("depth_axial_sigma", "must be positive [m]");
-    if (!(depth.axialSigmaQuadratic_per_m >= 0)) bad("depth_axial_sigma_quadratic", "must be >= 0");
-    if (!(depth.axialOffset_m >= 0)) bad("depth_axial_offset", "must be >= 0 [m]");
-    if (!(depth.lateralSigma_rad > 0)) bad("depth_lateral_sigma", "must be positive [rad]");
+        check.fail("stereo_sgbm_p2", "must be larger than stereo_sgbm_p1");
 }
 
 }  // namespace multibin::sensors

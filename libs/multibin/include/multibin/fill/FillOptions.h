@@ -77,7 +77,8 @@ struct FillOptions {
     bool enabled = true;  //!< [fill_enabled] run filling at all
 
     // --- Weighted median (small gaps) ---
-    int medianWindow_cells = 5;  //!< [fill_median_window] odd side of the window [cells], >= 3
+    int medianWindow_cells =
+        5;  //!< [fill_median_window_cells] odd side of the window [cells], >= 3
     /** [fill_median_min_known] a gap cell is filled by the median when its window holds at least
      * this many measured cells; a gap with a cell that has fewer goes to the Gaussian surface. */
     int medianMinKnown = 3;
@@ -87,7 +88,8 @@ struct FillOptions {
     /** [fill_max_gap_cells] gaps (4-connected never-observed cells) larger than this stay
      * Unfilled: beyond the sensors' reach there is nothing to interpolate from [cells]. */
     int maxGapCells = 2500;
-    int supportMargin_cells = 4;  //!< [fill_support_margin] margin of the square support [cells]
+    int supportMargin_cells =
+        4;  //!< [fill_support_margin_cells] margin of the square support [cells]
     /** [fill_max_training_points] measured cells used per support area at most: beyond it, the
      * ones nearest the gap are kept (bounds the fitting time) [-]. */
     int maxTrainingPoints = 600;
@@ -130,7 +132,7 @@ struct FillOptions {
      * (see ModelCriterion). */
     ModelCriterion criterion = ModelCriterion::AICc;
     int maxTerms = 4;             //!< [fill_max_terms] largest m tried by AIC [-]
-    double minWidth_cells = 1.0;  //!< [fill_min_width] narrowest Gaussian sigma [cells]
+    double minWidth_cells = 1.0;  //!< [fill_min_width_cells] narrowest Gaussian sigma [cells]
     int swarmParticles = 20;      //!< [fill_pso_particles]
     int swarmIterations = 25;     //!< [fill_pso_iterations]
     unsigned swarmSeed = 1;       //!< [fill_pso_seed]
@@ -143,7 +145,7 @@ struct FillOptions {
     double gaussianSigmaGain = 1.16;
     /** [fill_harmonic_sigma_gain] calibrated gain of the harmonic (surface path) sigma [-] */
     double harmonicSigmaGain = 0.76;
-    double sigmaFloor_m = 0.002;  //!< [fill_sigma_floor] smallest sigma of a filled cell [m]
+    double sigmaFloor_m = 0.002;  //!< [fill_sigma_floor_m] smallest sigma of a filled cell [m]
 
     /** The Gaussian-fit settings these options imply. */
     GaussianFitOptions gaussianFitOptions() const;

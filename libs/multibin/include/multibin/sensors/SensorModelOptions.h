@@ -26,7 +26,8 @@ struct LaserModelOptions {
         100.0;  //!< eq 1 threshold on Ires (key `laser_min_restored_intensity`)
     double intensityCheckRange_m = 1.0;  //!< only readings closer than this are checked [m]
     bool mixedPixelFilter = true;        //!< key `laser_mixed_pixel_filter`
-    /** Range jump separating two clusters of consecutive beams [m] (key `laser_mixed_pixel_jump`).
+    /** Range jump separating two clusters of consecutive beams [m] (key
+     * `laser_mixed_pixel_jump_m`).
      */
     double mixedPixelJump_m = 0.03;
     /** A cluster of at most this many beams whose range lies between its two neighbouring
@@ -39,10 +40,10 @@ struct LaserModelOptions {
      * `laser_continuity_pose_correlation`). */
     double continuityPoseCorrelation = 0.0;
     /** Height variation of the terrain inside a cell that the gate must allow [m] (key
-     * `laser_continuity_allowance`). */
+     * `laser_continuity_allowance_m`). */
     double continuityAllowance_m = 0.01;
     /** Scans further apart in time are not consecutive: no gate [s] (key
-     * `laser_continuity_max_dt`). */
+     * `laser_continuity_max_dt_s`). */
     double continuityMaxDt_s = 1.0;
 };
 
@@ -59,14 +60,14 @@ struct StereoModelOptions {
      * `stereo_extrinsics_sigma = s_rx s_ry s_rz s_tx s_ty s_tz`). */
     std::array<double, 6> extrinsicsSigma{0.0005, 0.0005, 0.0005, 0.0005, 0.0005, 0.0005};
     double matchingSigma_px =
-        0.25;  //!< matching noise per image [px] (key `stereo_matching_sigma`)
+        0.25;  //!< matching noise per image [px] (key `stereo_matching_sigma_px`)
     /** A point cloud of a stereo rig (CObservationPointCloud with the stereo model) has no
      * pixels: its covariance is eq 10 with matching noise only, for a rig of this focal length
-     * [px] and baseline [m] (keys `stereo_cloud_focal_length`, `stereo_cloud_baseline`). */
+     * [px] and baseline [m] (keys `stereo_cloud_focal_length_px`, `stereo_cloud_baseline_m`). */
     double cloudFocalLength_px = 500.0;
     double cloudBaseline_m = 0.09;
     int subsample = 2;        //!< use every n-th pixel in u and v (key `stereo_subsample`)
-    double minDepth_m = 0.2;  //!< nearer points are out of the horopter (key `stereo_min_depth`)
+    double minDepth_m = 0.2;  //!< nearer points are out of the horopter (key `stereo_min_depth_m`)
 
     /** @name OpenCV StereoSGBM, used when the observation has no disparity image (keys
      * `stereo_sgbm_*`). p1/p2 = 0 means OpenCV's usual 8 and 32 * block_size^2. @{ */
@@ -86,14 +87,16 @@ struct StereoModelOptions {
     /** @} */
 
     /** Halo filter: pixels on the near side of a disparity jump larger than haloJump_px, within
-     * haloRadius_px of it (keys `stereo_halo_filter`, `stereo_halo_jump`, `stereo_halo_radius`). */
+     * haloRadius_px of it (keys `stereo_halo_filter`, `stereo_halo_jump_px`,
+     * `stereo_halo_radius_px`). */
     bool haloFilter = true;
     double haloJump_px = 3.0;
     int haloRadius_px = 4;
     /** Near-cluster filter: connected regions (neighbours within nearClusterStep_px of disparity)
      * of fewer than nearClusterMaxArea_px pixels that are nearer than their surroundings by more
-     * than nearClusterJump_px (keys `stereo_near_cluster_filter`, `stereo_near_cluster_max_area`,
-     * `stereo_near_cluster_step`, `stereo_near_cluster_jump`). */
+     * than nearClusterJump_px (keys `stereo_near_cluster_filter`,
+     * `stereo_near_cluster_max_area_px`, `stereo_near_cluster_step_px`,
+     * `stereo_near_cluster_jump_px`). */
     bool nearClusterFilter = true;
     int nearClusterMaxArea_px = 400;
     double nearClusterStep_px = 2.0;
@@ -104,10 +107,10 @@ struct StereoModelOptions {
  * sigma_axial(z) = axialSigma0 + axialSigmaQuadratic (z - axialOffset)^2 along the ray,
  * sigma_lateral(z) = lateralSigma_rad * z across it, z the range of the point. */
 struct DepthModelOptions {
-    double axialSigma0_m = 0.0012;              //!< key `depth_axial_sigma` [m]
-    double axialSigmaQuadratic_per_m = 0.0019;  //!< key `depth_axial_sigma_quadratic` [m/m^2]
-    double axialOffset_m = 0.4;                 //!< key `depth_axial_offset` [m]
-    double lateralSigma_rad = 0.0014;  //!< key `depth_lateral_sigma` [rad] (0.8 px at 580 px)
+    double axialSigma0_m = 0.0012;              //!< key `depth_axial_sigma_m` [m]
+    double axialSigmaQuadratic_per_m = 0.0019;  //!< key `depth_axial_sigma_quadratic_per_m` [m/m^2]
+    double axialOffset_m = 0.4;                 //!< key `depth_axial_offset_m` [m]
+    double lateralSigma_rad = 0.0014;  //!< key `depth_lateral_sigma_rad` [rad] (0.8 px at 580 px)
 
     double axialSigma_m(double z_m) const {
         const double dz = z_m - axialOffset_m;
@@ -124,8 +127,8 @@ struct LidarModelOptions {
      * utm30lx; the keys below override them). */
     std::string sensor = "vlp16";
     RangeSigmaCurve rangeSigma{0.03, 0.0, 0.0};  //!< key `lidar_range_sigma_coeffs`
-    double angularSigma_rad = 0.001;             //!< key `lidar_angular_sigma` [rad]
-    double beamDivergence_rad = 0.003;           //!< key `lidar_beam_divergence` [rad]
+    double angularSigma_rad = 0.001;             //!< key `lidar_angular_sigma_rad` [rad]
+    double beamDivergence_rad = 0.003;           //!< key `lidar_beam_divergence_rad` [rad]
 
     /** The published figures of `name` (vlp16, os1, utm30lx); throws std::invalid_argument for
      * another name. */
