@@ -21,6 +21,7 @@
 #include <limits>
 
 #include "multibin/sensors/LidarModel.h"
+#include "multibin/sensors/RayModel.h"
 
 using namespace multibin;
 using namespace multibin::sensors;
@@ -80,7 +81,7 @@ void BM_LidarModelVlp16Revolution(benchmark::State& state) {
     PointsWithCov out;
     for (auto _ : state) {
         LidarStats st;
-        lidarCloudToPoints(cloud, opts, 0.02, 20.0, out, st);
+        cloudToPoints(cloud, opts, 0.02, 20.0, out, st);
         benchmark::DoNotOptimize(out.data());
     }
     state.counters["points"] = double(out.size());

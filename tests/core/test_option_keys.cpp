@@ -3,13 +3,19 @@
  * tests do not: renamed keys still read under their old names, every key written reads back to
  * the same options, and a value set in code is refused by the same rule as one read from a file. */
 #include <gtest/gtest.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/TMetricMapInitializer.h>
 
+#include <filesystem>
+#include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "multibin/io/ErrorMessage.h"
 #include "multibin/io/OptionKeys.h"
 
 namespace {
@@ -132,13 +138,13 @@ TEST(OptionKeys, ValuesSetInCodeAreCheckedByTheKeysRules) {
     Map::TInsertionOptions o;
     EXPECT_NO_THROW(o.validate());
     o.fill.medianWindow_cells = 4;
-    expectRefused(o, "fill_median_window_cells", "odd number from 3 to 15 [cells]");
+    expectRefused(o, "fill_median_window_cells", "odd number from 3 to 15 (cells)");
     o = {};
     o.sensors.stereo.haloJump_px = 0;
-    expectRefused(o, "stereo_halo_jump_px", "positive and finite [px]");
+    expectRefused(o, "stereo_halo_jump_px", "positive and finite (px)");
     o = {};
     o.sensors.depth.axialOffset_m = std::numeric_limits<double>::infinity();
-    expectRefused(o, "depth_axial_offset_m", ">= 0 and finite [m]");
+    expectRefused(o, "depth_axial_offset_m", ">= 0 and finite (m)");
     o = {};
     o.default_pose_sigmas[3] = -1;
     expectRefused(o, "default_pose_sigmas", ">= 0");
@@ -155,14 +161,42 @@ TEST(OptionKeys, ValuesSetInCodeAreCheckedByTheKeysRules) {
 
 // The rules' texts, which are the error messages.
 TEST(OptionKeys, RuleTextsSayTheRule) {
-    EXPECT_EQ(multibin::positive("m").text(), "must be positive and finite [m]");
+    EXPECT_EQ(multibin::positive("m").text(), "must be positive and finite (m)");
     EXPECT_EQ(multibin::atLeast(1).text(), "must be >= 1 and finite");
     EXPECT_EQ(multibin::between(0, 1).text(), "must be from 0 to 1");
     EXPECT_EQ(multibin::oddBetween(3, 15, "cells").text(),
-              "must be an odd number from 3 to 15 [cells]");
-    EXPECT_EQ(multibin::finite("m").text(), "must be finite [m]");
+              "must be an odd number from 3 to 15 (cells)");
+    EXPECT_EQ(multibin::finite("m").text(), "must be finite (m)");
     EXPECT_FALSE(multibin::oddBetween(3, 15).holds(4));
     EXPECT_TRUE(multibin::oddBetween(3, 15).holds(15));
     EXPECT_FALSE(multibin::positive().holds(0));
     EXPECT_FALSE(multibin::atLeast(0).holds(std::nan("")));
+}
+
+// A rule broken in an ini file reaches the user whole, through MRPT's map initializers (as
+// observations2map and elevation-mapper load maps): file, section, key, rule and unit. Before,
+// MRPT's exception wrapper cut the message at the ']' of "[m]", and the user saw "error: ".
+TEST(OptionKeys, BrokenRulesReachTheUserWholeThroughMrptsInitializers) {
+    const std::string dir = std::string(MULTIBIN_BINARY_DIR) + "/test_option_keys";
+    std::filesystem::create_directories(dir);
+    for (const std::string key : {"fill_median_window_cells = 4", "visibility_margin_m = -1",
+                                  "stereo_halo_jump_px = 0", "fill_pso_particles = 0"}) {
+        SCOPED_TRACE(key);
+        const std::string path = dir + "/broken.ini";
+        std::ofstream(path) << "[map]\nmultiBinElevationMap_count = 1\n"
+                            << "[map_multiBinElevationMap_00_insertOpts]\n"
+                            << key << "\n";
+        try {
+            mrpt::config::CConfigFile ini(path);
+            mrpt::maps::TSetOfMetricMapInitializers inits;
+            inits.loadFromConfigFile(ini, "map");
+            ADD_FAILURE() << "accepted";
+        } catch (const std::exception& e) {
+            const std::string msg = multibin::oneLineMessage(e);
+            for (const std::string& word :
+                 {path, std::string("map_multiBinElevationMap_00_insertOpts"),
+                  key.substr(0, key.find(' ')), std::string("must be")})
+                EXPECT_NE(msg.find(word), std::string::npos) << "'" << word << "' not in: " << msg;
+        }
+    }
 }

@@ -14,6 +14,7 @@
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/BinGrid.h"
 #include "multibin/sensors/DepthModel.h"
+#include "multibin/sensors/RayModel.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin;
@@ -25,7 +26,7 @@ TEST(DepthModel, AxialAndLateralSigmasFollowTheModel) {
     EXPECT_NEAR(o.axialSigma_m(0.4), 0.0012, 1e-12);
     EXPECT_NEAR(o.axialSigma_m(1.65), 0.0012 + 0.0019 * 1.5625, 1e-12);
     const Eigen::Vector3f p(2.0f, 1.0f, -0.5f);
-    const Eigen::Matrix3d C = depthPointCovariance(p, o).toMatrix();
+    const Eigen::Matrix3d C = rayPointCovariance(p, o).toMatrix();
     const double r = p.cast<double>().norm();
     const Eigen::Vector3d d = p.cast<double>() / r;
     EXPECT_NEAR(d.dot(C * d), std::pow(o.axialSigma_m(r), 2), 1e-9);
@@ -39,10 +40,14 @@ TEST(DepthModel, InvalidPointsSkippedAndCounted) {
     DepthModelOptions o;
     PointsWithCov out;
     DepthStats st;
-    appendDepthPoint(Eigen::Vector3f(NAN, 0, 0), o, 0.1, 5, out, st);
-    appendDepthPoint(Eigen::Vector3f(0, 0, 0), o, 0.1, 5, out, st);  // no return
-    appendDepthPoint(Eigen::Vector3f(6, 0, 0), o, 0.1, 5, out, st);
-    appendDepthPoint(Eigen::Vector3f(1, 0, 0), o, 0.1, 5, out, st);
+    mrpt::obs::CObservationPointCloud cloud;
+    auto pts = mrpt::maps::CSimplePointsMap::Create();
+    pts->insertPoint(NAN, 0, 0);
+    pts->insertPoint(0, 0, 0);  // no return
+    pts->insertPoint(6, 0, 0);
+    pts->insertPoint(1, 0, 0);
+    cloud.pointcloud = pts;
+    cloudToPoints(cloud, o, 0.1, 5, out, st);
     EXPECT_EQ(st.points, 4u);
     EXPECT_EQ(st.notFinite, 1u);
     EXPECT_EQ(st.outOfRange, 2u);
@@ -62,7 +67,7 @@ TEST(DepthModel, MonteCarloCovarianceMatchesPropagation) {
     const Eigen::Vector3d e1 = d.cross(Eigen::Vector3d::UnitZ()).normalized(), e2 = d.cross(e1);
     const PointWithCov pred =
         PosePropagator(pdf, sensor)
-            .apply(PointWithCov{p.cast<float>(), depthPointCovariance(p.cast<float>(), o)});
+            .apply(PointWithCov{p.cast<float>(), rayPointCovariance(p.cast<float>(), o)});
     std::mt19937 rng(5);
     std::normal_distribution<double> n01;
     std::vector<Eigen::Vector3d> samples;

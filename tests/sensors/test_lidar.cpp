@@ -16,6 +16,7 @@
 #include "multibin/io/StrictConfigSection.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/LidarModel.h"
+#include "multibin/sensors/RayModel.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin;
@@ -36,7 +37,7 @@ double acrossRay(const PointWithCov& p) {
 
 /** Monte Carlo of one lidar return at `p` (sensor frame): range noise, angular noise and a
  * uniformly random spot in the divergence footprint, and robot pose noise, through the real
- * transform; compared with lidarPointCovariance() + PosePropagator. */
+ * transform; compared with rayPointCovariance() + PosePropagator. */
 void expectLidarModelConsistent(const LidarModelOptions& o, const Eigen::Vector3d& p) {
     const mrpt::poses::CPose3D sensor(0.1, 0.0, 0.9, 0.05, 0.1, 0.0);
     const auto pdf = mc::robotPosePdf();
@@ -45,7 +46,7 @@ void expectLidarModelConsistent(const LidarModelOptions& o, const Eigen::Vector3
     const Eigen::Vector3d e1 = d.cross(Eigen::Vector3d::UnitZ()).normalized(), e2 = d.cross(e1);
     const PointWithCov pred =
         PosePropagator(pdf, sensor)
-            .apply(PointWithCov{p.cast<float>(), lidarPointCovariance(p.cast<float>(), o)});
+            .apply(PointWithCov{p.cast<float>(), rayPointCovariance(p.cast<float>(), o)});
     std::mt19937 rng(11);
     std::normal_distribution<double> n01;
     std::uniform_real_distribution<double> u01;
@@ -112,7 +113,7 @@ TEST(LidarModel, PresetsAreThePublishedFiguresAndTheLateralSigmaAddsTheFootprint
     EXPECT_THROW(LidarModelOptions::forSensor("hdl64"), std::invalid_argument);
     // Across the beam at 10 m: 10 * sqrt(0.001^2 + 0.003^2 / 16) = 12.5 mm.
     EXPECT_NEAR(vlp.lateralSigma_m(10.0), 0.0125, 1e-12);
-    const PointWithCov p{Eigen::Vector3f(6, 8, 0), lidarPointCovariance({6, 8, 0}, vlp)};
+    const PointWithCov p{Eigen::Vector3f(6, 8, 0), rayPointCovariance({6, 8, 0}, vlp)};
     EXPECT_NEAR(alongRay(p), 0.03 * 0.03, 1e-9);
     EXPECT_NEAR(acrossRay(p), 0.0125 * 0.0125, 1e-9);
 }

@@ -78,7 +78,7 @@ GaussianFitOptions FillOptions::gaussianFitOptions() const {
 
 void FillOptions::read(StrictConfigSection& s) {
     visitKeys(*this, OptionReader{s});
-    validate();
+    validateAsReadFrom(s, *this);
 }
 
 void FillOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& source,

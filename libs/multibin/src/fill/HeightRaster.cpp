@@ -2,6 +2,7 @@
 #include "multibin/fill/HeightRaster.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -75,24 +76,15 @@ FillResult initResult(const HeightRaster& r, std::vector<char>& measured) {
 }
 
 void countSources(FillResult& out) {
+    // Cells per HeightSource value (0 .. 4, the numbers of its raster layer; 5: any other).
+    std::array<size_t, 6> cells{};
+    for (auto src : out.source) cells[std::min<size_t>(size_t(src), 5)]++;
     auto& s = out.stats;
-    s.measured = s.median = s.gaussian = s.harmonic = s.unfilled = 0;
-    for (auto src : out.source) switch (src) {
-            case HeightSource::Measured:
-                s.measured++;
-                break;
-            case HeightSource::FilledMedian:
-                s.median++;
-                break;
-            case HeightSource::FilledSurface:
-                s.gaussian++;
-                break;
-            case HeightSource::FilledHarmonic:
-                s.gaussian++, s.harmonic++;
-                break;
-            default:
-                s.unfilled++;
-        }
+    s.measured = cells[size_t(HeightSource::Measured)];
+    s.median = cells[size_t(HeightSource::FilledMedian)];
+    s.harmonic = cells[size_t(HeightSource::FilledHarmonic)];
+    s.gaussian = cells[size_t(HeightSource::FilledSurface)] + s.harmonic;
+    s.unfilled = cells[size_t(HeightSource::Unknown)] + cells[5];
 }
 
 }  // namespace detail

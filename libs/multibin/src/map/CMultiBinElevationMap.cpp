@@ -49,14 +49,18 @@ namespace {
 const std::vector<std::string> kGenericMapKeys = {
     "enableSaveAs3DObject", "enableObservationLikelihood", "enableObservationInsertion"};
 
-/** options.validate(), its error prefixed with the file and section the options came from. */
-template <typename Options>
-void validateIn(const multibin::StrictConfigSection& s, const Options& options) {
-    try {
-        options.validate();
-    } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument(s.where() + ": " + e.what());
-    }
+/** Reads options from one section strictly: `readKeys(StrictConfigSection&)` reads their keys,
+ * any other key of the section (but `allowed`) is an error, then options.validate(); every error
+ * names the file and the section. */
+template <typename Options, typename ReadKeys>
+void loadStrictly(const mrpt::config::CConfigFileBase& source, const std::string& section,
+                  const Options& options, ReadKeys&& readKeys,
+                  const std::vector<std::string>& allowed = {}) {
+    multibin::StrictConfigSection s(source, section);
+    readKeys(s);
+    s.allow(allowed);
+    s.finish();
+    multibin::validateAsReadFrom(s, options);
 }
 
 /** "ini file 'F'" or "ini" (a source that is not a file). Messages hold no ']': MRPT's exception
@@ -158,11 +162,12 @@ void visitInsertionKeys(Options& o, Visit&& visit) {
 
 void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
-    multibin::StrictConfigSection s(source, section);
-    visitCreationKeys(*this, multibin::OptionReader{s});
-    s.allow(kGenericMapKeys);
-    s.finish();
-    validateIn(s, *this);
+    loadStrictly(
+        source, section, *this,
+        [&](multibin::StrictConfigSection& s) {
+            visitCreationKeys(*this, multibin::OptionReader{s});
+        },
+        kGenericMapKeys);
 }
 
 void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
@@ -219,13 +224,12 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
 
 void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
-    multibin::StrictConfigSection s(source, section);
-    visitInsertionKeys(*this, multibin::OptionReader{s});
-    visibility.read(s);
-    fill.read(s);
-    sensors.read(s);
-    s.finish();
-    validateIn(s, *this);
+    loadStrictly(source, section, *this, [&](multibin::StrictConfigSection& s) {
+        visitInsertionKeys(*this, multibin::OptionReader{s});
+        visibility.read(s);
+        fill.read(s);
+        sensors.read(s);
+    });
 }
 
 void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,

@@ -13,22 +13,13 @@
 
 namespace multibin::sensors {
 
-SymmetricCov3 depthPointCovariance(const Eigen::Vector3f& p_m, const DepthModelOptions& opts) {
-    const double r = p_m.cast<double>().norm();
-    return rayCovariance(p_m, opts.axialSigma_m(r), opts.lateralSigma_rad * r);
-}
-
+namespace {
 void appendDepthPoint(const Eigen::Vector3f& p_m, const DepthModelOptions& opts, double minRange_m,
                       double maxRange_m, PointsWithCov& out, DepthStats& stats) {
     stats.points++;
-    count(appendRayPoint(
-              p_m, minRange_m, maxRange_m,
-              [&](double r) {
-                  return std::pair{opts.axialSigma_m(r), opts.lateralSigma_rad * r};
-              },
-              out),
-          stats);
+    count(appendRayPoint(p_m, minRange_m, maxRange_m, opts.raySigmas(), out), stats);
 }
+}  // namespace
 
 namespace {
 void appendPointsMap(const mrpt::maps::CPointsMap& pts, const DepthModelOptions& opts,
@@ -64,14 +55,6 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
         const_cast<mrpt::obs::CObservation3DRangeScan&>(scan).unprojectInto(local, pp);
         appendPointsMap(local, opts, minRange_m, maxRange_m, out, stats);
     }
-}
-
-void pointCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
-                        const DepthModelOptions& opts, double minRange_m, double maxRange_m,
-                        PointsWithCov& out, DepthStats& stats) {
-    out.clear();
-    if (cloud.pointcloud)
-        appendPointsMap(*cloud.pointcloud, opts, minRange_m, maxRange_m, out, stats);
 }
 
 }  // namespace multibin::sensors

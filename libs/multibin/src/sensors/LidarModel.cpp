@@ -18,13 +18,6 @@
 namespace multibin::sensors {
 
 namespace {
-auto lidarSigmas(const LidarModelOptions& opts) {
-    const double lateralPerRange = opts.lateralSigma_m(1.0);  // lateral sigma is linear in range
-    return [&opts, lateralPerRange](double r) {
-        return std::pair{opts.rangeSigma(r), lateralPerRange * r};
-    };
-}
-
 /** A beam of a scan in the sensor's xy plane: no return, NaN, or a point. */
 void appendPlanarBeam(float range_m, bool valid, double scanMaxRange_m, double azimuth_rad,
                       const LidarModelOptions& opts, double minRange_m, double maxRange_m,
@@ -37,7 +30,7 @@ void appendPlanarBeam(float range_m, bool valid, double scanMaxRange_m, double a
     } else {
         const Eigen::Vector3f p(float(std::cos(azimuth_rad)) * range_m,
                                 float(std::sin(azimuth_rad)) * range_m, 0.f);
-        count(appendRayPoint(p, minRange_m, maxRange_m, lidarSigmas(opts), out), stats);
+        count(appendRayPoint(p, minRange_m, maxRange_m, opts.raySigmas(), out), stats);
     }
 }
 
@@ -54,23 +47,12 @@ struct Collector : mrpt::obs::CObservationVelodyneScan::PointCloudStorageWrapper
     void add_point(float x, float y, float z, uint8_t, const mrpt::system::TTimeStamp&, const float,
                    uint16_t) override {
         generated++;
-        count(appendRayPoint(Eigen::Vector3f(x, y, z), minRange_m, maxRange_m, lidarSigmas(opts),
-                             out),
-              stats);
+        count(
+            appendRayPoint(Eigen::Vector3f(x, y, z), minRange_m, maxRange_m, opts.raySigmas(), out),
+            stats);
     }
 };
 }  // namespace
-
-SymmetricCov3 lidarPointCovariance(const Eigen::Vector3f& p_m, const LidarModelOptions& opts) {
-    const double r = p_m.cast<double>().norm();
-    return rayCovariance(p_m, opts.rangeSigma(r), opts.lateralSigma_m(r));
-}
-
-void appendLidarPoint(const Eigen::Vector3f& p_m, const LidarModelOptions& opts, double minRange_m,
-                      double maxRange_m, PointsWithCov& out, LidarStats& stats) {
-    stats.returns++;
-    count(appendRayPoint(p_m, minRange_m, maxRange_m, lidarSigmas(opts), out), stats);
-}
 
 void velodyneScanToPoints(const mrpt::obs::CObservationVelodyneScan& scan,
                           const LidarModelOptions& opts, double minRange_m, double maxRange_m,
@@ -134,17 +116,6 @@ void rotatingScanToPoints(const mrpt::obs::CObservationRotatingScan& scan,
                          scan.startAzimuth + double(i) * step, opts, minRange_m, maxRange_m, out,
                          stats);
     }
-}
-
-void lidarCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
-                        const LidarModelOptions& opts, double minRange_m, double maxRange_m,
-                        PointsWithCov& out, LidarStats& stats) {
-    out.clear();
-    stats.scans++;
-    if (cloud.pointcloud)
-        forEachCloudPoint(*cloud.pointcloud, out, [&](const Eigen::Vector3f& p) {
-            appendLidarPoint(p, opts, minRange_m, maxRange_m, out, stats);
-        });
 }
 
 }  // namespace multibin::sensors

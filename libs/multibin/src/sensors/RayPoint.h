@@ -6,33 +6,23 @@
 #include <Eigen/Core>
 
 #include "multibin/geometry/PointsWithCovariance.h"
+#include "multibin/sensors/RayModel.h"
 
 namespace multibin::sensors {
-
-/** Covariance [m^2] of a point `p_m` measured along its ray from the sensor origin:
- * axial_m^2 d d^T + lateral_m^2 (I - d d^T), d = p / |p|. The depth, lidar and stereo-cloud
- * models differ only in their two sigmas. */
-inline SymmetricCov3 rayCovariance(const Eigen::Vector3f& p_m, double axial_m, double lateral_m) {
-    // = (axial^2 - lateral^2) d d^T + lateral^2 I: six entries, no 3x3 temporaries.
-    const Eigen::Vector3d d = p_m.cast<double>() / p_m.cast<double>().norm();
-    const double l2 = lateral_m * lateral_m, k = axial_m * axial_m - l2;
-    return {float(k * d.x() * d.x() + l2), float(k * d.x() * d.y()), float(k * d.x() * d.z()),
-            float(k * d.y() * d.y() + l2), float(k * d.y() * d.z()), float(k * d.z() * d.z() + l2)};
-}
 
 enum class RayPointFate { kept, notFinite, outOfRange };
 
 /** Appends `p_m` with rayCovariance(p, sigmas(r)) if it is finite and its range r lies in
  * [minRange_m, maxRange_m] (a point at the origin is a missing return: out of range). `sigmas`
- * maps a range [m] to {axial, lateral} [m]. */
+ * maps a range [m] to RaySigmas (a model's raySigmas()). */
 template <class Sigmas>
 RayPointFate appendRayPoint(const Eigen::Vector3f& p_m, double minRange_m, double maxRange_m,
                             const Sigmas& sigmas, PointsWithCov& out) {
     if (!p_m.allFinite()) return RayPointFate::notFinite;
     const float r = p_m.norm();
     if (!(r > 0) || r < minRange_m || r > maxRange_m) return RayPointFate::outOfRange;
-    const auto [axial_m, lateral_m] = sigmas(p_m.cast<double>().norm());
-    out.push_back({p_m, rayCovariance(p_m, axial_m, lateral_m)});
+    const RaySigmas s = sigmas(p_m.cast<double>().norm());
+    out.push_back({p_m, rayCovariance(p_m, s.axial_m, s.lateral_m)});
     return RayPointFate::kept;
 }
 

@@ -17,6 +17,7 @@
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/LaserModel.h"
 #include "multibin/sensors/LidarModel.h"
+#include "multibin/sensors/RayModel.h"
 #include "multibin/sensors/StereoModel.h"
 
 namespace multibin::sensors {
@@ -77,43 +78,37 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
         out.sensorPose = mrpt::poses::CPose3D(stereo->cameraPose);  // left camera on the robot
         return true;
     }
-    if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
-        chooseModel(obs, opts, K::depth, {K::depth});
-        depthScanToPoints(*depth, opts.depth, minRange_m, maxRange_m, out.points, out.stats.depth);
-        out.sensorPose = depth->sensorPose;
+    // A class that takes one model only: its points by `toPoints` with that model.
+    const auto onlyModel = [&](const auto& scan, K kind, auto toPoints, const auto& model,
+                               auto& stats) {
+        chooseModel(obs, opts, kind, {kind});
+        toPoints(scan, model, minRange_m, maxRange_m, out.points, stats);
+        out.sensorPose = scan.sensorPose;
         return true;
-    }
+    };
+    if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs))
+        return onlyModel(*depth, K::depth, depthScanToPoints, opts.depth, out.stats.depth);
     if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
         out.sensorPose = cloud->sensorPose;
         switch (chooseModel(obs, opts, K::depth, {K::depth, K::lidar, K::stereo})) {
             case K::lidar:
-                lidarCloudToPoints(*cloud, opts.lidar, minRange_m, maxRange_m, out.points,
-                                   out.stats.lidar);
+                cloudToPoints(*cloud, opts.lidar, minRange_m, maxRange_m, out.points,
+                              out.stats.lidar);
                 break;
             case K::stereo:
-                stereoCloudToPoints(*cloud, opts.stereo, minRange_m, maxRange_m, out.points,
-                                    out.stats.stereo);
+                cloudToPoints(*cloud, opts.stereo, minRange_m, maxRange_m, out.points,
+                              out.stats.stereo);
                 break;
             default:
-                pointCloudToPoints(*cloud, opts.depth, minRange_m, maxRange_m, out.points,
-                                   out.stats.depth);
+                cloudToPoints(*cloud, opts.depth, minRange_m, maxRange_m, out.points,
+                              out.stats.depth);
         }
         return true;
     }
-    if (const auto* velodyne = dynamic_cast<const mrpt::obs::CObservationVelodyneScan*>(&obs)) {
-        chooseModel(obs, opts, K::lidar, {K::lidar});
-        velodyneScanToPoints(*velodyne, opts.lidar, minRange_m, maxRange_m, out.points,
-                             out.stats.lidar);
-        out.sensorPose = velodyne->sensorPose;
-        return true;
-    }
-    if (const auto* rotating = dynamic_cast<const mrpt::obs::CObservationRotatingScan*>(&obs)) {
-        chooseModel(obs, opts, K::lidar, {K::lidar});
-        rotatingScanToPoints(*rotating, opts.lidar, minRange_m, maxRange_m, out.points,
-                             out.stats.lidar);
-        out.sensorPose = rotating->sensorPose;
-        return true;
-    }
+    if (const auto* velodyne = dynamic_cast<const mrpt::obs::CObservationVelodyneScan*>(&obs))
+        return onlyModel(*velodyne, K::lidar, velodyneScanToPoints, opts.lidar, out.stats.lidar);
+    if (const auto* rotating = dynamic_cast<const mrpt::obs::CObservationRotatingScan*>(&obs))
+        return onlyModel(*rotating, K::lidar, rotatingScanToPoints, opts.lidar, out.stats.lidar);
     return false;
 }
 

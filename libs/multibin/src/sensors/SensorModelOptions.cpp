@@ -253,7 +253,7 @@ void visitKeys(Options& o, Visit&& visit) {
 
 void SensorModelOptions::read(StrictConfigSection& s) {
     visitKeys(*this, OptionReader{s});
-    validate();
+    validateAsReadFrom(s, *this);
 }
 
 void SensorModelOptions::write(mrpt::config::CConfigFileBase& c, const std::string& sec) const {

@@ -492,19 +492,4 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
     stats.kept += c.kept;
 }
 
-void stereoCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
-                         const StereoModelOptions& opts, double minRange_m, double maxRange_m,
-                         PointsWithCov& out, StereoStats& stats) {
-    out.clear();
-    stats.pairs++;
-    if (!cloud.pointcloud) return;
-    const double f = opts.cloudFocalLength_px, sm = opts.matchingSigma_px;
-    const double axialPerR2 = std::sqrt(2.0) * sm / (f * opts.cloudBaseline_m);  // [1/m]
-    auto sigmas = [&](double r) { return std::pair{axialPerR2 * r * r, r * sm / f}; };
-    forEachCloudPoint(*cloud.pointcloud, out, [&](const Eigen::Vector3f& p) {
-        stats.pixels++;
-        count(appendRayPoint(p, minRange_m, maxRange_m, sigmas, out), stats);
-    });
-}
-
 }  // namespace multibin::sensors

@@ -50,13 +50,13 @@ struct OptionRule {
     double hi = std::numeric_limits<double>::infinity();
     bool loExcluded = false;
     bool odd = false;
-    const char* unit = "";  //!< shown after the rule, as " [m]"
+    const char* unit = "";  //!< shown after the rule, as " (m)"
 
     bool holds(double v) const {
         if (!std::isfinite(v) || (loExcluded ? !(v > lo) : !(v >= lo)) || !(v <= hi)) return false;
         return !odd || std::fmod(std::abs(v), 2.0) == 1.0;
     }
-    /** "must be positive and finite [m]", "must be from 3 to 15 [cells]", ... */
+    /** "must be positive and finite (m)", "must be from 3 to 15 (cells)", ... */
     std::string text() const {
         std::ostringstream os;
         os << "must be ";
@@ -70,7 +70,8 @@ struct OptionRule {
             os << "from " << lo << " to " << hi;
         else
             os << ">= " << lo << " and finite";
-        if (*unit) os << " [" << unit << "]";
+        // "(m)", not "[m]": MRPT's exception wrapper cuts a message at its first ']'.
+        if (*unit) os << " (" << unit << ")";
         return os.str();
     }
 };
@@ -239,6 +240,16 @@ public:
 private:
     std::string m_what;
 };
+/** options.validate(), its error prefixed with where the options were read from ("ini file 'F',
+ * section 'S': ..."). */
+template <class Options>
+void validateAsReadFrom(const StrictConfigSection& section, const Options& options) {
+    try {
+        options.validate();
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(section.where() + ": " + e.what());
+    }
+}
 /** @} */
 
 }  // namespace multibin

@@ -15,19 +15,10 @@ class CObservationPointCloud;  // in mrpt::maps, not in obs_frwds.h
 
 namespace multibin::sensors {
 
-/** Sensor-frame covariance [m^2] of a lidar return at `p_m` (sensor origin at 0):
- * sigma_r(r)^2 d d^T + opts.lateralSigma_m(r)^2 (I - d d^T), r = |p|, d = p / r. */
-SymmetricCov3 lidarPointCovariance(const Eigen::Vector3f& p_m, const LidarModelOptions& opts);
-
-/** Appends the return (sensor frame) with its lidar covariance, or counts it as not finite / out
- * of range (a point at the origin is out of range). */
-void appendLidarPoint(const Eigen::Vector3f& p_m, const LidarModelOptions& opts, double minRange_m,
-                      double maxRange_m, PointsWithCov& out, LidarStats& stats);
-
 /** Points of a Velodyne scan in its sensor frame, from MRPT's calibrated point generation
  * (CObservationVelodyneScan::generatePointCloud with no distance filter of its own). Every raw
- * channel of the scan's packets is counted: no echo, not decoded by MRPT, or as
- * appendLidarPoint() counts it. */
+ * channel of the scan's packets is counted: no echo, not decoded by MRPT, or
+ * out of range or not finite, like any ray point (RayModel.h). */
 void velodyneScanToPoints(const mrpt::obs::CObservationVelodyneScan& scan,
                           const LidarModelOptions& opts, double minRange_m, double maxRange_m,
                           PointsWithCov& out, LidarStats& stats);
@@ -46,10 +37,5 @@ void lidarScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
 void rotatingScanToPoints(const mrpt::obs::CObservationRotatingScan& scan,
                           const LidarModelOptions& opts, double minRange_m, double maxRange_m,
                           PointsWithCov& out, LidarStats& stats);
-
-/** Points of a point cloud taken by a lidar, in its sensor frame. */
-void lidarCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
-                        const LidarModelOptions& opts, double minRange_m, double maxRange_m,
-                        PointsWithCov& out, LidarStats& stats);
 
 }  // namespace multibin::sensors

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -15,6 +16,13 @@ class StrictConfigSection;
 }
 
 namespace multibin::sensors {
+
+/** The two standard deviations of a point measured along a ray [m]: along it and across it. The
+ * depth, lidar and stereo-cloud models differ only in these (RayModel.h). */
+struct RaySigmas {
+    double axial_m = 0;
+    double lateral_m = 0;
+};
 
 /** Pitched 2D laser scanner (Hokuyo URG-04LX) model options. */
 struct LaserModelOptions {
@@ -66,6 +74,15 @@ struct StereoModelOptions {
      * [px] and baseline [m] (keys `stereo_cloud_focal_length_px`, `stereo_cloud_baseline_m`). */
     double cloudFocalLength_px = 500.0;
     double cloudBaseline_m = 0.09;
+    /** The ray sigmas of a point of a stereo cloud as a function of its range r [m] (RayModel.h):
+     * eq 10 with matching noise only, r taken as the depth: r^2 sqrt(2) sigma_m / (f b) along
+     * the ray, r sigma_m / f across it. */
+    auto raySigmas() const {
+        const double f = cloudFocalLength_px, sm = matchingSigma_px;
+        return [axialPerR2 = std::sqrt(2.0) * sm / (f * cloudBaseline_m), sm, f](double range_m) {
+            return RaySigmas{axialPerR2 * range_m * range_m, range_m * sm / f};
+        };
+    }
     int subsample = 2;        //!< use every n-th pixel in u and v (key `stereo_subsample`)
     double minDepth_m = 0.2;  //!< nearer points are out of the horopter (key `stereo_min_depth_m`)
 
@@ -116,6 +133,12 @@ struct DepthModelOptions {
         const double dz = z_m - axialOffset_m;
         return axialSigma0_m + axialSigmaQuadratic_per_m * dz * dz;
     }
+    /** The ray sigmas as a function of range [m] (RayModel.h). */
+    auto raySigmas() const {
+        return [o = *this](double range_m) {
+            return RaySigmas{o.axialSigma_m(range_m), o.lateralSigma_rad * range_m};
+        };
+    }
 };
 
 /** Rotating or 2D lidar model: sigma_r(r) along the beam; across it r * sqrt(sigma_a^2 +
@@ -135,6 +158,13 @@ struct LidarModelOptions {
     static LidarModelOptions forSensor(const std::string& name);
     /** Standard deviation across the beam at range `range_m` [m]. */
     double lateralSigma_m(double range_m) const;
+    /** The ray sigmas as a function of range [m] (RayModel.h); the lateral one is linear in
+     * range, so its factor is computed once. */
+    auto raySigmas() const {
+        return [curve = rangeSigma, lateralPerRange = lateralSigma_m(1.0)](double range_m) {
+            return RaySigmas{curve(range_m), lateralPerRange * range_m};
+        };
+    }
 };
 
 /** The noise model a sensor's data get. */

@@ -123,13 +123,4 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
                     std::shared_ptr<const StereoCovarianceTable>& table, PointsWithCov& out,
                     StereoStats& stats);
 
-/** Points of a point cloud made by a stereo rig (CObservationPointCloud with the stereo model), in
- * its sensor frame. Without pixels or calibration, each point gets eq 10 for matching noise only,
- * taking its range r as the depth: sigma along the ray r^2 sqrt(2) sigma_m / (f b), across it
- * r sigma_m / f (sigma_m = opts.matchingSigma_px, f = opts.cloudFocalLength_px,
- * b = opts.cloudBaseline_m). Counted in stats.pixels, notFinite, outOfRange and kept. */
-void stereoCloudToPoints(const mrpt::obs::CObservationPointCloud& cloud,
-                         const StereoModelOptions& opts, double minRange_m, double maxRange_m,
-                         PointsWithCov& out, StereoStats& stats);
-
 }  // namespace multibin::sensors
