@@ -20,38 +20,19 @@
 #include <set>
 #include <sstream>
 
+#include "mapper_run.h"
 #include "multibin/io/EsriAsciiGrid.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
+using mapper_run::readAll;
+using mapper_run::runMapper;
+using mapper_run::RunResult;
+
 fs::path scratchDir(const std::string& name) {
-    const fs::path d = fs::path(MULTIBIN_BINARY_DIR) / "test_elevation_mapper" / name;
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string readAll(const fs::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
-
-struct RunResult {
-    int exitCode;
-    std::string out, err;
-};
-
-/** Runs elevation-mapper with `args` (a shell command line fragment) in `dir`; `prefix` goes
- * before the program (e.g. "ulimit -f 16;"). */
-RunResult runMapper(const fs::path& dir, const std::string& args, const std::string& prefix = "") {
-    const std::string cmd = prefix + " " + ELEVATION_MAPPER_EXE + " " + args + " > " +
-                            (dir / "stdout.txt").string() + " 2> " + (dir / "stderr.txt").string() +
-                            " < /dev/null";
-    const int status = std::system(("/bin/sh -c '" + cmd + "'").c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(dir / "stdout.txt"),
-            readAll(dir / "stderr.txt")};
+    return mapper_run::scratchDir("test_elevation_mapper", name);
 }
 
 void writeRawlog(const fs::path& path,

@@ -1,0 +1,44 @@
+/* Running the elevation-mapper program from a test: scratch folders, its output, its exit code. */
+#pragma once
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace mapper_run {
+
+/** An empty folder `name` under the build tree's `group` folder. */
+inline std::filesystem::path scratchDir(const std::string& group, const std::string& name) {
+    const std::filesystem::path d = std::filesystem::path(MULTIBIN_BINARY_DIR) / group / name;
+    std::filesystem::remove_all(d);
+    std::filesystem::create_directories(d);
+    return d;
+}
+
+inline std::string readAll(const std::filesystem::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+struct RunResult {
+    int exitCode;
+    std::string out, err;
+};
+
+/** Runs elevation-mapper with `args` (a shell command line fragment) in `dir`; `prefix` goes
+ * before the program (e.g. "ulimit -f 16;"). */
+inline RunResult runMapper(const std::filesystem::path& dir, const std::string& args,
+                           const std::string& prefix = "") {
+    const std::string cmd = prefix + " " + ELEVATION_MAPPER_EXE + " " + args + " > " +
+                            (dir / "stdout.txt").string() + " 2> " + (dir / "stderr.txt").string() +
+                            " < /dev/null";
+    const int status = std::system(("/bin/sh -c '" + cmd + "'").c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(dir / "stdout.txt"),
+            readAll(dir / "stderr.txt")};
+}
+
+}  // namespace mapper_run
