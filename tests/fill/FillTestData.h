@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "multibin/eval/Evaluation.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/io/EsriAsciiGrid.h"
 
@@ -143,6 +144,27 @@ inline fill::HeightRaster caseRaster(const std::vector<Board>& boards, const Gap
 
 inline double caseTruth(const std::vector<Board>& boards, const GapCase& c, int ix, int iy) {
     return boards[size_t(c.board)].at(kCropOffset + ix, kCropOffset + iy);
+}
+
+/** Calls fn(k, truth_m) for every filled cell k of `fill` that has a ground truth: the ESRI raster
+ * at `truthPath` averaged onto a lattice of the fill's cell size (eval::groundTruthOnLattice),
+ * matched at that lattice's cell centres. */
+template <class Fn>
+void forEachFilledCellWithTruth(const fill::FillResult& fill, const std::string& truthPath,
+                                Fn&& fn) {
+    Lattice lattice;
+    const auto truth = eval::groundTruthOnLattice(EsriAsciiGrid::load(truthPath),
+                                                  fill.lattice.cellSize_m, lattice);
+    for (int row = 0; row < lattice.ny(); row++)
+        for (int col = 0; col < lattice.nx(); col++) {
+            int c, r;
+            const float t = truth(row, col);
+            if (!std::isfinite(t) ||
+                !fill.lattice.cellOf(lattice.cellCenterX_m(col), lattice.cellCenterY_m(row), c, r))
+                continue;
+            const size_t k = fill.index(c, r);
+            if (fill.isFilled(k)) fn(k, double(t));
+        }
 }
 
 }  // namespace multibin::filltest

@@ -411,21 +411,10 @@ int mapper(const std::string& mapPath, const std::string& truthPath) {
     map.insertionOptions.fill = g_base;
     map.dem_update_map();
     const FillResult& fill = map.lastFill();
-    multibin::Lattice lattice;
-    const auto truth = multibin::eval::groundTruthOnLattice(EsriAsciiGrid::load(truthPath),
-                                                            fill.lattice.cellSize_m, lattice);
     std::map<HeightSource, std::vector<Err>> bySource;
-    for (int row = 0; row < lattice.ny(); row++)
-        for (int col = 0; col < lattice.nx(); col++) {
-            int c, r;
-            const float t = truth(row, col);
-            if (!std::isfinite(t) ||
-                !fill.lattice.cellOf(lattice.cellCenterX_m(col), lattice.cellCenterY_m(row), c, r))
-                continue;
-            const size_t k = fill.index(c, r);
-            if (fill.isFilled(k))
-                bySource[fill.source[k]].push_back({fill.height_m[k] - t, fill.sigma_m[k]});
-        }
+    multibin::filltest::forEachFilledCellWithTruth(fill, truthPath, [&](size_t k, double t) {
+        bySource[fill.source[k]].push_back({fill.height_m[k] - t, fill.sigma_m[k]});
+    });
     std::printf(
         "| filled by | - | cells | within 1 sigma [%%] | within 2 sigma [%%] | within 3 sigma [%%] "
         "| RMSE [mm] | mean sigma [mm] |\n|---|---|---|---|---|---|---|---|\n");

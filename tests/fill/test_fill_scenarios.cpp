@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <map>
 
+#include "FillTestData.h"
 #include "multibin/eval/Evaluation.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/io/EsriAsciiGrid.h"
@@ -45,26 +46,15 @@ std::map<multibin::HeightSource, Coverage> filledOnlyCoverage(const std::string&
     map.dem_update_map();
     const multibin::fill::FillResult& fill = map.lastFill();
 
-    multibin::Lattice lattice;
-    const auto truth = multibin::eval::groundTruthOnLattice(
-        multibin::EsriAsciiGrid::load(dir + "/rawlogs/" + scenario + "_gt.asc"),
-        fill.lattice.cellSize_m, lattice);
     std::map<multibin::HeightSource, Coverage> out;
-    for (int row = 0; row < lattice.ny(); row++)
-        for (int col = 0; col < lattice.nx(); col++) {
-            int c, r;
-            const float t = truth(row, col);
-            if (!std::isfinite(t) ||
-                !fill.lattice.cellOf(lattice.cellCenterX_m(col), lattice.cellCenterY_m(row), c, r))
-                continue;
-            const size_t k = fill.index(c, r);
-            if (!fill.isFilled(k)) continue;
+    multibin::filltest::forEachFilledCellWithTruth(
+        fill, dir + "/rawlogs/" + scenario + "_gt.asc", [&](size_t k, double t) {
             const bool inside = std::abs(fill.height_m[k] - t) <= 3 * fill.sigma_m[k];
             for (auto key : {fill.source[k], multibin::HeightSource::Unknown}) {
                 out[key].cells++;
                 out[key].within3Sigma += inside;
             }
-        }
+        });
     for (const auto& [src, cov] : out)
         std::printf("%s: source %d (0 = all filled): %zu cells, %.1f %% within 3 sigma\n",
                     scenario.c_str(), int(src), cov.cells, 100 * cov.share());

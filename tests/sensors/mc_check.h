@@ -12,6 +12,9 @@
 #include <random>
 #include <vector>
 
+#include "multibin/geometry/PosePropagation.h"
+#include "multibin/sensors/RayModel.h"
+
 namespace mc {
 
 /** A robot pose PDF with correlated 6x6 covariance (x y z yaw pitch roll). */
@@ -113,6 +116,32 @@ inline void expectConsistent(const std::vector<Eigen::Vector3d>& samples,
     EXPECT_GT(c.meanNees, c.neesLo) << "covariance too large";
     EXPECT_LT(c.meanNees, c.neesHi) << "covariance too small";
     EXPECT_NEAR(c.shareAbove, 0.01, c.shareTol) << "share of samples with NEES > 11.34";
+}
+
+/** Monte Carlo of a ray model (depth, lidar): 4000 draws of the point `p` (sensor frame) moved by
+ * `perturb(p, r, d, e1, e2, rng)` (the model's own noise: r = |p|, d = p / r, e1 and e2 across the
+ * ray) and of the robot pose, through the real transform of `sensor` on the robot; expected
+ * consistent with rayPointCovariance() + PosePropagator. */
+template <class Model, class Perturb>
+void expectRayModelConsistent(const Model& model, const mrpt::poses::CPose3D& sensor,
+                              const Eigen::Vector3d& p, unsigned seed, Perturb&& perturb) {
+    const auto pdf = robotPosePdf();
+    const double r = p.norm();
+    const Eigen::Vector3d d = p / r;
+    const Eigen::Vector3d e1 = d.cross(Eigen::Vector3d::UnitZ()).normalized(), e2 = d.cross(e1);
+    const multibin::PointWithCov pred =
+        multibin::PosePropagator(pdf, sensor)
+            .apply(multibin::PointWithCov{
+                p.cast<float>(), multibin::sensors::rayPointCovariance(p.cast<float>(), model)});
+    std::mt19937 rng(seed);
+    std::vector<Eigen::Vector3d> samples;
+    for (int k = 0; k < 4000; k++) {
+        const Eigen::Vector3d q = perturb(p, r, d, e1, e2, rng);
+        const auto m =
+            (samplePose(pdf, rng) + sensor).composePoint(mrpt::math::TPoint3D(q.x(), q.y(), q.z()));
+        samples.emplace_back(m.x, m.y, m.z);
+    }
+    expectConsistent(samples, pred.point_m.cast<double>(), pred.cov_m2.toMatrix());
 }
 
 }  // namespace mc

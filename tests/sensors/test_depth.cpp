@@ -59,26 +59,14 @@ TEST(DepthModel, MonteCarloCovarianceMatchesPropagation) {
     // Axial and lateral noise of the stated model, plus robot pose noise, through the real
     // transform; compared with the depth covariance + PosePropagator.
     DepthModelOptions o;
-    const mrpt::poses::CPose3D sensor(0.2, 0.0, 0.6, 0.1, 0.4, 0.0);
-    const auto pdf = mc::robotPosePdf();
-    const Eigen::Vector3d p(2.5, 0.4, -0.3);
-    const double r = p.norm();
-    const Eigen::Vector3d d = p / r;
-    const Eigen::Vector3d e1 = d.cross(Eigen::Vector3d::UnitZ()).normalized(), e2 = d.cross(e1);
-    const PointWithCov pred =
-        PosePropagator(pdf, sensor)
-            .apply(PointWithCov{p.cast<float>(), rayPointCovariance(p.cast<float>(), o)});
-    std::mt19937 rng(5);
     std::normal_distribution<double> n01;
-    std::vector<Eigen::Vector3d> samples;
-    for (int k = 0; k < 4000; k++) {
-        const Eigen::Vector3d q = p + o.axialSigma_m(r) * n01(rng) * d +
-                                  o.lateralSigma_rad * r * (n01(rng) * e1 + n01(rng) * e2);
-        const auto m = (mc::samplePose(pdf, rng) + sensor)
-                           .composePoint(mrpt::math::TPoint3D(q.x(), q.y(), q.z()));
-        samples.emplace_back(m.x, m.y, m.z);
-    }
-    mc::expectConsistent(samples, pred.point_m.cast<double>(), pred.cov_m2.toMatrix());
+    mc::expectRayModelConsistent(
+        o, mrpt::poses::CPose3D(0.2, 0.0, 0.6, 0.1, 0.4, 0.0), Eigen::Vector3d(2.5, 0.4, -0.3), 5,
+        [&](const Eigen::Vector3d& p, double r, const Eigen::Vector3d& d, const Eigen::Vector3d& e1,
+            const Eigen::Vector3d& e2, std::mt19937& rng) {
+            return Eigen::Vector3d(p + o.axialSigma_m(r) * n01(rng) * d +
+                                   o.lateralSigma_rad * r * (n01(rng) * e1 + n01(rng) * e2));
+        });
 }
 
 TEST(DepthModel, PointArraysOfDifferentSizesAreRefused) {

@@ -39,31 +39,20 @@ double acrossRay(const PointWithCov& p) {
  * uniformly random spot in the divergence footprint, and robot pose noise, through the real
  * transform; compared with rayPointCovariance() + PosePropagator. */
 void expectLidarModelConsistent(const LidarModelOptions& o, const Eigen::Vector3d& p) {
-    const mrpt::poses::CPose3D sensor(0.1, 0.0, 0.9, 0.05, 0.1, 0.0);
-    const auto pdf = mc::robotPosePdf();
-    const double r = p.norm();
-    const Eigen::Vector3d d = p / r;
-    const Eigen::Vector3d e1 = d.cross(Eigen::Vector3d::UnitZ()).normalized(), e2 = d.cross(e1);
-    const PointWithCov pred =
-        PosePropagator(pdf, sensor)
-            .apply(PointWithCov{p.cast<float>(), rayPointCovariance(p.cast<float>(), o)});
-    std::mt19937 rng(11);
     std::normal_distribution<double> n01;
     std::uniform_real_distribution<double> u01;
-    std::vector<Eigen::Vector3d> samples;
-    for (int k = 0; k < 4000; k++) {
-        // Spot uniform in a disc of angular radius delta / 2.
-        const double rho = 0.5 * o.beamDivergence_rad * std::sqrt(u01(rng));
-        const double phi = 2 * M_PI * u01(rng);
-        const double a1 = o.angularSigma_rad * n01(rng) + rho * std::cos(phi);
-        const double a2 = o.angularSigma_rad * n01(rng) + rho * std::sin(phi);
-        const Eigen::Vector3d dir = (d + a1 * e1 + a2 * e2).normalized();
-        const Eigen::Vector3d q = (r + o.rangeSigma(r) * n01(rng)) * dir;
-        const auto m = (mc::samplePose(pdf, rng) + sensor)
-                           .composePoint(mrpt::math::TPoint3D(q.x(), q.y(), q.z()));
-        samples.emplace_back(m.x, m.y, m.z);
-    }
-    mc::expectConsistent(samples, pred.point_m.cast<double>(), pred.cov_m2.toMatrix());
+    mc::expectRayModelConsistent(
+        o, mrpt::poses::CPose3D(0.1, 0.0, 0.9, 0.05, 0.1, 0.0), p, 11,
+        [&](const Eigen::Vector3d&, double r, const Eigen::Vector3d& d, const Eigen::Vector3d& e1,
+            const Eigen::Vector3d& e2, std::mt19937& rng) {
+            // Spot uniform in a disc of angular radius delta / 2.
+            const double rho = 0.5 * o.beamDivergence_rad * std::sqrt(u01(rng));
+            const double phi = 2 * M_PI * u01(rng);
+            const double a1 = o.angularSigma_rad * n01(rng) + rho * std::cos(phi);
+            const double a2 = o.angularSigma_rad * n01(rng) + rho * std::sin(phi);
+            const Eigen::Vector3d dir = (d + a1 * e1 + a2 * e2).normalized();
+            return Eigen::Vector3d((r + o.rangeSigma(r) * n01(rng)) * dir);
+        });
 }
 
 mrpt::obs::CObservationPointCloud cloudOf(const std::vector<Eigen::Vector3f>& pts,
