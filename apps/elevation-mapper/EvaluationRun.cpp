@@ -238,7 +238,9 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     const auto scores = multibin::eval::scoreMethods(m_truth, methods);
     std::vector<std::string> order;
     for (const auto& m : methods) order.push_back(m.name);
-    std::vector<multibin::eval::AreaScores> areas;
+    // Every method where MRPT's height grid has no value: what filling adds where MRPT has nothing.
+    std::vector<multibin::eval::AreaScores> areas{
+        multibin::eval::scoreGapsOf(heightGrid.name, m_truth, methods)};
     if (m_mrf)  // every method on the GMRF's crop only
         areas.push_back(
             multibin::eval::scoreArea("mrf_crop", m_truth, methods, m_lattice, m_mrfLattice));

@@ -191,6 +191,8 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
             if (!m.filledFrom.empty() && twin != byName.end()) {
                 const Mask filledOnly = !twin->second->height_m.isFinite();
                 s.within3SigmaFilledOnly = within3Sigma(&filledOnly, s.filledOnlyCells);
+                s.rmseFilledOnly_m =
+                    std::sqrt(meanSquaredError(m.height_m, truth_m, &filledOnly).mse_m2);
             }
         }
         s.insert_s = m.insert_s;
@@ -200,21 +202,38 @@ std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
     return scores;
 }
 
+namespace {
+using Mask = Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic>;
+AreaScores scoreCells(const std::string& name, const CellArray& truth_m,
+                      const std::vector<MethodEstimate>& methods, const Mask& cells) {
+    AreaScores a;
+    a.name = name;
+    for (const auto& m : methods) a.errors[m.name] = meanSquaredError(m.height_m, truth_m, &cells);
+    return a;
+}
+}  // namespace
+
 AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
                      const std::vector<MethodEstimate>& methods, const Lattice& lattice,
                      const Lattice& area) {
-    Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> mask(lattice.window.ny, lattice.window.nx);
+    Mask mask(lattice.window.ny, lattice.window.nx);
     for (int r = 0; r < lattice.window.ny; r++)
         for (int c = 0; c < lattice.window.nx; c++) {
             const int ix = lattice.window.ix0 + c, iy = lattice.window.iy0 + r;
             mask(r, c) = ix >= area.window.ix0 && ix < area.window.ix0 + area.window.nx &&
                          iy >= area.window.iy0 && iy < area.window.iy0 + area.window.ny;
         }
-    AreaScores a;
-    a.name = name;
+    AreaScores a = scoreCells(name, truth_m, methods, mask);
     a.area_m = area.area_m();
-    for (const auto& m : methods) a.errors[m.name] = meanSquaredError(m.height_m, truth_m, &mask);
     return a;
+}
+
+AreaScores scoreGapsOf(const std::string& gapsOf, const CellArray& truth_m,
+                       const std::vector<MethodEstimate>& methods) {
+    for (const auto& m : methods)
+        if (m.name == gapsOf)
+            return scoreCells(gapsOf + "_gaps", truth_m, methods, !m.height_m.isFinite());
+    throw std::invalid_argument("evaluation: no method '" + gapsOf + "' to score the gaps of");
 }
 
 std::string reportJson(const std::map<std::string, MethodScore>& scores,
@@ -237,6 +256,7 @@ std::string reportJson(const std::map<std::string, MethodScore>& scores,
                          {"valid_cells", s.validCells}};
         if (s.within3SigmaFilledOnly) {
             methods[name]["within_3sigma_filled_only"] = number(*s.within3SigmaFilledOnly);
+            methods[name]["rmse_filled_only_m"] = number(s.rmseFilledOnly_m.value_or(NAN));
             methods[name]["filled_only_cells"] = s.filledOnlyCells;
         }
     }
@@ -251,7 +271,8 @@ std::string reportJson(const std::map<std::string, MethodScore>& scores,
             rmse[name] = number(std::sqrt(it->second.mse_m2));
             cells[name] = it->second.cells;
         }
-        report[a.name] = {{"area_m", a.area_m}, {"rmse_m", rmse}, {"cells", cells}};
+        report[a.name] = {{"rmse_m", rmse}, {"cells", cells}};
+        if (!a.area_m.empty()) report[a.name]["area_m"] = a.area_m;
     }
     return report.dump(2) + "\n";
 }
@@ -276,8 +297,11 @@ std::string reportTable(const std::map<std::string, MethodScore>& scores,
         os << line;
     }
     for (const AreaScores& a : areas) {
-        std::snprintf(line, sizeof line, "RMSE [mm] over %s x [%.3f, %.3f] y [%.3f, %.3f] m:\n",
-                      a.name.c_str(), a.area_m[0], a.area_m[1], a.area_m[2], a.area_m[3]);
+        if (a.area_m.size() == 4)
+            std::snprintf(line, sizeof line, "RMSE [mm] over %s x [%.3f, %.3f] y [%.3f, %.3f] m:\n",
+                          a.name.c_str(), a.area_m[0], a.area_m[1], a.area_m[2], a.area_m[3]);
+        else
+            std::snprintf(line, sizeof line, "RMSE [mm] over %s:\n", a.name.c_str());
         os << line;
         for (const std::string& name : order) {
             const auto it = a.errors.find(name);

@@ -83,6 +83,7 @@ struct MethodScore {
      * and their count; set only for a method with filledFrom and a sigma. */
     std::optional<double> within3SigmaFilledOnly;
     size_t filledOnlyCells = 0;
+    std::optional<double> rmseFilledOnly_m;  //!< RMSE over the same filled-only cells [m]
     double insert_s = 0, fill_s = 0;
 };
 
@@ -91,21 +92,25 @@ struct MethodScore {
 std::map<std::string, MethodScore> scoreMethods(const CellArray& truth_m,
                                                 const std::vector<MethodEstimate>& methods);
 
-/** Errors of every method over a sub-area only (e.g. the crop MRPT's GMRF map is solved on). */
+/** Errors of every method over some cells only: a sub-area (the crop MRPT's GMRF map is solved
+ * on) or the cells another method leaves without a value (the gaps of MRPT's height grid). */
 struct AreaScores {
-    std::string name;            //!< what the area is, e.g. "mrf_crop"
-    std::vector<double> area_m;  //!< {xmin, xmax, ymin, ymax} [m]
+    std::string name;            //!< what the cells are, e.g. "mrf_crop"
+    std::vector<double> area_m;  //!< {xmin, xmax, ymin, ymax} [m] of a sub-area; empty otherwise
     std::map<std::string, SquaredError> errors;
 };
 /** Scores the methods over the cells of `area` (a sub-lattice of `lattice`). */
 AreaScores scoreArea(const std::string& name, const CellArray& truth_m,
                      const std::vector<MethodEstimate>& methods, const Lattice& lattice,
                      const Lattice& area);
+/** Scores the methods over the truth cells where the method `gapsOf` has no value. */
+AreaScores scoreGapsOf(const std::string& gapsOf, const CellArray& truth_m,
+                       const std::vector<MethodEstimate>& methods);
 
 /** report.json: {"methods": {name: {rmse_m, pi, pi_shared, coverage, within_3sigma, insert_s,
- * fill_s, valid_cells[, within_3sigma_filled_only, filled_only_cells]}}, "cell_size_m", "area_m":
- * [xmin, xmax, ymin, ymax]}; methods in `order`. Each sub-area adds {"<name>": {"area_m": [...],
- * "rmse_m": {method: x}, "cells": {method: n}}}.
+ * fill_s, valid_cells[, within_3sigma_filled_only, rmse_filled_only_m, filled_only_cells]}},
+ * "cell_size_m", "area_m": [xmin, xmax, ymin, ymax]}; methods in `order`. Each AreaScores adds
+ * {"<name>": {["area_m": [...], ]"rmse_m": {method: x}, "cells": {method: n}}}.
  */
 std::string reportJson(const std::map<std::string, MethodScore>& scores,
                        const std::vector<std::string>& order, const Lattice& lattice,
