@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iomanip>
 #include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -106,16 +107,16 @@ std::string meshPlyText(const EsriAsciiGrid& raster) {
 
     std::ostringstream out;
     out << "ply\nformat ascii 1.0\ncomment multibin elevation map, map frame [m]\n"
-        << "element vertex " << vertices << "\nproperty float x\nproperty float y\n"
+        << "element vertex " << vertices << "\nproperty double x\nproperty double y\n"
         << "property float z\nelement face " << faces.size()
         << "\nproperty list uchar int vertex_indices\nend_header\n";
-    out.precision(7);
+    // x, y in double with 12 digits: 10 um at UTM northings (a float would round to 0.5 m).
     for (int r = 0; r < rows; r++)
         for (int c = 0; c < cols; c++)
             if (vertexOf[size_t(r) * cols + c] >= 0)
-                out << raster.xllcenter_m + c * raster.cellsize_m << ' '
-                    << raster.yllcenter_m + r * raster.cellsize_m << ' ' << raster.heights_m(r, c)
-                    << '\n';
+                out << std::setprecision(12) << raster.xllcenter_m + c * raster.cellsize_m << ' '
+                    << raster.yllcenter_m + r * raster.cellsize_m << ' ' << std::setprecision(7)
+                    << raster.heights_m(r, c) << '\n';
     for (const auto& f : faces) out << "3 " << f[0] << ' ' << f[1] << ' ' << f[2] << '\n';
     return out.str();
 }

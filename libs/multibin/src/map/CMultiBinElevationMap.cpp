@@ -4,11 +4,14 @@
 #include <mrpt/rtti/CObject.h>
 #include "CMultiBinElevationMap_impl.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include "multibin/io/OptionKeys.h"
@@ -16,6 +19,7 @@
 
 using namespace mrpt::maps;
 using multibin::atLeast;
+using multibin::between;
 using multibin::finite;
 using multibin::OptionNames;
 using multibin::positive;
@@ -116,6 +120,10 @@ void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::st
 // Options
 // ---------------------------------------------------------------------------------------------
 namespace {
+/** Largest map origin [m]: beyond any projected coordinate system (UTM northings stay below 1e7
+ * m); a double still resolves 15 nm there. */
+constexpr double kMaxOrigin_m = 1e8;
+
 /** The creation keys of `o` (a TCreationOptions or a const one), in the order they are written,
  * for the options protocol (multibin/io/OptionKeys.h). */
 template <class Options, class Visit>
@@ -133,6 +141,9 @@ void visitCreationKeys(Options& o, Visit&& visit) {
     visit({"local_resolution_m", "local_resolution"}, o.local_resolution_m, positive("m"));
     visit("global_size_m", o.global_size_m, positive("m"));
     visit({"global_resolution_m", "global_resolution"}, o.global_resolution_m, positive("m"));
+    visit("origin_auto", o.origin_auto);
+    visit("origin_x_m", o.origin_x_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
+    visit("origin_y_m", o.origin_y_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
 }
 
 const OptionNames<mrpt::img::TColormap> kColormaps{
@@ -158,7 +169,29 @@ void visitInsertionKeys(Options& o, Visit&& visit) {
     visit("dem_return_filled", o.dem_return_filled);
     visit("relief_sigma", o.relief_sigma);
 }
+
+/** The origin the options fix before any data arrive: the explicit one, or originNear() of a
+ * single grid's extent centre; none when it waits for the first insertion. */
+std::optional<mrpt::math::TPoint2D> originBeforeData(
+    const CMultiBinElevationMap::TCreationOptions& c) {
+    if (!c.origin_auto) return mrpt::math::TPoint2D(c.origin_x_m, c.origin_y_m);
+    if (!c.dual_grid && c.max_x > c.min_x && c.max_y > c.min_y)
+        return c.originNear(0.5 * (c.min_x + c.max_x), 0.5 * (c.min_y + c.max_y));
+    return std::nullopt;
+}
 }  // namespace
+
+mrpt::math::TPoint2D CMultiBinElevationMap::TCreationOptions::originNear(double x_m,
+                                                                         double y_m) const {
+    const double cell_m = dual_grid ? global_resolution_m : resolution_m;
+    // Clamped to the origin's range: data beyond it are beyond any map (and stay finite here).
+    const auto snap = [&](double v) {
+        const double km =
+            std::clamp(std::round(v / 1000.0), -kMaxOrigin_m / 1000, kMaxOrigin_m / 1000);
+        return std::round(km * 1000.0 / cell_m) * cell_m;
+    };
+    return {snap(x_m), snap(y_m)};
+}
 
 void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
@@ -186,15 +219,23 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
     const auto bad = [&](const std::string& key, const std::string& what) {
         check.fail(key, what);
     };
-    for (const auto& [key, v] : {std::pair{"min_x_m", min_x},
-                                 {"max_x_m", max_x},
-                                 {"min_y_m", min_y},
-                                 {"max_y_m", max_y}}) {
-        // Cell indices are int: an extent far from the origin would overflow them.
-        if (std::abs(v / resolution_m) > kMaxCellIndex) {
+    const mrpt::math::TPoint2D origin = originBeforeData(*this).value_or(mrpt::math::TPoint2D());
+    for (const auto& [key, v, o] : {std::tuple{"min_x_m", min_x, origin.x},
+                                    {"max_x_m", max_x, origin.x},
+                                    {"min_y_m", min_y, origin.y},
+                                    {"max_y_m", max_y, origin.y}}) {
+        if (std::abs(v) > kMaxOrigin_m) {
             std::ostringstream os;
-            os << v << " m is cell index " << v / resolution_m << " at " << resolution_m
-               << " m cells, beyond the +-" << kMaxCellIndex << " the grid can index";
+            os << v << " m is beyond the +-" << kMaxOrigin_m << " m of map coordinates (cell index "
+               << v / resolution_m << " at " << resolution_m << " m cells)";
+            bad(key, os.str());
+        }
+        // Cell indices are int: an extent far from the map origin would overflow them.
+        if (std::abs((v - o) / resolution_m) > kMaxCellIndex) {
+            std::ostringstream os;
+            os << v << " m is cell index " << (v - o) / resolution_m << " from the map origin " << o
+               << " m at " << resolution_m << " m cells, beyond the +-" << kMaxCellIndex
+               << " the grid can index";
             bad(key, os.str());
         }
     }
@@ -342,13 +383,17 @@ void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation)
 void CMultiBinElevationMap::internal_clear() {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     const auto& c = creationOptions;
+    const std::optional<mrpt::math::TPoint2D> origin = originBeforeData(c);
+    m_impl->originFixed = origin.has_value();
+    m_impl->origin_m = origin ? Eigen::Vector2d(origin->x, origin->y) : Eigen::Vector2d(0, 0);
+    const Eigen::Vector2d& o = m_impl->origin_m;
     multibin::CellWindow w;
     const double res = c.resolution_m;
     if (c.max_x > c.min_x && c.max_y > c.min_y) {
-        w.ix0 = static_cast<int>(std::floor(c.min_x / res));
-        w.iy0 = static_cast<int>(std::floor(c.min_y / res));
-        w.nx = static_cast<int>(std::ceil(c.max_x / res)) - w.ix0;
-        w.ny = static_cast<int>(std::ceil(c.max_y / res)) - w.iy0;
+        w.ix0 = static_cast<int>(std::floor((c.min_x - o.x()) / res));
+        w.iy0 = static_cast<int>(std::floor((c.min_y - o.y()) / res));
+        w.nx = static_cast<int>(std::ceil((c.max_x - o.x()) / res)) - w.ix0;
+        w.ny = static_cast<int>(std::ceil((c.max_y - o.y()) / res)) - w.iy0;
     }
     if (c.dual_grid) {
         // Robot-centred windows, placed by recenter() at the first observation.
@@ -388,8 +433,9 @@ bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     multibin::CellSurface c;
-    if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,
-                             binUpdateParams(), insertionOptions.relief_sigma, c))
+    const Eigen::Vector2d& o = m_impl->origin_m;
+    if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m - o.x(),
+                             y_m - o.y(), binUpdateParams(), insertionOptions.relief_sigma, c))
         return false;
     height_m = c.height_m;
     sigma_m = std::sqrt(c.variance_m2);
@@ -412,16 +458,34 @@ std::string CMultiBinElevationMap::asString() const {
 }
 
 double CMultiBinElevationMap::getXMin() const {
-    return m_impl->grid.window().ix0 * m_impl->grid.cellSize_m();
+    return m_impl->origin_m.x() + m_impl->grid.window().ix0 * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getXMax() const {
-    return (m_impl->grid.window().ix0 + m_impl->grid.window().nx) * m_impl->grid.cellSize_m();
+    return m_impl->origin_m.x() +
+           (m_impl->grid.window().ix0 + m_impl->grid.window().nx) * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getYMin() const {
-    return m_impl->grid.window().iy0 * m_impl->grid.cellSize_m();
+    return m_impl->origin_m.y() + m_impl->grid.window().iy0 * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getYMax() const {
-    return (m_impl->grid.window().iy0 + m_impl->grid.window().ny) * m_impl->grid.cellSize_m();
+    return m_impl->origin_m.y() +
+           (m_impl->grid.window().iy0 + m_impl->grid.window().ny) * m_impl->grid.cellSize_m();
+}
+
+mrpt::math::TPoint2D CMultiBinElevationMap::mapOrigin() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    return {m_impl->origin_m.x(), m_impl->origin_m.y()};
+}
+
+mrpt::math::TPoint2D CMultiBinElevationMap::originFor(double x_m, double y_m) const {
+    if (m_impl->originFixed) return {m_impl->origin_m.x(), m_impl->origin_m.y()};
+    return creationOptions.originNear(x_m, y_m);
+}
+
+void CMultiBinElevationMap::fixOriginNear(double x_m, double y_m) {
+    const mrpt::math::TPoint2D o = originFor(x_m, y_m);
+    m_impl->origin_m = {o.x, o.y};
+    m_impl->originFixed = true;
 }
 
 float CMultiBinElevationMap::compute3DMatchingRatio(const mrpt::maps::CMetricMap*,
@@ -449,12 +513,14 @@ bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y
     creationOptions.validate();
     insertionOptions.validate();
     const double sigma = params.pt_z_std > 0 ? params.pt_z_std : insertionOptions.range_sigma_m;
+    if (std::isfinite(x) && std::isfinite(y)) fixOriginNear(x, y);
+    const double xr = x - m_impl->origin_m.x(), yr = y - m_impl->origin_m.y();
     multibin::PointsWithCov pts(1);
-    pts[0].point_m = Eigen::Vector3f(float(x), float(y), float(z));
+    pts[0].point_m = Eigen::Vector3f(float(xr), float(yr), float(z));
     // Horizontal position taken as exact to the cell; only the height variance matters here.
     const float tiny = static_cast<float>(1e-12);
     pts[0].cov_m2 = {tiny, 0, 0, tiny, 0, float(sigma * sigma)};
-    growToCover(pts, Eigen::Vector3d(x, y, z));
+    growToCover(pts, Eigen::Vector3d(xr, yr, z));
     return insertPoints(pts).accepted == 1;
 }
 

@@ -44,6 +44,11 @@ void CMultiBinElevationMap::recenter(double x_m, double y_m) {
                                     std::to_string(x_m) + ", " + std::to_string(y_m) +
                                     ") is not finite");
     if (!isDualGrid()) return;
+    fixOriginNear(x_m, y_m);
+    recenterRelative(x_m - m_impl->origin_m.x(), y_m - m_impl->origin_m.y());
+}
+
+void CMultiBinElevationMap::recenterRelative(double x_m, double y_m) {
     m_impl->fillStale = true;
     // Global first, so that local cells written back land inside it.
     for (multibin::BinGrid* g : {&m_impl->grid, &m_impl->local}) {

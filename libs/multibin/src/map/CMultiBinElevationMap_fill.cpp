@@ -17,11 +17,12 @@ void CMultiBinElevationMap::dem_update_map() {
     if (!m_impl->fillStale) return;
     const multibin::CellWindow w = m_impl->grid.window();
     multibin::fill::HeightRaster raster(multibin::Lattice{m_impl->grid.cellSize_m(), w});
+    const Eigen::Vector2d& o = m_impl->origin_m;  // getHeight() takes pose-frame coordinates
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             double h, s;
-            if (getHeight(m_impl->grid.cellCenter_m(w.ix0 + c),
-                          m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
+            if (getHeight(o.x() + m_impl->grid.cellCenter_m(w.ix0 + c),
+                          o.y() + m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
                 raster.setMeasured(c, r, float(h), float(s));
         }
     m_impl->fill = multibin::fill::fillGaps(raster, insertionOptions.fill);
@@ -36,7 +37,8 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (getHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
     if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
-    const int ix = m_impl->grid.cellIndex(x_m), iy = m_impl->grid.cellIndex(y_m);
+    const int ix = m_impl->grid.cellIndex(x_m - m_impl->origin_m.x()),
+              iy = m_impl->grid.cellIndex(y_m - m_impl->origin_m.y());
     if (!m_impl->fillWindow.contains(ix, iy)) return HeightSource::Unknown;
     const size_t k = m_impl->fill.index(ix - m_impl->fillWindow.ix0, iy - m_impl->fillWindow.iy0);
     if (!m_impl->fill.isFilled(k)) return HeightSource::Unknown;
@@ -54,8 +56,8 @@ bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (cx >= dem_get_size_x() || cy >= dem_get_size_y()) return false;
     const multibin::CellWindow& w = m_impl->grid.window();
-    return dem_get_z(m_impl->grid.cellCenter_m(w.ix0 + int(cx)),
-                     m_impl->grid.cellCenter_m(w.iy0 + int(cy)), z_out);
+    return dem_get_z(m_impl->origin_m.x() + m_impl->grid.cellCenter_m(w.ix0 + int(cx)),
+                     m_impl->origin_m.y() + m_impl->grid.cellCenter_m(w.iy0 + int(cy)), z_out);
 }
 
 bool CMultiBinElevationMap::dem_get_z(const double x, const double y, double& z_out) const {

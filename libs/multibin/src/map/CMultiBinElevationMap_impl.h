@@ -7,10 +7,10 @@
 
 #include <optional>
 
+#include "MapLock.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/geometry/Lattice.h"
 #include "multibin/map/BinGrid.h"
-#include "MapLock.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 namespace mrpt::maps {
@@ -18,6 +18,10 @@ namespace mrpt::maps {
 struct CMultiBinElevationMap::Impl {
     multibin::BinGrid grid;   //!< the single grid, or the global grid of the dual grid
     multibin::BinGrid local;  //!< dual grid only: the precise local grid
+    /** The map origin [m, pose frame]: cells and map-frame points are relative to it. Not yet
+     * fixed when automatic and nothing was inserted. */
+    Eigen::Vector2d origin_m{0, 0};
+    bool originFixed = false;
     multibin::InsertStats stats;
     multibin::VisibilityStats visibilityStats;
     size_t poseFallbacks = 0;

@@ -142,7 +142,7 @@ size_t CMultiBinElevationMap::insertSimpleMapWithPosePdfs(
 }
 
 bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs,
-                                              const mrpt::poses::CPose3DPDFGaussian& robotPose) {
+                                              const mrpt::poses::CPose3DPDFGaussian& posePdf) {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     if (!acceptsLabel(obs.sensorLabel)) {
@@ -150,9 +150,16 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
         return false;
     }
     for (int i = 0; i < 6; i++)
-        if (!std::isfinite(robotPose.mean[i]))
+        if (!std::isfinite(posePdf.mean[i]))
             throw std::invalid_argument("CMultiBinElevationMap: robot pose of observation '" +
                                         obs.sensorLabel + "' has a NaN or infinite component");
+    // From here on the pose is relative to the map origin (in double), so the single-precision
+    // geometry after it stays small at any georeferenced coordinate.
+    // An automatic origin is fixed once the observation is known good.
+    const mrpt::math::TPoint2D origin = originFor(posePdf.mean.x(), posePdf.mean.y());
+    mrpt::poses::CPose3DPDFGaussian robotPose = posePdf;
+    robotPose.mean.x(posePdf.mean.x() - origin.x);
+    robotPose.mean.y(posePdf.mean.y() - origin.y);
     obs.load();  // externally stored observations
 
     multibin::sensors::SensorPoints sensed;
@@ -160,6 +167,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
             obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
             insertionOptions.max_range_m, m_impl->sensorState, sensed))
         return false;  // not an observation this map models
+    fixOriginNear(posePdf.mean.x(), posePdf.mean.y());
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
     const double continuityBound_m = sensed.continuityBound_m;
@@ -172,7 +180,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
     if (isDualGrid()) {
-        recenter(robotPose.mean.x(), robotPose.mean.y());
+        recenterRelative(robotPose.mean.x(), robotPose.mean.y());
     } else if (growthNeeded(sensorPoints, propagator)) {
         // Growth is sized by all map-frame points: propagate them first (the rare case).
         PointsWithCov mapPoints;
@@ -249,6 +257,7 @@ multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
+    m_impl->originFixed = true;  // the points are relative to it
     return insertIntoGrid(
         isDualGrid() ? m_impl->local : m_impl->grid,
         [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {

@@ -88,6 +88,9 @@ void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double
 }
 /** What a serialized map holds, read completely (and checked) before the map is touched. */
 struct StoredMap {
+    /** Options text without the origin keys (written before the map had an origin): the grid's
+     * cells are relative to (0, 0). */
+    bool originAtZero = false;
     CMultiBinElevationMap::TCreationOptions creation;
     CMultiBinElevationMap::TInsertionOptions insertion;
     multibin::BinGrid grid, local;
@@ -105,6 +108,7 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
     if (textBytes > 0 && in.ReadBuffer(iniText.data(), textBytes) != textBytes)
         corrupt("options text cut short");
     mrpt::config::CConfigFileMemory ini(iniText);
+    m.originAtZero = !ini.keyExists(kCreationSection, "origin_auto");
     m.creation.loadFromConfigFile(ini, kCreationSection);
     m.insertion.loadFromConfigFile(ini, kInsertionSection);
     multibin::BinGrid &grid = m.grid, &local = m.local;
@@ -146,7 +150,14 @@ void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) cons
         auto body = mrpt::serialization::archiveFrom(mem);
         // Options travel as ini text: readable, and keys can be added without a new version.
         mrpt::config::CConfigFileMemory ini;
-        creationOptions.saveToConfigFile(ini, kCreationSection);
+        // A fixed origin travels as an explicit one: the stored cells are relative to it.
+        TCreationOptions creation = creationOptions;
+        if (m_impl->originFixed) {
+            creation.origin_auto = false;
+            creation.origin_x_m = m_impl->origin_m.x();
+            creation.origin_y_m = m_impl->origin_m.y();
+        }
+        creation.saveToConfigFile(ini, kCreationSection);
         insertionOptions.saveToConfigFile(ini, kInsertionSection);
         std::string iniText;
         ini.getContent(iniText);
@@ -168,6 +179,10 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
         creationOptions = m.creation;
         insertionOptions = m.insertion;
         internal_clear();
+        if (m.originAtZero) {
+            m_impl->origin_m = {0, 0};
+            m_impl->originFixed = true;
+        }
         m_impl->grid = std::move(m.grid);
         m_impl->local = std::move(m.local);
     };
@@ -212,13 +227,16 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
     const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::CellWindow& w = m_impl->grid.window();
     multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
+    const Eigen::Vector2d& o = m_impl->origin_m;  // the raster is in the pose frame
+    g.xllcenter_m += o.x();
+    g.yllcenter_m += o.y();
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             const int ix = w.ix0 + c, iy = w.iy0 + r;
             double h, s;
-            const HeightSource src =
-                getElevation(m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy), h, s,
-                             insertionOptions.dem_return_filled);
+            const HeightSource src = getElevation(o.x() + m_impl->grid.cellCenter_m(ix),
+                                                  o.y() + m_impl->grid.cellCenter_m(iy), h, s,
+                                                  insertionOptions.dem_return_filled);
             if (src == HeightSource::Unknown) continue;
             float& out = g.heights_m(r, c);
             switch (layer) {

@@ -76,7 +76,17 @@ const char* sceneColouringName(SceneColouring c) {
 
 void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring,
                       mrpt::opengl::CSetOfObjects& out) {
-    const EsriAsciiGrid whole = map.toRaster(Layer::Height);
+    // Built relative to the map origin and placed at it, so the view's floats stay small at
+    // georeferenced coordinates.
+    const mrpt::math::TPoint2D origin = map.mapOrigin();
+    EsriAsciiGrid whole = map.toRaster(Layer::Height);
+    whole.xllcenter_m -= origin.x;
+    whole.yllcenter_m -= origin.y;
+    auto placed = mrpt::opengl::CSetOfObjects::Create();
+    placed->setName("map origin");
+    placed->setLocation(origin.x, origin.y, 0);
+    const bool atZero = origin.x == 0 && origin.y == 0;
+    mrpt::opengl::CSetOfObjects& into = atZero ? out : *placed;
     const RasterBox box = knownBox(whole, 1);
     const EsriAsciiGrid heights = cropRaster(whole, box);
     const EsriAsciiGrid values = colouring == SceneColouring::Height
@@ -139,7 +149,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
                         heights.yMax_m());
     mesh->assignImageAndZ(texture, Z);
     mesh->setMask(mask);
-    out.insert(mesh);
+    into.insert(mesh);
 
     // Scale: a grid of nice spacing just under the lowest cell, its spacing written beside it.
     const double xSpan = heights.xMax_m() - heights.xllcenter_m,
@@ -152,13 +162,13 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
     auto grid = mrpt::opengl::CGridPlaneXY::Create(x0, x1, y0, y1, zLo - 0.01, step);
     grid->setName("grid");
     grid->setColor_u8(mrpt::img::TColor(90, 90, 90));
-    out.insert(grid);
+    into.insert(grid);
     char buf[96];
     std::snprintf(buf, sizeof buf, "grid: %g m", step);
     auto gridLabel = mrpt::opengl::CText::Create(buf);
     gridLabel->setLocation(x0, y0 - 0.5 * step, zLo);
     gridLabel->setColor_u8(mrpt::img::TColor(40, 40, 40));
-    out.insert(gridLabel);
+    into.insert(gridLabel);
 
     // Legend beside the map (+x side), centred on it in y.
     const double legendH = std::max(step, 0.4 * ySpan);
@@ -169,7 +179,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
             auto t = mrpt::opengl::CText::Create(k.name);
             t->setLocation(lx, y, zHi);
             t->setColor_u8(mrpt::img::TColor(k.rgb[0], k.rgb[1], k.rgb[2]));
-            out.insert(t);
+            into.insert(t);
             y -= 0.1 * legendH;
         }
     } else {
@@ -180,13 +190,14 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
                                                    format, float(0.035 * legendH));
         bar->setName("colour bar");
         bar->setLocation(lx, ly, zHi);
-        out.insert(bar);
+        into.insert(bar);
         std::snprintf(buf, sizeof buf, "%s%s", sceneColouringName(colouring), unit);
         auto title = mrpt::opengl::CText::Create(buf);
         title->setLocation(lx, ly - 0.1 * legendH, zHi);  // under the bar: its drawn height varies
         title->setColor_u8(mrpt::img::TColor(40, 40, 40));
-        out.insert(title);
+        into.insert(title);
     }
+    if (!atZero) out.insert(placed);
 }
 
 }  // namespace multibin

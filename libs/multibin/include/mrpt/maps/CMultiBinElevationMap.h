@@ -64,6 +64,11 @@ namespace mrpt::maps {
  * TCreationOptions::max_size_m per axis; points beyond are counted and dropped. With
  * `grow = false` the extent is fixed by min_x .. max_y.
  *
+ * Coordinates: every x, y the map takes or returns is in the frame of the robot poses, which may
+ * be georeferenced (UTM: |x|, |y| up to 1e7 m). Inside, the map keeps them relative to an origin
+ * held in double (mapOrigin(), TCreationOptions::origin_auto), so its single-precision geometry
+ * stays exact within 2 km of it (doc/frames.md).
+ *
  * In a CMultiMetricMap ini file:
  * \code
  * [map]
@@ -105,6 +110,17 @@ public:
         double local_resolution_m = 0.015;  //!< local cell size [m] (key `local_resolution`)
         double global_size_m = 10.0;        //!< side of the global grid [m] (key `global_size_m`)
         double global_resolution_m = 0.05;  //!< global cell size [m] (key `global_resolution`)
+
+        /** The map origin (keys `origin_auto`, `origin_x_m`, `origin_y_m`): the point of the pose
+         * frame, held in double, that cells, bins and the single-precision geometry are relative
+         * to (doc/frames.md). With origin_auto, originNear() of the extent's centre when an extent
+         * is given, else of the first pose (or point) inserted; otherwise (origin_x_m, origin_y_m)
+         * [m] as given. Every coordinate that enters or leaves the map is in the pose frame. */
+        bool origin_auto = true;
+        double origin_x_m = 0, origin_y_m = 0;
+        /** The automatic origin for data at (x, y) [m]: the nearest whole kilometre, rounded to
+         * whole cells of the (global) grid so the cells stay on multiples of the cell size. */
+        mrpt::math::TPoint2D originNear(double x_m, double y_m) const;
 
         void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                 const std::string& section) override;
@@ -191,9 +207,10 @@ public:
         const std::function<void(size_t, size_t)>& progress = {});
 
     /** Inserts points already in the map frame with their covariance (the shared insertion core,
-     * for sensors the map does not model): one update cycle. `continuityBound_m` is eq 14's
-     * Delta_zmax. With a sensor origin [m, map frame] the visibility constraint follows. The grid
-     * does not grow here (see insertObservation). */
+     * for sensors the map does not model): one update cycle. The points and the sensor origin are
+     * relative to mapOrigin() (single precision; the first call fixes an automatic origin where
+     * it is). `continuityBound_m` is eq 14's Delta_zmax. With a sensor origin the visibility
+     * constraint follows. The grid does not grow here (see insertObservation). */
     multibin::InsertStats insertPoints(
         const multibin::PointsWithCov& mapPoints,
         double continuityBound_m = std::numeric_limits<double>::infinity(),
@@ -219,6 +236,10 @@ public:
      * dual grid, where both grids know the place and agree within 3 sigma, their independent
      * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
+
+    /** The map origin [m] in the frame of the robot poses (TCreationOptions::origin_auto): fixed
+     * at construction, by the first insertion or by recenter(); (0, 0) until then. */
+    mrpt::math::TPoint2D mapOrigin() const;
 
     /** @name Dual grid @{ */
     bool isDualGrid() const { return creationOptions.dual_grid; }
@@ -327,6 +348,12 @@ private:
     /** One update cycle of `grid`: insertion core, then the visibility constraint. */
     multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid, const FuseIntoGrid& fuse,
                                          const std::optional<Eigen::Vector3d>& sensorOrigin_m);
+    /** recenter() on (x, y) relative to mapOrigin() [m]. */
+    void recenterRelative(double x_m, double y_m);
+    /** mapOrigin() if fixed, else the origin data at (x, y) [m, pose frame] would fix. */
+    mrpt::math::TPoint2D originFor(double x_m, double y_m) const;
+    /** Fixes an automatic map origin at originFor(x, y) if it is not fixed yet. */
+    void fixOriginNear(double x_m, double y_m);
     /** Fuses one local cell into the global grid (write-back of data the global grid lacks). */
     void writeBackLocalCell(int ix, int iy);
     multibin::BinGrid& gridFor(const mrpt::obs::CObservation& obs);
