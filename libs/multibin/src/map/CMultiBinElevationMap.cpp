@@ -240,6 +240,8 @@ void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     visibility.read(s);
     s.read("dem_return_filled", dem_return_filled);
     s.read("relief_sigma", relief_sigma);
+    s.readChoice<HeightQuery>("height_query", height_query,
+                              {{"plane", HeightQuery::Plane}, {"nearest", HeightQuery::Nearest}});
     fill.read(s);
     sensors.read(s);
     s.finish();
@@ -272,6 +274,8 @@ void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CC
     visibility.write(c, section);
     c.write(section, "dem_return_filled", dem_return_filled);
     c.write(section, "relief_sigma", relief_sigma);
+    c.write(section, "height_query",
+            std::string(height_query == HeightQuery::Plane ? "plane" : "nearest"));
     fill.write(c, section);
     sensors.write(c, section);
 }
@@ -436,6 +440,25 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
+    return insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane
+               ? heightAt(x_m, y_m, height_m, sigma_m)
+               : cellHeight(x_m, y_m, height_m, sigma_m);
+}
+
+bool CMultiBinElevationMap::heightAt(double x_m, double y_m, double& height_m,
+                                     double& sigma_m) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    multibin::CellSurface c;
+    if (!multibin::heightAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,
+                            binUpdateParams(), insertionOptions.relief_sigma, c))
+        return false;
+    height_m = c.height_m;
+    sigma_m = std::sqrt(c.variance_m2);
+    return true;
+}
+
+bool CMultiBinElevationMap::cellHeight(double x_m, double y_m, double& height_m,
+                                       double& sigma_m) const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     multibin::CellSurface c;
     if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m, y_m,

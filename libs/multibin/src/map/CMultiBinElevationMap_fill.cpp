@@ -20,8 +20,8 @@ void CMultiBinElevationMap::dem_update_map() {
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             double h, s;
-            if (getHeight(m_impl->grid.cellCenter_m(w.ix0 + c),
-                          m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
+            if (cellHeight(m_impl->grid.cellCenter_m(w.ix0 + c),
+                           m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
                 raster.setMeasured(c, r, float(h), float(s));
         }
     m_impl->fill = multibin::fill::fillGaps(raster, insertionOptions.fill);
@@ -35,7 +35,22 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         bool includeFilled) const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (getHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
-    if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
+    return includeFilled ? filledElevation(x_m, y_m, height_m, sigma_m) : HeightSource::Unknown;
+}
+
+CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double x_m, double y_m,
+                                                                         double& height_m,
+                                                                         double& sigma_m,
+                                                                         bool includeFilled) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    if (cellHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
+    return includeFilled ? filledElevation(x_m, y_m, height_m, sigma_m) : HeightSource::Unknown;
+}
+
+CMultiBinElevationMap::HeightSource CMultiBinElevationMap::filledElevation(double x_m, double y_m,
+                                                                           double& height_m,
+                                                                           double& sigma_m) const {
+    if (m_impl->fill.source.empty()) return HeightSource::Unknown;
     const int ix = m_impl->grid.cellIndex(x_m), iy = m_impl->grid.cellIndex(y_m);
     if (!m_impl->fillWindow.contains(ix, iy)) return HeightSource::Unknown;
     const size_t k = m_impl->fill.index(ix - m_impl->fillWindow.ix0, iy - m_impl->fillWindow.iy0);

@@ -217,8 +217,8 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
             const int ix = w.ix0 + c, iy = w.iy0 + r;
             double h, s;
             const HeightSource src =
-                getElevation(m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy), h, s,
-                             insertionOptions.dem_return_filled);
+                cellElevation(m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy), h, s,
+                              insertionOptions.dem_return_filled);
             if (src == HeightSource::Unknown) continue;
             float& out = g.heights_m(r, c);
             switch (layer) {

@@ -138,7 +138,8 @@ private:
     /** Gates 13 and bin range passed: eq 14 and the per-point Kalman update (eq 15). */
     bool fuseMeasurement(size_t slot, int ix, int iy, int16_t n, double height_m,
                          double variance_m2, const BinUpdateParams& params,
-                         double continuityBound_m, InsertStats& stats);
+                         double continuityBound_m, InsertStats& stats,
+                         const PointWithCov* point);  //!< its place feeds the plane moments
 
     VisibilityIndex m_index;
 };
