@@ -91,8 +91,9 @@ bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height
     }
     addMeasurement(bin, height_m, variance_m2, params);
     if (point)  // a height without a place (insertHeight) says nothing of the slope
-        addPlanePoint(bin.plane, point->point_m.x() - cellCenter_m(ix),
-                      point->point_m.y() - cellCenter_m(iy), height_m, 1.0 / variance_m2);
+        addPlanePoint(bin.plane, float(point->point_m.x() - cellCenter_m(ix)),
+                      float(point->point_m.y() - cellCenter_m(iy)), float(height_m),
+                      float(1.0 / variance_m2));
     stats.accepted++;
     m_index.noteUpdate(s, ix, iy, height_m, 1);
     return true;
@@ -169,6 +170,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
         int ix = 0, iy = 0;
         uint32_t points = 0;
         HeightInformation sum;
+        PlaneMoments* plane = nullptr;    // the bin's: no bin is added while a run is open
+        double cellX_m = 0, cellY_m = 0;  // the cell's centre [m]
         double maxHeight_m = 0;
         bool frozen = false;  // the bin has zero variance: its height cannot move
     } run;
@@ -243,14 +246,17 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
                 run.iy = cb.iy[i];
                 run.points = 0;
                 run.maxHeight_m = h;
-                const Bin& bin = BinStore::bin(run.bin);
+                Bin& bin = BinStore::bin(run.bin);
+                run.plane = &bin.plane;
+                run.cellX_m = cellCenter_m(run.ix);
+                run.cellY_m = cellCenter_m(run.iy);
                 run.frozen = bin.pointCount > 0 && !(bin.variance_m2 > 0);
                 run.sum = HeightInformation{};
                 if (bin.pointCount > 0 && !run.frozen) run.sum.add(bin.height_m, bin.variance_m2);
             }
             run.sum.add(h, var);
-            addPlanePoint(BinStore::bin(run.bin).plane, pts[i].point_m.x() - cellCenter_m(run.ix),
-                          pts[i].point_m.y() - cellCenter_m(run.iy), h, 1.0 / var);
+            addPlanePoint(*run.plane, float(pts[i].point_m.x() - run.cellX_m),
+                          float(pts[i].point_m.y() - run.cellY_m), float(h), float(1.0 / var));
             run.maxHeight_m = std::max(run.maxHeight_m, h);
             run.points++;
             stats.accepted++;

@@ -61,20 +61,22 @@ inline void addMeasurement(BinEstimate& bin, double height_m, double variance_m2
 
 /** Adds a point at (dx_m, dy_m) from its cell's centre, height z_m, weight w = 1/var_z to the
  * bin's plane moments: the centred update of a weighted mean and co-moments (West 1979). */
-inline void addPlanePoint(PlaneMoments& m, double dx_m, double dy_m, double z_m, double w) {
-    const double W = double(m.weight) + w;
-    const double f = w / W, k = w - w * f;  // k = w W_old / W
-    const double ex = dx_m - m.mx_m, ey = dy_m - m.my_m, ez = z_m - m.mz_m;
-    m.weight = static_cast<float>(W);
-    m.mx_m = static_cast<float>(m.mx_m + f * ex);
-    m.my_m = static_cast<float>(m.my_m + f * ey);
-    m.mz_m = static_cast<float>(m.mz_m + f * ez);
-    m.sxx = static_cast<float>(m.sxx + k * ex * ex);
-    m.sxy = static_cast<float>(m.sxy + k * ex * ey);
-    m.syy = static_cast<float>(m.syy + k * ey * ey);
-    m.sxz = static_cast<float>(m.sxz + k * ex * ez);
-    m.syz = static_cast<float>(m.syz + k * ey * ez);
-    m.szz = static_cast<float>(m.szz + k * ez * ez);
+inline void addPlanePoint(PlaneMoments& m, float dx_m, float dy_m, float z_m, float w) {
+    // In float: the offsets are at most a cell and the height's deviations from the bin's mean
+    // at most a bin, far inside float's 7 digits; the stored moments are floats anyway.
+    const float W = m.weight + w;
+    const float f = w / W, k = w - w * f;  // k = w W_old / W
+    const float ex = dx_m - m.mx_m, ey = dy_m - m.my_m, ez = z_m - m.mz_m;
+    m.weight = W;
+    m.mx_m += f * ex;
+    m.my_m += f * ey;
+    m.mz_m += f * ez;
+    m.sxx += k * ex * ex;
+    m.sxy += k * ex * ey;
+    m.syy += k * ey * ey;
+    m.sxz += k * ex * ez;
+    m.syz += k * ey * ez;
+    m.szz += k * ez * ez;
 }
 
 /** Merges the moments `o` (their x, y shifted by (dx_m, dy_m), e.g. a neighbouring cell's
