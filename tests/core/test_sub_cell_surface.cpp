@@ -2,6 +2,8 @@
  * height per cell, honest sigma, never across a step (doc/sub-cell-surface.md). */
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/math/TLine3D.h>
+#include <mrpt/math/TObject3D.h>
 
 #include <cmath>
 #include <random>
@@ -114,20 +116,35 @@ TEST(SubCellSurface, NearestKeepsTheCellValue) {
     map.insertPoints(samplePoints(10, 5, terrain));
     using Q = CMultiBinElevationMap::TInsertionOptions::HeightQuery;
     for (const double x : {0.101, 0.2345, 0.4567}) {
-        double hg, sg, hc, sc, ha, sa, z;
-        map.insertionOptions.height_query = Q::Nearest;
-        ASSERT_TRUE(map.getHeight(x, 0.3, hg, sg));
-        ASSERT_TRUE(map.cellHeight(x, 0.3, hc, sc));
-        EXPECT_EQ(hg, hc);
-        EXPECT_EQ(sg, sc);
-        ASSERT_TRUE(map.dem_get_z(x, 0.3, z));
-        EXPECT_EQ(z, hc);
-        map.insertionOptions.height_query = Q::Plane;
-        ASSERT_TRUE(map.getHeight(x, 0.3, hg, sg));
-        ASSERT_TRUE(map.heightAt(x, 0.3, ha, sa));
-        EXPECT_EQ(hg, ha);
-        EXPECT_EQ(sg, sa);
-        ASSERT_TRUE(map.dem_get_z(x, 0.3, z));
-        EXPECT_EQ(z, ha);
+        for (const Q mode : {Q::Nearest, Q::Plane}) {
+            map.insertionOptions.height_query = mode;
+            double hg, sg, hWant, sWant, z;
+            ASSERT_TRUE(map.getHeight(x, 0.3, hg, sg));
+            ASSERT_TRUE(mode == Q::Nearest ? map.cellHeight(x, 0.3, hWant, sWant)
+                                           : map.heightAt(x, 0.3, hWant, sWant));
+            EXPECT_EQ(hg, hWant);
+            EXPECT_EQ(sg, sWant);
+            ASSERT_TRUE(map.dem_get_z(x, 0.3, z));
+            EXPECT_EQ(z, hWant);
+        }
     }
+}
+
+TEST(SubCellSurface, IntersectLine3DMeetsTheSubCellSurface) {
+    // MRPT's intersectLine3D samples dem_get_z along the ray: a vertical ray at a cell's edge on
+    // a slope meets the plane there, not the cell's value.
+    CMultiBinElevationMap map = fixedMap();
+    map.insertPoints(samplePoints(30, 6, [](double x, double) { return x; }));
+    const double x = 0.3195, y = 0.305;
+    double h, s, hCell, sCell;
+    ASSERT_TRUE(map.heightAt(x, y, h, s));
+    ASSERT_TRUE(map.cellHeight(x, y, hCell, sCell));
+    ASSERT_GT(std::abs(h - hCell), 0.006) << "the test needs the two answers apart";
+    mrpt::math::TObject3D hit;
+    ASSERT_TRUE(map.intersectLine3D(
+        mrpt::math::TLine3D(mrpt::math::TPoint3D(x, y, 1.0), mrpt::math::TPoint3D(x, y, 0.0)),
+        hit));
+    mrpt::math::TPoint3D p;
+    ASSERT_TRUE(hit.getPoint(p));
+    EXPECT_NEAR(p.z, h, 1e-6);
 }

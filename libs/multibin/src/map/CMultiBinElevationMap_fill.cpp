@@ -34,8 +34,8 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
     const multibin::MapLock::Shared lock(m_impl->lock);
-    if (getHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
-    return includeFilled ? filledElevation(x_m, y_m, height_m, sigma_m) : HeightSource::Unknown;
+    const bool measured = getHeight(x_m, y_m, height_m, sigma_m);
+    return measuredOrFilled(measured, includeFilled, x_m, y_m, height_m, sigma_m);
 }
 
 CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double x_m, double y_m,
@@ -43,14 +43,17 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double 
                                                                          double& sigma_m,
                                                                          bool includeFilled) const {
     const multibin::MapLock::Shared lock(m_impl->lock);
-    if (cellHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
-    return includeFilled ? filledElevation(x_m, y_m, height_m, sigma_m) : HeightSource::Unknown;
+    const bool measured = cellHeight(x_m, y_m, height_m, sigma_m);
+    return measuredOrFilled(measured, includeFilled, x_m, y_m, height_m, sigma_m);
 }
 
-CMultiBinElevationMap::HeightSource CMultiBinElevationMap::filledElevation(double x_m, double y_m,
-                                                                           double& height_m,
-                                                                           double& sigma_m) const {
-    if (m_impl->fill.source.empty()) return HeightSource::Unknown;
+CMultiBinElevationMap::HeightSource CMultiBinElevationMap::measuredOrFilled(bool measured,
+                                                                            bool includeFilled,
+                                                                            double x_m, double y_m,
+                                                                            double& height_m,
+                                                                            double& sigma_m) const {
+    if (measured) return HeightSource::Measured;
+    if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
     const int ix = m_impl->grid.cellIndex(x_m), iy = m_impl->grid.cellIndex(y_m);
     if (!m_impl->fillWindow.contains(ix, iy)) return HeightSource::Unknown;
     const size_t k = m_impl->fill.index(ix - m_impl->fillWindow.ix0, iy - m_impl->fillWindow.iy0);

@@ -327,8 +327,10 @@ private:
     bool internal_canComputeObservationLikelihood(
         const mrpt::obs::CObservation& obs) const override;
 
-    /** The last gap filling's height where it filled the cell of (x, y) (caller holds the lock). */
-    HeightSource filledElevation(double x_m, double y_m, double& height_m, double& sigma_m) const;
+    /** Measured if `measured`; else, with includeFilled, the last gap filling's height where it
+     * filled the cell of (x, y) (the caller holds the lock). */
+    HeightSource measuredOrFilled(bool measured, bool includeFilled, double x_m, double y_m,
+                                  double& height_m, double& sigma_m) const;
     /** Observation -> sensor-frame points -> map frame -> grid. */
     bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);
