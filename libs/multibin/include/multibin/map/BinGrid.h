@@ -22,7 +22,7 @@ class PosePropagator;
  * BinUpdate.h) and the visibility index kept in step with both (VisibilityIndex: update cycles,
  * block height bounds), as OctoMap's OccupancyOcTreeBase adds its update rule to the storage of
  * OcTreeBaseImpl. Memory: 12 B per cell of the window (4 B store, 8 B index), 12 B per block of
- * 256 cells and 24 B per bin. */
+ * 256 cells and 64 B per bin (Bin.h). */
 class BinGrid : private BinStore {
 public:
     using BinStore::BinId;
