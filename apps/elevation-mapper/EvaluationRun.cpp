@@ -175,11 +175,13 @@ MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBin
     m.name = name;
     m.height_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
     m.sigma_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
+    // The cells' values, as the rasters give them: the table scores one height per cell against
+    // the truth raster on the same lattice (the sub-cell surface: doc/sub-cell-surface.md).
     for (int r = 0; r < m_lattice.window.ny; r++)
         for (int c = 0; c < m_lattice.window.nx; c++) {
             double h, s;
-            if (map.getElevation(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), h, s,
-                                 filled) != CMultiBinElevationMap::HeightSource::Unknown) {
+            if (map.cellElevation(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), h, s,
+                                  filled) != CMultiBinElevationMap::HeightSource::Unknown) {
                 m.height_m(r, c) = float(h);
                 m.sigma_m(r, c) = float(s);
             }

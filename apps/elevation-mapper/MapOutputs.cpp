@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #include "MapOutputs.h"
 
+#include <cmath>
+
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CSetOfObjects.h>
@@ -192,6 +194,49 @@ void MapLayers::saveAsc(const OutputFolder& folder) const {
                              grids[i]->save(path);
                              return true;
                          });
+}
+
+SupersampledLayers SupersampledLayers::of(const CMultiBinElevationMap& map, const MapLayers& layers,
+                                          double cell_m) {
+    SupersampledLayers out;
+    const multibin::EsriAsciiGrid& box = layers.height;
+    // The same area as the map-resolution rasters: their cells' outer edges.
+    const double x0 = box.xllcenter_m - 0.5 * box.cellsize_m;
+    const double y0 = box.yllcenter_m - 0.5 * box.cellsize_m;
+    const int cols = int(std::ceil(box.cols() * box.cellsize_m / cell_m - 1e-9));
+    const int rows = int(std::ceil(box.rows() * box.cellsize_m / cell_m - 1e-9));
+    if (double(cols) * double(rows) > 1e8)
+        throw std::invalid_argument("--export-resolution " + std::to_string(cell_m) +
+                                    " m: " + std::to_string(cols) + " x " + std::to_string(rows) +
+                                    " samples, over 1e8");
+    for (multibin::EsriAsciiGrid* g : {&out.height, &out.sigma}) {
+        g->heights_m.setConstant(rows, cols, NAN);
+        g->xllcenter_m = x0 + 0.5 * cell_m;
+        g->yllcenter_m = y0 + 0.5 * cell_m;
+        g->cellsize_m = cell_m;
+    }
+    const bool filled = map.insertionOptions.dem_return_filled;
+    for (int r = 0; r < rows; r++)
+        for (int c = 0; c < cols; c++) {
+            const double x = out.height.xllcenter_m + c * cell_m;
+            const double y = out.height.yllcenter_m + r * cell_m;
+            double h, s;
+            if (map.heightAt(x, y, h, s) || map.cellElevation(x, y, h, s, filled) !=
+                                                CMultiBinElevationMap::HeightSource::Unknown) {
+                out.height.heights_m(r, c) = float(h);
+                out.sigma.heights_m(r, c) = float(s);
+            }
+        }
+    return out;
+}
+
+void SupersampledLayers::saveAsc(const OutputFolder& folder) const {
+    const multibin::EsriAsciiGrid* grids[] = {&height, &sigma};
+    for (int i = 0; i < 2; i++)
+        folder.writeWith(kFiles[i], [&](const std::string& path) {
+            grids[i]->save(path);
+            return true;
+        });
 }
 
 std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const MapLayers& layers,

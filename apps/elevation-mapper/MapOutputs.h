@@ -68,6 +68,18 @@ struct MapLayers {
     void saveAsc(const OutputFolder& folder) const;
 };
 
+/** The sub-cell surface (heightAt) sampled every `cell_m` over the box of `layers` (--export-
+ * resolution): elevation_{height,sigma}_supersampled.asc. Where a cell has no measurement the
+ * sample takes the cell's filled value (as the rasters at the map's resolution). */
+struct SupersampledLayers {
+    multibin::EsriAsciiGrid height, sigma;
+    static constexpr const char* kFiles[2] = {"elevation_height_supersampled.asc",
+                                              "elevation_sigma_supersampled.asc"};
+    static SupersampledLayers of(const mrpt::maps::CMultiBinElevationMap& map,
+                                 const MapLayers& layers, double cell_m);
+    void saveAsc(const OutputFolder& folder) const;
+};
+
 /** Writes the selected outputs of `map` (filled already) into the folder, with a progress bar on
  * a terminal. Returns the names of the files written. */
 std::vector<std::string> writeMapOutputs(const mrpt::maps::CMultiBinElevationMap& map,

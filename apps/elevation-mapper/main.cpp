@@ -46,7 +46,7 @@ namespace {
 struct Arguments {
     std::string config, section = "MappingApplication", rawlog, simplemap,
                         out = "elevation-mapper-out", groundTruth, profile, evalArea,
-                        outputs = OutputSelection::kDefault, sceneColour;
+                        outputs = OutputSelection::kDefault, sceneColour, exportResolution;
     bool withMrf = false, plots = true;
     bool usedDefaults = false;
 };
@@ -73,6 +73,8 @@ void printUsage() {
            "  --out DIR            output folder, created if needed (default: "
         << d.out
         << ")\n"
+           "  --export-resolution M  also write elevation_{height,sigma}_supersampled.asc:\n"
+           "                       the sub-cell surface (heightAt) every M metres, rasters' area\n"
            "  --outputs LIST       comma-separated, or 'all' (default: "
         << d.outputs << ")\n"
         << OutputSelection::help()
@@ -114,6 +116,7 @@ Arguments parseArguments(int argc, char** argv) {
         {"--rawlog", &a.rawlog},      {"--simplemap", &a.simplemap},      {"--out", &a.out},
         {"--outputs", &a.outputs},    {"--ground-truth", &a.groundTruth}, {"--profile", &a.profile},
         {"--eval-area", &a.evalArea}, {"--scene-colour", &a.sceneColour}};
+    flags["--export-resolution"] = &a.exportResolution;
     for (int i = 1; i < argc; i++) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
@@ -209,6 +212,11 @@ const std::vector<std::string> kEvaluationFiles{"report.json", "profile.csv",   
 
 int run(const Arguments& args) {
     OutputSelection selection = OutputSelection::parse(args.outputs);
+    double exportCell_m = 0;  // --export-resolution: 0 = none
+    if (!args.exportResolution.empty() &&
+        (!multibin::parseFiniteNumber(args.exportResolution, exportCell_m) || !(exportCell_m > 0)))
+        throw std::invalid_argument("--export-resolution: '" + args.exportResolution +
+                                    "' is not a positive cell size [m]");
     const std::string inputName =
         args.rawlog.empty() ? "simplemap '" + args.simplemap + "'" : "rawlog '" + args.rawlog + "'";
     // Checked before the (long) mapping: no planned output may be one of the inputs.
@@ -217,6 +225,8 @@ int run(const Arguments& args) {
                                          {"--simplemap", args.simplemap},
                                          {"--ground-truth", args.groundTruth}});
     for (const std::string& name : selection.fileNames()) folder.checkNotAnInput(name);
+    if (exportCell_m > 0)
+        for (const char* name : SupersampledLayers::kFiles) folder.checkNotAnInput(name);
     if (!args.groundTruth.empty())
         for (const std::string& name : kEvaluationFiles) folder.checkNotAnInput(name);
 
@@ -310,7 +320,16 @@ int run(const Arguments& args) {
     if (evaluation) table = evaluation->finish(folder, insert_s, fill_s);
     MapLayers layers;
     ProgressBar::runWithProgress("layers", [&] { layers = MapLayers::of(*elevation); });
-    const std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
+    std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
+    if (exportCell_m > 0) {
+        SupersampledLayers fine;
+        ProgressBar::runWithProgress("supersampled", [&] {
+            fine = SupersampledLayers::of(*elevation, layers, exportCell_m);
+        });
+        fine.saveAsc(folder);
+        written.insert(written.end(), std::begin(SupersampledLayers::kFiles),
+                       std::end(SupersampledLayers::kFiles));
+    }
 
     const auto& fs_ = elevation->lastFill().stats;
     std::cout << elevation->asString() << "\n"

@@ -88,9 +88,9 @@ TEST(ElevationMapperCli, HelpListsEveryOptionWithItsDefault) {
     const fs::path d = scratchDir("help");
     const RunResult r = runMapper(d, "--help");
     ASSERT_EQ(r.exitCode, 0) << r.err;
-    for (const char* flag :
-         {"--config", "--section", "-s,", "--rawlog", "--simplemap", "--out", "--outputs",
-          "--ground-truth", "--with-mrf", "--profile", "--eval-area", "--no-plots", "--help"})
+    for (const char* flag : {"--config", "--section", "-s,", "--rawlog", "--simplemap", "--out",
+                             "--outputs", "--ground-truth", "--with-mrf", "--profile",
+                             "--eval-area", "--no-plots", "--help", "--export-resolution"})
         EXPECT_NE(r.out.find(flag), std::string::npos) << flag << " missing from --help";
     for (const char* def : {"default: MappingApplication", "default: elevation-mapper-out",
                             "default: map,tif,scene,png"})
@@ -227,6 +227,46 @@ TEST(ElevationMapperOutputs, OutputsChoosesWhatIsWritten) {
     double h = 0, s = 0;
     EXPECT_TRUE(map.getHeight(1.05, 0.05, h, s));
     EXPECT_NEAR(h, -0.3, 0.01);
+}
+
+// --export-resolution samples the sub-cell surface over the rasters' area, finer than the map;
+// a cell size that is not a positive number is an error naming the flag.
+TEST(ElevationMapperOutputs, ExportResolutionSamplesTheSubCellSurface) {
+    const fs::path d = scratchDir("supersampled");
+    writePatchRawlog(d / "patch.rawlog");
+    writeIni(d / "maps.ini");
+    const std::string common =
+        "--config " + (d / "maps.ini").string() + " --rawlog " + (d / "patch.rawlog").string();
+    const RunResult r = runMapper(
+        d, common + " --outputs asc --export-resolution 0.005 --out " + (d / "o").string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const auto coarse = multibin::EsriAsciiGrid::load((d / "o" / "elevation_height.asc").string());
+    const auto fine =
+        multibin::EsriAsciiGrid::load((d / "o" / "elevation_height_supersampled.asc").string());
+    const auto sigma =
+        multibin::EsriAsciiGrid::load((d / "o" / "elevation_sigma_supersampled.asc").string());
+    EXPECT_DOUBLE_EQ(fine.cellsize_m, 0.005);
+    EXPECT_NEAR(fine.xllcenter_m - 0.0025, coarse.xllcenter_m - 0.5 * coarse.cellsize_m, 1e-9);
+    EXPECT_NEAR(fine.yllcenter_m - 0.0025, coarse.yllcenter_m - 0.5 * coarse.cellsize_m, 1e-9);
+    EXPECT_NEAR(fine.cols() * 0.005, coarse.cols() * coarse.cellsize_m, 0.005);
+    EXPECT_EQ(sigma.cols(), fine.cols());
+    // The patch is flat at -0.3 m: every sample the coarse raster knows is known, and flat.
+    size_t known = 0;
+    for (int r = 0; r < fine.rows(); r++)
+        for (int c = 0; c < fine.cols(); c++) {
+            const double x = fine.xllcenter_m + c * 0.005, y = fine.yllcenter_m + r * 0.005;
+            const int cc = int(std::floor((x - coarse.xllcenter_m) / coarse.cellsize_m + 0.5));
+            const int rr = int(std::floor((y - coarse.yllcenter_m) / coarse.cellsize_m + 0.5));
+            if (!std::isfinite(coarse.heights_m(rr, cc))) continue;
+            ASSERT_TRUE(std::isfinite(fine.heights_m(r, c))) << x << ", " << y;
+            EXPECT_NEAR(fine.heights_m(r, c), -0.3, 0.01) << x << ", " << y;
+            known++;
+        }
+    EXPECT_GT(known, 16u);
+    const RunResult bad =
+        runMapper(d, common + " --export-resolution 0 --out " + (d / "bad").string());
+    EXPECT_EQ(bad.exitCode, 1);
+    EXPECT_NE(bad.err.find("--export-resolution"), std::string::npos) << bad.err;
 }
 
 // An input at the path of an output is an error naming both, before anything is written, and the

@@ -110,7 +110,7 @@ TEST(DualGrid, RoutesBySensorAndFusesWithoutCountingTwice) {
     EXPECT_FALSE(map.localGrid().empty());
     EXPECT_TRUE(map.grid().empty());
     double h, sLocal;
-    ASSERT_TRUE(map.getHeight(0.5123, 0.3071, h, sLocal));
+    ASSERT_TRUE(map.cellHeight(0.5123, 0.3071, h, sLocal));
     EXPECT_NEAR(sLocal, 0.01 / 2, 1e-4);  // 4 independent points
 
     // Scroll the spot out of the local grid (written back to the global grid) and back in.
@@ -118,10 +118,10 @@ TEST(DualGrid, RoutesBySensorAndFusesWithoutCountingTwice) {
     EXPECT_FALSE(map.grid().empty());
 
     double hBack, sBack;
-    ASSERT_TRUE(map.getHeight(0.5123, 0.3071, hBack, sBack));
+    ASSERT_TRUE(map.cellHeight(0.5123, 0.3071, hBack, sBack));
     EXPECT_NEAR(sBack, sLocal, 1e-6);
     map.recenter(0.0, 0.0);
-    ASSERT_TRUE(map.getHeight(0.5123, 0.3071, hBack, sBack));
+    ASSERT_TRUE(map.cellHeight(0.5123, 0.3071, hBack, sBack));
     EXPECT_NEAR(hBack, h, 1e-6);
     EXPECT_NEAR(sBack, sLocal, 1e-6) << "a re-entering local cell must not count its data twice";
 
@@ -131,7 +131,7 @@ TEST(DualGrid, RoutesBySensorAndFusesWithoutCountingTwice) {
     stereo->sensorPose = mrpt::poses::CPose3D(0.5123, 0.3071, 1.0, 0, 0, 0);
     ASSERT_TRUE(map.insertObservation(*stereo, exactPose(0, 0)));
     double sFused;
-    ASSERT_TRUE(map.getHeight(0.5123, 0.3071, h, sFused));
+    ASSERT_TRUE(map.cellHeight(0.5123, 0.3071, h, sFused));
     EXPECT_LE(sFused, sLocal);
     EXPECT_NEAR(sFused, 0.01 / std::sqrt(5.0), 1e-4);
 }
@@ -148,8 +148,8 @@ TEST(DualGrid, GridsFollowTheRobot) {
                        (map.localGrid().window().ix0 + map.localGrid().window().nx) * 0.015),
                 19.5123, 0.02);
     double h, s;
-    EXPECT_TRUE(map.getHeight(16.0123, 0.0123, h, s));   // written back, in the global grid
-    EXPECT_FALSE(map.getHeight(10.0123, 0.0123, h, s));  // beyond the global grid: forgotten
-    EXPECT_TRUE(map.getHeight(19.5123, 0.0123, h, s));   // in the local grid
+    EXPECT_TRUE(map.cellHeight(16.0123, 0.0123, h, s));   // written back, in the global grid
+    EXPECT_FALSE(map.cellHeight(10.0123, 0.0123, h, s));  // beyond the global grid: forgotten
+    EXPECT_TRUE(map.cellHeight(19.5123, 0.0123, h, s));   // in the local grid
     EXPECT_LE(map.localGrid().binCount(), 3u);
 }

@@ -185,7 +185,7 @@ TEST(CMultiBinElevationMap, UsesLatestRobotPoseCovarianceWhileFresh) {
     ASSERT_TRUE(map.insertObservation(*scan, CPose3D()));
     EXPECT_EQ(map.poseFallbackCount(), 0u);
     double h, sFresh;
-    ASSERT_TRUE(map.getHeight(0.26, 0.0, h, sFresh));
+    ASSERT_TRUE(map.cellHeight(0.26, 0.0, h, sFresh));
     // sigma_z of the robot pose is 20 mm; one scan's points are fused as independent, so the
     // cell's sigma is 20 mm / sqrt(points in the cell).
     EXPECT_GT(sFresh, 0.005);
@@ -197,7 +197,7 @@ TEST(CMultiBinElevationMap, UsesLatestRobotPoseCovarianceWhileFresh) {
     ASSERT_TRUE(map2.insertObservation(*scan, CPose3D()));
     EXPECT_EQ(map2.poseFallbackCount(), 1u);
     double sStale;
-    ASSERT_TRUE(map2.getHeight(0.26, 0.0, h, sStale));
+    ASSERT_TRUE(map2.cellHeight(0.26, 0.0, h, sStale));
     // sigma_z: about 10.4 mm with the default covariance against 20 mm with the robot pose's.
     EXPECT_NEAR(sStale / sFresh, 10.4 / 20.0, 0.05);
 }

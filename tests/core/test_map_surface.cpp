@@ -36,7 +36,7 @@ TEST(CellSurface, AdjacentBinsThatAgreeAreOneSurface) {
     const double heights[] = {0.048, 0.052, 0.047, 0.053, 0.049, 0.051};
     for (double z : heights) insert(map, 0.55, 0.55, z, 0.003);
     double h, s;
-    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    ASSERT_TRUE(map.cellHeight(0.55, 0.55, h, s));
     EXPECT_NEAR(h, 0.05, 1e-6) << "the mean of all six points, not of one bin's share";
     EXPECT_NEAR(s, 0.003 / std::sqrt(6.0), 1e-5);
 
@@ -45,7 +45,7 @@ TEST(CellSurface, AdjacentBinsThatAgreeAreOneSurface) {
     two.insertionOptions.relief_sigma = false;
     for (int i = 0; i < 3; i++) insert(two, 0.55, 0.55, 0.01, 0.003);
     for (int i = 0; i < 2; i++) insert(two, 0.55, 0.55, 0.11, 0.003);
-    ASSERT_TRUE(two.getHeight(0.55, 0.55, h, s));
+    ASSERT_TRUE(two.cellHeight(0.55, 0.55, h, s));
     EXPECT_NEAR(h, 0.01, 1e-6);
 }
 
@@ -59,11 +59,11 @@ TEST(CellSurface, ReliefOfASlopeAddsItsHeightSpreadToSigma) {
             insert(map, x, y, 0.3 + slope * x, sigma);
         }
     double h, s;
-    ASSERT_TRUE(map.getHeight(0.05, 0.05, h, s));
+    ASSERT_TRUE(map.cellHeight(0.05, 0.05, h, s));
     // sigma^2 = max(Kalman, floor) + (g s)^2 / 12; Kalman = floor = 1 mm here.
     EXPECT_NEAR(s, std::sqrt(sigma * sigma + std::pow(slope * cell, 2) / 12.0), 1e-6);
     map.insertionOptions.relief_sigma = false;
-    ASSERT_TRUE(map.getHeight(0.05, 0.05, h, s));
+    ASSERT_TRUE(map.cellHeight(0.05, 0.05, h, s));
     EXPECT_NEAR(s, sigma, 1e-6);
 }
 
@@ -75,12 +75,12 @@ TEST(CellSurface, OtherSurfacesInTheCellAddTheirCertaintyWeightedSpreadToSigma) 
     for (int i = 0; i < 3; i++) insert(map, 0.55, 0.55, 0.11, 0.003);
     for (int i = 0; i < 2; i++) insert(map, 0.55, 0.55, 0.01, 0.003);
     double h, s;
-    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    ASSERT_TRUE(map.cellHeight(0.55, 0.55, h, s));
     EXPECT_NEAR(h, 0.11, 1e-6);
     const double kalman2 = 0.003 * 0.003 / 3;  // the winning bin: 3 points of 3 mm
     EXPECT_NEAR(s * s, kalman2 + 2.0 / 5.0 * 0.1 * 0.1, 1e-9);
     map.insertionOptions.relief_sigma = false;  // the paper's sigma: the winning bin's alone
-    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    ASSERT_TRUE(map.cellHeight(0.55, 0.55, h, s));
     EXPECT_NEAR(s * s, kalman2, 1e-9);
 }
 
@@ -92,7 +92,7 @@ TEST(CellSurface, EveryLayerDescribesTheSameSurface) {
     map.insertionOptions.relief_sigma = false;
     for (double z : {0.048, 0.052, 0.047, 0.053, 0.049, 0.051}) insert(map, 0.55, 0.55, z, 0.003);
     double h, s;
-    ASSERT_TRUE(map.getHeight(0.55, 0.55, h, s));
+    ASSERT_TRUE(map.cellHeight(0.55, 0.55, h, s));
     using Layer = CMultiBinElevationMap::RasterLayer;
     EXPECT_FLOAT_EQ(map.toRaster(Layer::Height).heights_m(5, 5), float(h));
     EXPECT_FLOAT_EQ(map.toRaster(Layer::Sigma).heights_m(5, 5), float(s));

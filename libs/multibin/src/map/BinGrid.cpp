@@ -45,6 +45,7 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
         bin.index = n;
     } else {
         fuse(bin.height_m, bin.variance_m2, other.height_m, other.variance_m2);
+        mergePlaneMoments(bin.plane, other.plane);
         bin.certainty += other.certainty;
         bin.pointCount += other.pointCount;
     }
@@ -76,18 +77,23 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
         return false;
     }
     return fuseMeasurement(slot(ix, iy), ix, iy, n, height_m, variance_m2, params,
-                           continuityBound_m, stats);
+                           continuityBound_m, stats, nullptr);
 }
 
 bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height_m,
                               double variance_m2, const BinUpdateParams& params,
-                              double continuityBound_m, InsertStats& stats) {
+                              double continuityBound_m, InsertStats& stats,
+                              const PointWithCov* point) {
     Bin& bin = BinStore::bin(findOrAddBin(s, n));
     if (!passesEq14(bin, height_m, continuityBound_m)) {
         stats.continuityRejected++;
         return false;
     }
     addMeasurement(bin, height_m, variance_m2, params);
+    if (point)  // a height without a place (insertHeight) says nothing of the slope
+        addPlanePoint(bin.plane, float(point->point_m.x() - cellCenter_m(ix)),
+                      float(point->point_m.y() - cellCenter_m(iy)), float(height_m),
+                      float(1.0 / variance_m2));
     stats.accepted++;
     m_index.noteUpdate(s, ix, iy, height_m, 1);
     return true;
@@ -164,6 +170,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
         int ix = 0, iy = 0;
         uint32_t points = 0;
         HeightInformation sum;
+        PlaneMoments* plane = nullptr;    // the bin's: no bin is added while a run is open
+        double cellX_m = 0, cellY_m = 0;  // the cell's centre [m]
         double maxHeight_m = 0;
         bool frozen = false;  // the bin has zero variance: its height cannot move
     } run;
@@ -226,7 +234,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
             const size_t s = cb.slot[i];
             if (perPoint) {
                 fuseMeasurement(s, cb.ix[i], cb.iy[i], cb.bin[i], h, var, params, continuityBound_m,
-                                stats);
+                                stats, &pts[i]);
                 continue;
             }
             if (run.bin == kNoBin || run.slot != s || run.n != cb.bin[i]) {
@@ -238,12 +246,17 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
                 run.iy = cb.iy[i];
                 run.points = 0;
                 run.maxHeight_m = h;
-                const Bin& bin = BinStore::bin(run.bin);
+                Bin& bin = BinStore::bin(run.bin);
+                run.plane = &bin.plane;
+                run.cellX_m = cellCenter_m(run.ix);
+                run.cellY_m = cellCenter_m(run.iy);
                 run.frozen = bin.pointCount > 0 && !(bin.variance_m2 > 0);
                 run.sum = HeightInformation{};
                 if (bin.pointCount > 0 && !run.frozen) run.sum.add(bin.height_m, bin.variance_m2);
             }
             run.sum.add(h, var);
+            addPlanePoint(*run.plane, float(pts[i].point_m.x() - run.cellX_m),
+                          float(pts[i].point_m.y() - run.cellY_m), float(h), float(1.0 / var));
             run.maxHeight_m = std::max(run.maxHeight_m, h);
             run.points++;
             stats.accepted++;

@@ -146,6 +146,10 @@ void visitCreationKeys(Options& o, Visit&& visit) {
     visit("origin_y_m", o.origin_y_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
 }
 
+using HeightQuery = CMultiBinElevationMap::TInsertionOptions::HeightQuery;
+const OptionNames<HeightQuery> kHeightQueries{{"plane", HeightQuery::Plane},
+                                              {"nearest", HeightQuery::Nearest}};
+
 const OptionNames<mrpt::img::TColormap> kColormaps{
     {"jet", mrpt::img::cmJET}, {"hot", mrpt::img::cmHOT}, {"grayscale", mrpt::img::cmGRAYSCALE}};
 
@@ -168,6 +172,7 @@ void visitInsertionKeys(Options& o, Visit&& visit) {
     visit("color_by_sigma", o.color_by_sigma);
     visit("dem_return_filled", o.dem_return_filled);
     visit("relief_sigma", o.relief_sigma);
+    visit("height_query", o.height_query, kHeightQueries);
 }
 
 /** The origin the options fix before any data arrive: the explicit one, or originNear() of a
@@ -431,15 +436,44 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
+    return insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane
+               ? heightAt(x_m, y_m, height_m, sigma_m)
+               : cellHeight(x_m, y_m, height_m, sigma_m);
+}
+
+namespace {
+/** Height and sigma from one of CellSurface.h's estimators (heightAt or surfaceAt). */
+using SurfaceEstimator = bool (*)(const multibin::BinGrid&, const multibin::BinGrid*, double,
+                                  double, const multibin::BinUpdateParams&, bool,
+                                  multibin::CellSurface&);
+bool answer(SurfaceEstimator estimate, const multibin::BinGrid& grid,
+            const multibin::BinGrid* local, double x_m, double y_m,
+            const multibin::BinUpdateParams& p, bool reliefSigma, double& height_m,
+            double& sigma_m) {
     multibin::CellSurface c;
-    const Eigen::Vector2d& o = m_impl->origin_m;
-    if (!multibin::surfaceAt(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m - o.x(),
-                             y_m - o.y(), binUpdateParams(), insertionOptions.relief_sigma, c))
-        return false;
+    if (!estimate(grid, local, x_m, y_m, p, reliefSigma, c)) return false;
     height_m = c.height_m;
     sigma_m = std::sqrt(c.variance_m2);
     return true;
+}
+}  // namespace
+
+bool CMultiBinElevationMap::heightAt(double x_m, double y_m, double& height_m,
+                                     double& sigma_m) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    const Eigen::Vector2d& o = m_impl->origin_m;
+    return answer(multibin::heightAt, m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
+                  x_m - o.x(), y_m - o.y(), binUpdateParams(), insertionOptions.relief_sigma,
+                  height_m, sigma_m);
+}
+
+bool CMultiBinElevationMap::cellHeight(double x_m, double y_m, double& height_m,
+                                       double& sigma_m) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    const Eigen::Vector2d& o = m_impl->origin_m;
+    return answer(multibin::surfaceAt, m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
+                  x_m - o.x(), y_m - o.y(), binUpdateParams(), insertionOptions.relief_sigma,
+                  height_m, sigma_m);
 }
 
 bool CMultiBinElevationMap::isEmpty() const {

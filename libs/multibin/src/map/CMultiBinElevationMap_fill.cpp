@@ -21,8 +21,8 @@ void CMultiBinElevationMap::dem_update_map() {
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             double h, s;
-            if (getHeight(o.x() + m_impl->grid.cellCenter_m(w.ix0 + c),
-                          o.y() + m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
+            if (cellHeight(o.x() + m_impl->grid.cellCenter_m(w.ix0 + c),
+                           o.y() + m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
                 raster.setMeasured(c, r, float(h), float(s));
         }
     m_impl->fill = multibin::fill::fillGaps(raster, insertionOptions.fill);
@@ -35,7 +35,25 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
     const multibin::MapLock::Shared lock(m_impl->lock);
-    if (getHeight(x_m, y_m, height_m, sigma_m)) return HeightSource::Measured;
+    const bool measured = getHeight(x_m, y_m, height_m, sigma_m);
+    return measuredOrFilled(measured, includeFilled, x_m, y_m, height_m, sigma_m);
+}
+
+CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double x_m, double y_m,
+                                                                         double& height_m,
+                                                                         double& sigma_m,
+                                                                         bool includeFilled) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    const bool measured = cellHeight(x_m, y_m, height_m, sigma_m);
+    return measuredOrFilled(measured, includeFilled, x_m, y_m, height_m, sigma_m);
+}
+
+CMultiBinElevationMap::HeightSource CMultiBinElevationMap::measuredOrFilled(bool measured,
+                                                                            bool includeFilled,
+                                                                            double x_m, double y_m,
+                                                                            double& height_m,
+                                                                            double& sigma_m) const {
+    if (measured) return HeightSource::Measured;
     if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
     const int ix = m_impl->grid.cellIndex(x_m - m_impl->origin_m.x()),
               iy = m_impl->grid.cellIndex(y_m - m_impl->origin_m.y());

@@ -234,9 +234,9 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
         for (int c = 0; c < w.nx; c++) {
             const int ix = w.ix0 + c, iy = w.iy0 + r;
             double h, s;
-            const HeightSource src = getElevation(o.x() + m_impl->grid.cellCenter_m(ix),
-                                                  o.y() + m_impl->grid.cellCenter_m(iy), h, s,
-                                                  insertionOptions.dem_return_filled);
+            const HeightSource src = cellElevation(o.x() + m_impl->grid.cellCenter_m(ix),
+                                                   o.y() + m_impl->grid.cellCenter_m(iy), h, s,
+                                                   insertionOptions.dem_return_filled);
             if (src == HeightSource::Unknown) continue;
             float& out = g.heights_m(r, c);
             switch (layer) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "multibin/map/BinUpdate.h"
@@ -37,6 +38,230 @@ bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, 
     return true;
 }
 
+namespace {
+
+/** Adds to the variance the spread of the cell's certain bins outside the surface. */
+void addOtherBinsSpread(const BinGrid& grid, int ix, int iy, CellSurface& cell) {
+    // Certain bins outside the surface: the cell also holds surfaces at other heights (a step
+    // inside the cell, its top and its foot seen from different places). The truth of the cell,
+    // the mean over its area, lies between them: their spread around the reported height,
+    // weighted by each bin's share of the cell's certainty, is part of the cell's uncertainty.
+    double otherCertainty = 0, otherSpread_m2 = 0;
+    grid.forEachBin(ix, iy, [&](const Bin& b) {
+        if (b.certainty <= 0 || (b.index >= cell.firstBin && b.index <= cell.lastBin)) return;
+        otherCertainty += b.certainty;
+        otherSpread_m2 += b.certainty * (b.height_m - cell.height_m) * (b.height_m - cell.height_m);
+    });
+    if (otherCertainty > 0) cell.variance_m2 += otherSpread_m2 / (otherCertainty + cell.certainty);
+}
+
+/** Combines the estimates of the global and the local grid (either may be missing). */
+bool combineGrids(bool haveG, const CellSurface& g, bool haveL, const CellSurface& l,
+                  CellSurface& out) {
+    if (!haveG && !haveL) return false;
+    if (!haveG || !haveL) {
+        out = haveG ? g : l;
+        return true;
+    }
+    const double d = l.height_m - g.height_m;
+    if (d * d <= 9.0 * (g.variance_m2 + l.variance_m2)) {
+        HeightInformation both;
+        both.add(g.height_m, g.variance_m2);
+        both.add(l.height_m, l.variance_m2);
+        out = l;
+        out.height_m = both.height_m();
+        out.variance_m2 = both.variance_m2();
+        out.certainty = g.certainty + l.certainty;
+    } else {
+        out = l.certainty >= g.certainty ? l : g;
+    }
+    return true;
+}
+
+/** A cell's surface with the plane moments of its bins merged. */
+struct CellPlane {
+    CellSurface surface;
+    PlaneMoments moments;
+    double points = 0;
+};
+
+/** The most surfaces of one cell heightAt tells apart. */
+constexpr int kMaxSurfaces = 4;
+
+/** The surface of the certain bins [first, last] of a cell. */
+void planeOfBins(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, CellPlane& out) {
+    HeightInformation h;
+    out.moments = PlaneMoments{};
+    out.points = 0;
+    out.surface.certainty = 0;
+    grid.forEachBin(ix, iy, [&](const Bin& b) {
+        if (b.certainty <= 0 || b.index < out.surface.firstBin || b.index > out.surface.lastBin)
+            return;
+        h.add(b.height_m, std::max<double>(b.variance_m2, p.varianceFloor_m2));
+        out.surface.certainty += b.certainty;
+        mergePlaneMoments(out.moments, b.plane);
+        out.points += b.pointCount;
+    });
+    out.surface.height_m = h.height_m();
+    out.surface.variance_m2 = std::max(h.variance_m2(), p.varianceFloor_m2);
+}
+
+/** The surfaces of a cell, most certain first: runs of certain bins with contiguous indices
+ * whose heights could come from one surface, point for point (within 3 sigma of the points'
+ * own noise, n / sum w per bin). cellSurface's test compares the bins' means, which split a
+ * surface lying on a bin boundary once the bins hold many points (each keeps a truncated
+ * share, their means a point sigma or more apart); a step of a bin's height or more stays
+ * apart. Returns how many. */
+int cellPlanes(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p,
+               CellPlane (&out)[kMaxSurfaces]) {
+    const Bin* bins[32];
+    int count = 0;
+    grid.forEachBin(ix, iy, [&](const Bin& b) {
+        if (b.certainty > 0 && count < 32) bins[count++] = &b;
+    });
+    if (count == 0) return 0;
+    std::sort(bins, bins + count, [](const Bin* a, const Bin* b) { return a->index < b->index; });
+    auto pointVariance = [&](const Bin& b) {
+        return b.plane.weight > 0 ? b.pointCount / double(b.plane.weight)
+                                  : std::max<double>(b.variance_m2, p.varianceFloor_m2);
+    };
+    int n = 0;
+    for (int i = 0; i < count;) {
+        int j = i;
+        while (j + 1 < count && bins[j + 1]->index == bins[j]->index + 1) {
+            const double d = bins[j + 1]->height_m - bins[j]->height_m;
+            if (d * d > 9.0 * (pointVariance(*bins[j]) + pointVariance(*bins[j + 1]))) break;
+            j++;
+        }
+        CellPlane c;
+        c.surface.firstBin = bins[i]->index;
+        c.surface.lastBin = bins[j]->index;
+        planeOfBins(grid, ix, iy, p, c);
+        // Keep the most certain kMaxSurfaces, most certain first.
+        int k = std::min(n, kMaxSurfaces - 1);
+        if (n == kMaxSurfaces && !(c.surface.certainty > out[k].surface.certainty)) {
+            i = j + 1;
+            continue;
+        }
+        for (; k > 0 && c.surface.certainty > out[k - 1].surface.certainty; k--)
+            out[k] = out[k - 1];
+        out[k] = c;
+        n = std::min(n + 1, kMaxSurfaces);
+        i = j + 1;
+    }
+    return n;
+}
+
+/** Which of a cell's surfaces holds the point (dx_m, dy_m) from the cell's centre: the most
+ * likely under a Gaussian of each surface's points' footprint (weighted mean and covariance,
+ * widened by a tenth of the cell), its prior the surface's share of the points. */
+int surfaceHolding(const CellPlane* planes, int count, double dx_m, double dy_m, double cell_m) {
+    int best = 0;
+    double bestScore = std::numeric_limits<double>::infinity();
+    const double widen_m2 = 0.01 * cell_m * cell_m;
+    for (int k = 0; k < count; k++) {
+        const PlaneMoments& m = planes[k].moments;
+        if (!(m.weight > 0) || !(planes[k].points > 0)) continue;
+        const double a = m.sxx / m.weight + widen_m2, b = m.sxy / m.weight,
+                     c = m.syy / m.weight + widen_m2;
+        const double det = a * c - b * b;
+        const double ex = dx_m - m.mx_m, ey = dy_m - m.my_m;
+        const double d2 = (c * ex * ex - 2 * b * ex * ey + a * ey * ey) / det;
+        const double score = d2 + std::log(det) - 2 * std::log(planes[k].points);
+        if (score < bestScore) {
+            bestScore = score;
+            best = k;
+        }
+    }
+    return best;
+}
+
+/** A gradient [-] and its covariance; chi2 is the plane fit's residual per degree of freedom
+ * (at least 1: the points' own variances are the least the scatter can be). */
+struct Gradient {
+    double gx = 0, gy = 0;
+    double cxx = kUnknownSlope * kUnknownSlope, cxy = 0, cyy = kUnknownSlope * kUnknownSlope;
+    double chi2 = 1;
+    double variance(double ex, double ey) const {
+        return cxx * ex * ex + 2 * cxy * ex * ey + cyy * ey * ey;
+    }
+};
+
+/** The weighted least-squares gradient of the moments; false if they define no plane (fewer
+ * than 4 points, or points on a line). */
+bool gradientOf(const PlaneMoments& m, double points, Gradient& g) {
+    const double a = m.sxx, b = m.sxy, c = m.syy;
+    const double det = a * c - b * b, trace = a + c;
+    if (points < 4 || !(det > 1e-3 * trace * trace)) return false;
+    g.gx = (c * m.sxz - b * m.syz) / det;
+    g.gy = (a * m.syz - b * m.sxz) / det;
+    const double rss = m.szz - g.gx * m.sxz - g.gy * m.syz;
+    g.chi2 = std::max(1.0, rss / (points - 3));
+    g.cxx = g.chi2 * c / det;
+    g.cxy = -g.chi2 * b / det;
+    g.cyy = g.chi2 * a / det;
+    return true;
+}
+
+/** heightAt on one grid. */
+bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& p,
+                   bool reliefSigma, CellSurface& out) {
+    const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
+    CellPlane planes[kMaxSurfaces];
+    const int count = cellPlanes(grid, ix, iy, p, planes);
+    if (count == 0) return false;
+    const double s = grid.cellSize_m();
+    const double qx = x_m - grid.cellCenter_m(ix), qy = y_m - grid.cellCenter_m(iy);
+    const CellPlane& own = planes[surfaceHolding(planes, count, qx, qy, s)];
+    const PlaneMoments& m = own.moments;
+    const double h = own.surface.height_m, hVar = own.surface.variance_m2;
+    Gradient gOwn;
+    gradientOf(m, own.points, gOwn);
+    // The neighbours on the same surface: a surface of the neighbour whose height at its
+    // centroid and the cell's agree within 3 sigma as seen from either plane.
+    PlaneMoments window = m;
+    double windowPoints = own.points;
+    for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+            CellPlane nb[kMaxSurfaces];
+            const int nbCount =
+                (dx == 0 && dy == 0) ? 0 : cellPlanes(grid, ix + dx, iy + dy, p, nb);
+            for (int k = 0; k < nbCount; k++) {
+                if (!(nb[k].moments.weight > 0)) continue;
+                const double ex = dx * s + nb[k].moments.mx_m - m.mx_m;
+                const double ey = dy * s + nb[k].moments.my_m - m.my_m;
+                const double d = nb[k].surface.height_m - h;
+                const double both = hVar + nb[k].surface.variance_m2;
+                const double fromOwn = d - gOwn.gx * ex - gOwn.gy * ey;
+                if (fromOwn * fromOwn > 9.0 * (both + gOwn.variance(ex, ey))) continue;
+                Gradient gNb;
+                gradientOf(nb[k].moments, nb[k].points, gNb);
+                const double fromNb = d - gNb.gx * ex - gNb.gy * ey;
+                if (fromNb * fromNb > 9.0 * (both + gNb.variance(ex, ey))) continue;
+                mergePlaneMoments(window, nb[k].moments, dx * s, dy * s);
+                windowPoints += nb[k].points;
+                break;
+            }
+        }
+    Gradient g;
+    if (!gradientOf(window, windowPoints, g)) g = gOwn;
+    // Without points (a map loaded from a file keeps no moments) the centroid is the centre.
+    const double ex = qx - m.mx_m, ey = qy - m.my_m;
+    out = own.surface;
+    out.height_m = h + g.gx * ex + g.gy * ey;
+    // The points' scatter around the plane beyond their own variances: it widens h's variance,
+    // and the truth at the query point departs from the plane by as much (the relief the plane
+    // does not follow).
+    const double relief_m2 =
+        window.weight > 0 ? (g.chi2 - 1) * windowPoints / double(window.weight) : 0.0;
+    out.variance_m2 =
+        std::max(hVar, m.weight > 0 ? g.chi2 / m.weight : 0.0) + relief_m2 + g.variance(ex, ey);
+    if (reliefSigma) addOtherBinsSpread(grid, ix, iy, out);
+    return true;
+}
+
+}  // namespace
+
 void addReliefVariance(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& p,
                        CellSurface& cell) {
     // Without it sigma is a few mm on 45 degree rock faces where the cell's height is uncertain
@@ -57,17 +282,7 @@ void addReliefVariance(const BinGrid& grid, double x_m, double y_m, const BinUpd
         slope2 += g * g;
     }
     cell.variance_m2 += slope2 * s * s / 12.0;
-    // Certain bins outside the surface: the cell also holds surfaces at other heights (a step
-    // inside the cell, its top and its foot seen from different places). The truth of the cell,
-    // the mean over its area, lies between them: their spread around the reported height,
-    // weighted by each bin's share of the cell's certainty, is part of the cell's uncertainty.
-    double otherCertainty = 0, otherSpread_m2 = 0;
-    grid.forEachBin(grid.cellIndex(x_m), grid.cellIndex(y_m), [&](const Bin& b) {
-        if (b.certainty <= 0 || (b.index >= cell.firstBin && b.index <= cell.lastBin)) return;
-        otherCertainty += b.certainty;
-        otherSpread_m2 += b.certainty * (b.height_m - cell.height_m) * (b.height_m - cell.height_m);
-    });
-    if (otherCertainty > 0) cell.variance_m2 += otherSpread_m2 / (otherCertainty + cell.certainty);
+    addOtherBinsSpread(grid, grid.cellIndex(x_m), grid.cellIndex(y_m), cell);
 }
 
 bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
@@ -75,28 +290,19 @@ bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m
     CellSurface g, l;
     const bool haveG = cellSurface(grid, x_m, y_m, p, g);
     const bool haveL = local && cellSurface(*local, x_m, y_m, p, l);
-    if (!haveG && !haveL) return false;
     if (reliefSigma) {
         if (haveG) addReliefVariance(grid, x_m, y_m, p, g);
         if (haveL) addReliefVariance(*local, x_m, y_m, p, l);
     }
-    if (!haveG || !haveL) {
-        out = haveG ? g : l;
-        return true;
-    }
-    const double d = l.height_m - g.height_m;
-    if (d * d <= 9.0 * (g.variance_m2 + l.variance_m2)) {
-        HeightInformation both;
-        both.add(g.height_m, g.variance_m2);
-        both.add(l.height_m, l.variance_m2);
-        out = l;
-        out.height_m = both.height_m();
-        out.variance_m2 = both.variance_m2();
-        out.certainty = g.certainty + l.certainty;
-    } else {
-        out = l.certainty >= g.certainty ? l : g;
-    }
-    return true;
+    return combineGrids(haveG, g, haveL, l, out);
+}
+
+bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
+              const BinUpdateParams& p, bool reliefSigma, CellSurface& out) {
+    CellSurface g, l;
+    const bool haveG = planeHeightAt(grid, x_m, y_m, p, reliefSigma, g);
+    const bool haveL = local && planeHeightAt(*local, x_m, y_m, p, reliefSigma, l);
+    return combineGrids(haveG, g, haveL, l, out);
 }
 
 }  // namespace multibin

@@ -166,6 +166,11 @@ public:
          * certain bins around the reported height (a cell holding a step holds surfaces at
          * several heights). Off: the bins' Kalman sigma alone (the paper's). */
         bool relief_sigma = true;
+        /** What getHeight(), dem_get_z() (and so intersectLine3D()) answer at a point (key
+         * `height_query`): `plane` (default) the sub-cell surface of heightAt(); `nearest` the
+         * value of the cell containing the point (cellHeight(), the answer before the sub-cell
+         * surface). Rasters and gap filling always use the cell values. */
+        enum class HeightQuery { Plane, Nearest } height_query = HeightQuery::Plane;
 
         void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                 const std::string& section) override;
@@ -226,6 +231,10 @@ public:
      * still unobserved. Filled cells keep certainty 0. */
     HeightSource getElevation(double x_m, double y_m, double& height_m, double& sigma_m,
                               bool includeFilled = true) const;
+    /** The same with the cell's value (cellHeight()) where measured: one value per cell, what
+     * the rasters export. */
+    HeightSource cellElevation(double x_m, double y_m, double& height_m, double& sigma_m,
+                               bool includeFilled = true) const;
     /** True when observations arrived after the last gap filling (dem_update_map() refills). */
     bool fillIsStale() const;
     /** The last gap filling's result over the grid window it was run on. */
@@ -236,6 +245,15 @@ public:
      * dual grid, where both grids know the place and agree within 3 sigma, their independent
      * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
+    /** Height [m] and sigma [m] of the sub-cell surface at (x, y): the plane of the cell's
+     * surface evaluated at the point, its gradient from the cell's points and those of the
+     * neighbouring cells on the same surface (never across a step); sigma grows towards the
+     * cell's edges with the gradient's uncertainty (multibin::heightAt in CellSurface.h,
+     * doc/sub-cell-surface.md). False if unobserved. */
+    bool heightAt(double x_m, double y_m, double& height_m, double& sigma_m) const;
+    /** Height [m] and sigma [m] of the cell containing (x, y): the cell surface (CellSurface.h),
+     * one value per cell, what rasters and gap filling use. False if unobserved. */
+    bool cellHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
 
     /** The map origin [m] in the frame of the robot poses (TCreationOptions::origin_auto): fixed
      * at construction, by the first insertion or by recenter(); (0, 0) until then. */
@@ -330,6 +348,10 @@ private:
     bool internal_canComputeObservationLikelihood(
         const mrpt::obs::CObservation& obs) const override;
 
+    /** Measured if `measured`; else, with includeFilled, the last gap filling's height where it
+     * filled the cell of (x, y) (the caller holds the lock). */
+    HeightSource measuredOrFilled(bool measured, bool includeFilled, double x_m, double y_m,
+                                  double& height_m, double& sigma_m) const;
     /** Observation -> sensor-frame points -> map frame -> grid. */
     bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);

@@ -22,7 +22,7 @@ class PosePropagator;
  * BinUpdate.h) and the visibility index kept in step with both (VisibilityIndex: update cycles,
  * block height bounds), as OctoMap's OccupancyOcTreeBase adds its update rule to the storage of
  * OcTreeBaseImpl. Memory: 12 B per cell of the window (4 B store, 8 B index), 12 B per block of
- * 256 cells and 24 B per bin. */
+ * 256 cells and 64 B per bin (Bin.h). */
 class BinGrid : private BinStore {
 public:
     using BinStore::BinId;
@@ -138,7 +138,8 @@ private:
     /** Gates 13 and bin range passed: eq 14 and the per-point Kalman update (eq 15). */
     bool fuseMeasurement(size_t slot, int ix, int iy, int16_t n, double height_m,
                          double variance_m2, const BinUpdateParams& params,
-                         double continuityBound_m, InsertStats& stats);
+                         double continuityBound_m, InsertStats& stats,
+                         const PointWithCov* point);  //!< its place feeds the plane moments
 
     VisibilityIndex m_index;
 };

@@ -20,7 +20,7 @@ namespace multibin {
  * (ix mod nx) + (iy mod ny) nx, so moving the window only clears the slots of the cells that
  * enter, and growing it re-slots the cell heads without touching any bin. Bins: one pool shared
  * by all cells, chained per cell in insertion order and addressed by a BinId, so callers hold
- * ids, never pointers (the pool may reallocate). Memory: 4 B per cell of the window and 24 B per
+ * ids, never pointers (the pool may reallocate). Memory: 4 B per cell of the window and 64 B per
  * bin. */
 class BinStore {
 public:

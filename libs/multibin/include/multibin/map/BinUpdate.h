@@ -59,6 +59,52 @@ inline void addMeasurement(BinEstimate& bin, double height_m, double variance_m2
     bin.pointCount++;
 }
 
+/** Adds a point at (dx_m, dy_m) from its cell's centre, height z_m, weight w = 1/var_z to the
+ * bin's plane moments: the centred update of a weighted mean and co-moments (West 1979). */
+inline void addPlanePoint(PlaneMoments& m, float dx_m, float dy_m, float z_m, float w) {
+    // In float: the offsets are at most a cell and the height's deviations from the bin's mean
+    // at most a bin, far inside float's 7 digits; the stored moments are floats anyway.
+    const float W = m.weight + w;
+    const float f = w / W, k = w - w * f;  // k = w W_old / W
+    const float ex = dx_m - m.mx_m, ey = dy_m - m.my_m, ez = z_m - m.mz_m;
+    m.weight = W;
+    m.mx_m += f * ex;
+    m.my_m += f * ey;
+    m.mz_m += f * ez;
+    m.sxx += k * ex * ex;
+    m.sxy += k * ex * ey;
+    m.syy += k * ey * ey;
+    m.sxz += k * ex * ez;
+    m.syz += k * ey * ez;
+    m.szz += k * ez * ez;
+}
+
+/** Merges the moments `o` (their x, y shifted by (dx_m, dy_m), e.g. a neighbouring cell's
+ * centre) into `m`: exact, as if every point of both had been added (parallel axis theorem). */
+inline void mergePlaneMoments(PlaneMoments& m, const PlaneMoments& o, double dx_m = 0,
+                              double dy_m = 0) {
+    if (!(o.weight > 0)) return;
+    if (!(m.weight > 0)) {
+        m = o;
+        m.mx_m = static_cast<float>(o.mx_m + dx_m);
+        m.my_m = static_cast<float>(o.my_m + dy_m);
+        return;
+    }
+    const double W = double(m.weight) + double(o.weight);
+    const double f = double(o.weight) / W, k = double(m.weight) * f;
+    const double ex = o.mx_m + dx_m - m.mx_m, ey = o.my_m + dy_m - m.my_m, ez = o.mz_m - m.mz_m;
+    m.weight = static_cast<float>(W);
+    m.mx_m = static_cast<float>(m.mx_m + f * ex);
+    m.my_m = static_cast<float>(m.my_m + f * ey);
+    m.mz_m = static_cast<float>(m.mz_m + f * ez);
+    m.sxx = static_cast<float>(double(m.sxx) + o.sxx + k * ex * ex);
+    m.sxy = static_cast<float>(double(m.sxy) + o.sxy + k * ex * ey);
+    m.syy = static_cast<float>(double(m.syy) + o.syy + k * ey * ey);
+    m.sxz = static_cast<float>(double(m.sxz) + o.sxz + k * ex * ez);
+    m.syz = static_cast<float>(double(m.syz) + o.syz + k * ey * ez);
+    m.szz = static_cast<float>(double(m.szz) + o.szz + k * ez * ez);
+}
+
 /** Eq 14: a laser point must agree with a bin that is already certain (c > 0) to within
  * `continuityBound_m`; a bin without certainty has no height to compare against. */
 inline bool passesEq14(const BinEstimate& bin, double height_m, double continuityBound_m) {

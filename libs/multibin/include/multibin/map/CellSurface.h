@@ -45,4 +45,21 @@ void addReliefVariance(const BinGrid& grid, double x_m, double y_m, const BinUpd
 bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
                const BinUpdateParams& params, bool reliefSigma, CellSurface& out);
 
+/** The sub-cell surface at (x_m, y_m): the plane of the cell's surface evaluated at the query
+ * point, h + g . (q - m), with h the surface's height (eq 15) at its points' weighted centroid m
+ * and g the weighted least-squares gradient of the points of the cell and of those neighbouring
+ * cells (8-neighbourhood) whose surfaces agree with the cell's plane within 3 sigma both ways
+ * (never across a step the bins show). The variance is var(h) + (q - m)^T C_g (q - m), C_g the
+ * gradient's covariance scaled by the plane fit's residual chi^2 per degree of freedom (at least
+ * 1): it grows towards the cell's edges and where the slope is uncertain; with `reliefSigma` the
+ * spread of the cell's other certain bins (a step inside the cell) is added as in
+ * addReliefVariance. A cell whose points give no plane (fewer than 4, or collinear) and no agreeing
+ * neighbour falls back to a gradient 0 +- kUnknownSlope. With a dual grid, combined as surfaceAt
+ * does. False if neither grid has a surface there. */
+bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
+              const BinUpdateParams& params, bool reliefSigma, CellSurface& out);
+
+/** The slope sigma assumed where no points give one [-]: 45 degrees. */
+constexpr double kUnknownSlope = 1.0;
+
 }  // namespace multibin

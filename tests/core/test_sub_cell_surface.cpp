@@ -1,0 +1,150 @@
+/* The sub-cell surface (heightAt): heights at query points on no lattice, better than any one
+ * height per cell, honest sigma, never across a step (doc/sub-cell-surface.md). */
+#include <gtest/gtest.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/math/TLine3D.h>
+#include <mrpt/math/TObject3D.h>
+
+#include <cmath>
+#include <random>
+
+#include "SurfaceAccuracy.h"
+
+using mrpt::maps::CMultiBinElevationMap;
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kCell_m = 0.02;
+constexpr double kStepX_m = 0.311;  // inside a cell: that cell holds both sides
+constexpr double kStep_m = 0.1;
+
+/** Rock-like relief (slopes up to about 1.5) with a 10 cm step at x = kStepX_m. */
+double terrain(double x, double y) {
+    return 0.03 * std::sin(2 * kPi * x / 0.15) * std::cos(2 * kPi * y / 0.18) +
+           0.008 * std::sin(2 * kPi * (x + 0.6 * y) / 0.05) + (x >= kStepX_m ? kStep_m : 0.0);
+}
+
+CMultiBinElevationMap fixedMap() {
+    CMultiBinElevationMap::TCreationOptions c;
+    c.resolution_m = kCell_m;
+    c.grow = false;
+    c.min_x = c.min_y = 0;
+    c.max_x = c.max_y = 0.6;
+    CMultiBinElevationMap map(c);
+    map.insertionOptions.height_sigma_floor_m = 0.0005;
+    return map;
+}
+
+/** `perCell` points per cell on average, uniformly placed, each displaced by its covariance
+ * (1 mm horizontally, 2 mm vertically): the map is told the truth about its noise. */
+multibin::PointsWithCov samplePoints(double perCell, unsigned seed,
+                                     double (*surface)(double, double)) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 0.6);
+    std::normal_distribution<double> n(0.0, 1.0);
+    const double sxy = 0.001, sz = 0.002;
+    multibin::PointsWithCov pts;
+    const size_t count = size_t(perCell * (0.6 / kCell_m) * (0.6 / kCell_m));
+    for (size_t i = 0; i < count; i++) {
+        const double x = u(rng), y = u(rng);
+        multibin::PointWithCov p;
+        p.point_m = Eigen::Vector3f(float(x + sxy * n(rng)), float(y + sxy * n(rng)),
+                                    float(surface(x, y) + sz * n(rng)));
+        p.cov_m2 = multibin::SymmetricCov3{};
+        p.cov_m2.xx = p.cov_m2.yy = float(sxy * sxy);
+        p.cov_m2.zz = float(sz * sz);
+        pts.push_back(p);
+    }
+    return pts;
+}
+}  // namespace
+
+TEST(SubCellSurface, BeatsTheOneHeightPerCellFloorAtRandomPoints) {
+    CMultiBinElevationMap map = fixedMap();
+    map.insertPoints(samplePoints(30, 1, terrain));
+    // The inner area: every query point has four cell centres around it (bilinear).
+    const auto r =
+        multibin::test::measureSurfaceAccuracy(map, terrain, 0.02, 0.58, 0.02, 0.58, 20000, 2);
+    ASSERT_EQ(r.points, 20000u);
+    RecordProperty("floor_mm", std::to_string(1e3 * r.floor_m));
+    RecordProperty("heightAt_mm", std::to_string(1e3 * r.heightAt_m));
+    std::cout << "RMSE [mm]: floor " << 1e3 * r.floor_m << ", nearest " << 1e3 * r.nearest_m
+              << ", bilinear " << 1e3 * r.bilinear_m << ", heightAt " << 1e3 * r.heightAt_m
+              << "; within 3 sigma " << r.within3Sigma << " (nearest " << r.nearestWithin3Sigma
+              << ")\n";
+    EXPECT_GT(r.nearest_m, r.floor_m) << "no one height per cell beats the exact cell mean";
+    EXPECT_LE(r.heightAt_m, 0.85 * r.floor_m);
+    EXPECT_LT(r.heightAt_m, r.bilinear_m);
+    EXPECT_GE(r.within3Sigma, 0.95);
+}
+
+TEST(SubCellSurface, SigmaGrowsTowardsTheCellEdgeOnASlope) {
+    // A plane z = 0.5 x: exact at any point of a cell, its sigma least at the points' centroid.
+    CMultiBinElevationMap map = fixedMap();
+    map.insertPoints(samplePoints(30, 3, [](double x, double) { return 0.5 * x; }));
+    const double cx = 0.31, cy = 0.31;  // a cell's centre
+    double hc, sc, he, se;
+    ASSERT_TRUE(map.heightAt(cx, cy, hc, sc));
+    ASSERT_TRUE(map.heightAt(cx + 0.0099, cy + 0.0099, he, se));
+    EXPECT_NEAR(hc, 0.5 * cx, 3 * sc);
+    EXPECT_NEAR(he, 0.5 * (cx + 0.0099), 3 * se);
+    EXPECT_NEAR(he - hc, 0.5 * 0.0099, 0.001) << "the slope inside the cell";
+    EXPECT_GT(se, sc);
+}
+
+TEST(SubCellSurface, NeverAcrossAStep) {
+    // A 10 cm step on a cell boundary (x = 0.3) and one inside a cell (x = 0.511): queried up
+    // to 3 mm (3 horizontal point sigmas) from the step, each side keeps its own surface, where
+    // the cell's value mixes them or takes the wrong one.
+    CMultiBinElevationMap map = fixedMap();
+    const auto steps = [](double x, double) {
+        return (x >= 0.3 ? 0.1 : 0.0) + (x >= 0.511 ? 0.1 : 0.0);
+    };
+    map.insertPoints(samplePoints(30, 4, steps));
+    for (const double x : {0.261, 0.297, 0.303, 0.339, 0.5, 0.508, 0.514, 0.519}) {
+        for (const double y : {0.305, 0.412}) {
+            double h, s;
+            ASSERT_TRUE(map.heightAt(x, y, h, s));
+            EXPECT_NEAR(h, steps(x, y), 0.003) << "x = " << x << ", y = " << y;
+            EXPECT_LE(std::abs(h - steps(x, y)), 3 * s) << "x = " << x << ", y = " << y;
+        }
+    }
+}
+
+TEST(SubCellSurface, NearestKeepsTheCellValue) {
+    CMultiBinElevationMap map = fixedMap();
+    map.insertPoints(samplePoints(10, 5, terrain));
+    using Q = CMultiBinElevationMap::TInsertionOptions::HeightQuery;
+    for (const double x : {0.101, 0.2345, 0.4567}) {
+        for (const Q mode : {Q::Nearest, Q::Plane}) {
+            map.insertionOptions.height_query = mode;
+            double hg, sg, hWant, sWant, z;
+            ASSERT_TRUE(map.getHeight(x, 0.3, hg, sg));
+            ASSERT_TRUE(mode == Q::Nearest ? map.cellHeight(x, 0.3, hWant, sWant)
+                                           : map.heightAt(x, 0.3, hWant, sWant));
+            EXPECT_EQ(hg, hWant);
+            EXPECT_EQ(sg, sWant);
+            ASSERT_TRUE(map.dem_get_z(x, 0.3, z));
+            EXPECT_EQ(z, hWant);
+        }
+    }
+}
+
+TEST(SubCellSurface, IntersectLine3DMeetsTheSubCellSurface) {
+    // MRPT's intersectLine3D samples dem_get_z along the ray: a vertical ray at a cell's edge on
+    // a slope meets the plane there, not the cell's value.
+    CMultiBinElevationMap map = fixedMap();
+    map.insertPoints(samplePoints(30, 6, [](double x, double) { return x; }));
+    const double x = 0.3195, y = 0.305;
+    double h, s, hCell, sCell;
+    ASSERT_TRUE(map.heightAt(x, y, h, s));
+    ASSERT_TRUE(map.cellHeight(x, y, hCell, sCell));
+    ASSERT_GT(std::abs(h - hCell), 0.006) << "the test needs the two answers apart";
+    mrpt::math::TObject3D hit;
+    ASSERT_TRUE(map.intersectLine3D(
+        mrpt::math::TLine3D(mrpt::math::TPoint3D(x, y, 1.0), mrpt::math::TPoint3D(x, y, 0.0)),
+        hit));
+    mrpt::math::TPoint3D p;
+    ASSERT_TRUE(hit.getPoint(p));
+    EXPECT_NEAR(p.z, h, 1e-6);
+}
