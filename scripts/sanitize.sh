@@ -56,10 +56,6 @@ for target in map_deserialize ini_options observation_insert rawlog_read; do
     { tail -n 40 "$log"; exit 1; }
   grep -E '^#[0-9]+.*DONE' "$log" || true
   seconds=$fuzz_seconds
-  # fuzz_rawlog_read: replay only. Fuzzing it finds a crash inside MRPT 2.5 itself
-  # (CActionRobotMovement2D::serializeFrom dereferences null on a corrupt action; finding 14 in
-  # doc/reliability.md) that the reading path does not guard yet.
-  [ "$target" = rawlog_read ] && seconds=0
   if [ "$seconds" -gt 0 ]; then
     echo "== fuzz_$target: fuzz ${seconds} s"
     "$exe" -max_total_time="$seconds" -print_final_stats=1 \

@@ -17,6 +17,7 @@
 #include <stdexcept>
 
 #include "RawlogSourceGuard.h"
+#include "RawlogStreamGuard.h"
 #include "multibin/io/ErrorMessage.h"
 
 namespace {
@@ -60,9 +61,16 @@ std::string gigabytes(uint64_t bytes) {
     return b;
 }
 
-/** Reads one object under the read budget; a refused allocation becomes an error saying so
- * (built after the budget ends: the budget is spent by then). */
+/** An entry refused by the reading path itself (its message already names the file and the
+ * entry), as opposed to an error of MRPT's to be prefixed. */
+struct RefusedEntry : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/** Reads one object under the read budget; a refused allocation or content the stream guard
+ * refused becomes an error saying so (built after the budget ends: the budget is spent by then). */
 mrpt::serialization::CSerializable::Ptr readBounded(mrpt::serialization::CArchive& arch,
+                                                    const RawlogStreamGuard& guard,
                                                     uint64_t bytesLeft, const std::string& where) {
     uint64_t asked = 0;
     {
@@ -71,13 +79,13 @@ mrpt::serialization::CSerializable::Ptr readBounded(mrpt::serialization::CArchiv
             return arch.ReadObject();
         } catch (const std::exception&) {
             asked = ReadBudget::largestRefused();
-            if (asked == 0) throw;
+            if (asked == 0 && guard.refusal().empty()) throw;
         }
     }
-    throw std::runtime_error(where +
-                             " declares more data than the file holds: reading it asked for " +
-                             gigabytes(asked) + " in all, more than 64 MiB + 16 x the " +
-                             std::to_string(bytesLeft) + " bytes left");
+    if (asked == 0) throw RefusedEntry(where + ": " + guard.refusal());
+    throw RefusedEntry(where + " declares more data than the file holds: reading it asked for " +
+                       gigabytes(asked) + " in all, more than 64 MiB + 16 x the " +
+                       std::to_string(bytesLeft) + " bytes left");
 }
 
 bool finitePose(const mrpt::poses::CPose3D& p) {
@@ -102,7 +110,8 @@ size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& vis
 size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& name,
                                      uint64_t sizeBound_bytes, const Visitor& visit,
                                      const Progress& progress) {
-    auto arch = mrpt::serialization::archiveFrom(in);
+    RawlogStreamGuard guard(in);
+    auto arch = mrpt::serialization::archiveFrom(guard);
     const uint64_t start = in.getPosition();
     mrpt::poses::CPose3DPDFGaussian pose;  // latest CObservationRobotPose, or odometry
     bool poseHasCov = false;
@@ -128,16 +137,14 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
         const uint64_t entryStart = in.getPosition();
         const uint64_t read = entryStart - start;
         try {
-            obj =
-                readBounded(arch, sizeBound_bytes > read ? sizeBound_bytes - read : 0, entryName());
+            obj = readBounded(arch, guard, sizeBound_bytes > read ? sizeBound_bytes - read : 0,
+                              entryName());
+        } catch (const RefusedEntry&) {
+            throw;
         } catch (const mrpt::serialization::CExceptionEOF&) {
             if (in.getPosition() == entryStart) break;  // clean end, between two entries
             throw std::runtime_error(name + " is truncated inside entry " +
                                      std::to_string(entries));
-        } catch (const std::runtime_error& e) {
-            if (ReadBudget::largestRefused() > 0) throw;  // already names the entry
-            throw std::runtime_error(name + " is truncated or corrupt at entry " +
-                                     std::to_string(entries) + ": " + multibin::oneLineMessage(e));
         } catch (const std::exception& e) {
             throw std::runtime_error(name + " is truncated or corrupt at entry " +
                                      std::to_string(entries) + ": " + multibin::oneLineMessage(e));
@@ -207,18 +214,21 @@ mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const 
                                                    uint64_t sizeBound_bytes) {
     mrpt::maps::CSimpleMap sm;
     uint64_t asked = 0;
+    RawlogStreamGuard guard(in);
     try {
         ReadBudget budget(ReadBudget::limitFor(sizeBound_bytes));
         try {
-            auto arch = mrpt::serialization::archiveFrom(in);
+            auto arch = mrpt::serialization::archiveFrom(guard);
             arch >> sm;
         } catch (const std::exception&) {
             asked = ReadBudget::largestRefused();
-            if (asked == 0) throw;
+            if (asked == 0 && guard.refusal().empty()) throw;
         }
     } catch (const std::exception& e) {
         throw std::runtime_error(name + " is truncated or corrupt: " + multibin::oneLineMessage(e));
     }
+    if (asked == 0 && !guard.refusal().empty())
+        throw std::runtime_error(name + ": " + guard.refusal());
     if (asked > 0)
         throw std::runtime_error(name +
                                  " declares more data than the file holds: reading it asked for " +

@@ -164,6 +164,72 @@ TEST(HostileFiles, NullOrNonFiniteOdometryIsAnError) {
     expectOneLineError(runMapper("--rawlog", inf, dir), inf, "the odometry is not finite");
 }
 
+// A 2D odometry action of serialization version 0 or 1 whose pose change is null or not a pose
+// PDF: MRPT 2.5's CActionRobotMovement2D::serializeFrom calls getMean() on the null pointer
+// (finding 14, SIGSEGV inside MRPT before). Refused wherever the action sits: in an action
+// collection, in a sensory frame's observation slot, in a simplemap; new and old framing.
+TEST(HostileFiles, AnOldOdometryActionWithoutAPosePdfIsAnErrorNotACrash) {
+    const fs::path dir = scratchDir("hostile_old_odometry");
+    mrpt::obs::CActionRobotMovement2D move;
+    move.computeFromOdometry(mrpt::poses::CPose2D(0.1, 0, 0), {});
+    mrpt::obs::CActionCollection acts;
+    acts.insert(move);
+    const Bytes moveBytes =
+        bytesOf(mrpt::obs::CAction::Ptr(std::make_shared<mrpt::obs::CActionRobotMovement2D>(move)));
+    const Bytes good = bytesOf(acts) + sensoryFrameWith(scan(50));
+    const std::string cls = move.GetRuntimeClass()->className;
+    const Bytes odometry(4, '\0');  // int32 0: emOdometry, the branch that dereferences
+    // version byte, pose change object, estimation method, MRPT's end-of-object flag (0x88)
+    auto v0 = [&](const std::string& name, char version, const Bytes& pdf) {
+        return Bytes(1, char(0x80 | name.size())) + name + Bytes(1, version) + pdf + odometry +
+               Bytes(1, char(0x88));
+    };
+    // MRPT before 0.5.5: length as int32 (high bit clear), int32 version, no end flag.
+    const Bytes oldFraming = Bytes(1, char(cls.size())) + Bytes(3, '\0') + cls + Bytes(4, '\0') +
+                             nullObject() + odometry;
+    const std::string shortName = "CActionRobotMovement2D";  // MRPT also finds it without namespace
+    const std::vector<std::pair<std::string, Bytes>> actions = {
+        {"null", v0(cls, 0, nullObject())},
+        {"pose", v0(cls, 1, poseObject())},
+        {"short", v0(shortName, 0, nullObject())},
+        {"old", oldFraming}};
+    for (const auto& [name, action] : actions) {
+        SCOPED_TRACE(name);
+        const fs::path f = dir / (name + ".rawlog");
+        write(f, good + spliced(bytesOf(acts), moveBytes, action) + sensoryFrameWith(scan(50)));
+        expectOneLineError(runMapper("--rawlog", f, dir), f,
+                           "2D odometry action of serialization version");
+    }
+    // The same action where an observation belongs (MRPT reads any class there first).
+    const auto obs = scan(50);
+    const Bytes frame = sensoryFrameWith(obs);
+    const fs::path inFrame = dir / "in_frame.rawlog";
+    write(inFrame, good + spliced(frame, bytesOf(mrpt::obs::CObservation::Ptr(obs)),
+                                  v0(cls, 0, nullObject())));
+    expectOneLineError(runMapper("--rawlog", inFrame, dir), inFrame,
+                       "2D odometry action of serialization version 0");
+    auto sf = mrpt::obs::CSensoryFrame::Create();
+    sf->insert(obs);
+    mrpt::maps::CSimpleMap sm;
+    sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), sf);
+    const fs::path inSimplemap = dir / "in.simplemap";
+    write(inSimplemap, spliced(bytesOf(sm), bytesOf(mrpt::obs::CObservation::Ptr(obs)),
+                               v0(cls, 0, nullObject())));
+    expectOneLineError(runMapper("--simplemap", inSimplemap, dir), inSimplemap,
+                       "2D odometry action of serialization version 0");
+    // Control: a version-0 action with a pose PDF is read (and used as odometry).
+    const fs::path withPdf = dir / "with_pdf.rawlog";
+    write(withPdf,
+          good +
+              spliced(bytesOf(acts), moveBytes,
+                      v0(cls, 0,
+                         bytesOf(mrpt::poses::CPosePDF::Ptr(mrpt::poses::CPosePDFGaussian::Create(
+                             mrpt::poses::CPose2D(0.1, 0, 0)))))) +
+              sensoryFrameWith(scan(50)));
+    const RunResult ok = runMapper("--rawlog", withPdf, dir);
+    EXPECT_EQ(ok.exitCode, 0) << ok.stderrText;
+}
+
 // Keyframes with a null pose, a null sensory frame, a null observation: MRPT's height grids
 // and the map's simplemap helper dereferenced them.
 TEST(HostileFiles, NullEntriesInASimplemapAreOneLineErrors) {
