@@ -6,6 +6,7 @@
 
 #include "multibin/map/Bin.h"
 #include "multibin/map/MapTypes.h"
+#include "multibin/util/Counters.h"
 
 namespace multibin {
 
@@ -56,7 +57,7 @@ inline void addMeasurement(BinEstimate& bin, double height_m, double variance_m2
     } else {
         fuse(bin.height_m, bin.variance_m2, height_m, variance_m2);
     }
-    bin.pointCount++;
+    util::addSaturating(bin.pointCount, 1u);
 }
 
 /** Eq 14: a laser point must agree with a bin that is already certain (c > 0) to within
