@@ -156,10 +156,15 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     obs.load();  // externally stored observations
 
     multibin::sensors::SensorPoints sensed;
-    if (!multibin::sensors::observationToSensorPoints(
-            obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-            insertionOptions.max_range_m, m_impl->sensorState, sensed))
-        return false;  // not an observation this map models
+    try {
+        if (!multibin::sensors::observationToSensorPoints(
+                obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
+                insertionOptions.max_range_m, m_impl->sensorState, sensed))
+            return false;  // not an observation this map models
+    } catch (const std::invalid_argument&) {
+        m_impl->sensorState.stats += sensed.stats;  // the refusal's counter (badAperture, ...)
+        throw;
+    }
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
     const double continuityBound_m = sensed.continuityBound_m;
