@@ -358,6 +358,32 @@ TEST(BadInputExtent, PointsFarOutsideAFixedMapAreCounted) {
     EXPECT_EQ(serialize(map), before);
 }
 
+// A window that cannot hold the data is never a silent empty map. A growth limit smaller than
+// the growth margin put the window beside the data (max_size_m = 1 m: 0 fused), one 30 m cell
+// likewise; a fixed window far away fuses nothing and counts every point as outsideMap.
+TEST(BadInputExtent, AWindowSmallerThanItsMarginHoldsTheDataItCan) {
+    for (const auto& [maxSize_m, resolution_m] :
+         {std::pair{1.0, 0.02}, {2.0, 0.02}, {40.0, 30.0}}) {
+        SCOPED_TRACE(std::to_string(maxSize_m) + " m at " + std::to_string(resolution_m) + " m");
+        Map::TCreationOptions c;
+        c.max_size_m = maxSize_m;
+        c.resolution_m = resolution_m;
+        Map map(c);
+        map.insertObservation(*floorScan(), posePdf());
+        const multibin::InsertStats& s = map.insertStats();
+        EXPECT_GT(s.accepted, 0u) << "outside " << s.outsideMap;  // on the data, not beside it
+        EXPECT_EQ(s.accepted + s.outsideMap, map.sensorModelStats().laser.kept);
+    }
+    Map::TCreationOptions far = fixedTwoMetreMap();
+    far.resolution_m = 30;
+    far.min_x = 1e9, far.max_x = 1e9 + 1;
+    Map map(far);
+    map.insertObservation(*floorScan(), posePdf());
+    EXPECT_EQ(map.insertStats().accepted, 0u);
+    EXPECT_EQ(map.insertStats().outsideMap, map.sensorModelStats().laser.kept);
+    EXPECT_GT(map.insertStats().outsideMap, 0u);
+}
+
 TEST(BadInputExtent, AStrayFarPointDoesNotStretchAGrowingMap) {
     Map map = mapWithData();
     const multibin::CellWindow w = map.grid().window();

@@ -95,12 +95,13 @@ const std::string kLimit = "";
 const std::string kLimit = "ulimit -v 1048576; ";  // 1 GB address space
 #endif
 
-/** elevation-mapper with the shipped walk.ini on `input`, under a 1 GB address-space limit. */
-RunResult runMapper(const std::string& flag, const fs::path& input, const fs::path& dir) {
+/** elevation-mapper with `ini` (default: the shipped walk.ini) on `input`, under a 1 GB
+ * address-space limit. */
+RunResult runMapper(const std::string& flag, const fs::path& input, const fs::path& dir,
+                    const fs::path& ini = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini") {
     const fs::path err = dir / "stderr.txt";
-    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " +
-                            (fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini").string() +
-                            " " + flag + " " + input.string() + " --no-plots --out " +
+    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " + ini.string() + " " +
+                            flag + " " + input.string() + " --no-plots --out " +
                             (dir / "out").string() + " > " + (dir / "stdout.txt").string() +
                             " 2> " + err.string() + " < /dev/null";
     const auto t0 = std::chrono::steady_clock::now();
@@ -228,6 +229,23 @@ TEST(HostileFiles, AnOldOdometryActionWithoutAPosePdfIsAnErrorNotACrash) {
               sensoryFrameWith(scan(50)));
     const RunResult ok = runMapper("--rawlog", withPdf, dir);
     EXPECT_EQ(ok.exitCode, 0) << ok.stderrText;
+}
+
+// A fixed window that cannot hold the data is an error naming the window, never a silent empty
+// map: before, "no point fused ..." only listed "outside map N" among the rejections.
+TEST(HostileFiles, AFixedWindowThatDoesNotHoldTheDataIsAnErrorSayingSo) {
+    const fs::path dir = scratchDir("hostile_window");
+    const fs::path ini = dir / "far.ini";
+    std::string text = readAll(fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini");
+    const std::string creation = "_creationOpts]\n";
+    text.insert(text.find(creation) + creation.size(),
+                "grow = false\nmin_x_m = 1000\nmax_x_m = 1001\nmin_y_m = -1\n"
+                "max_y_m = 1\n");
+    write(ini, text);
+    const fs::path walk = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog";
+    const RunResult r = runMapper("--rawlog", walk, dir, ini);
+    expectOneLineError(r, walk, "does not hold the data");
+    EXPECT_NE(r.stderrText.find("points fell outside it"), std::string::npos) << r.stderrText;
 }
 
 // Keyframes with a null pose, a null sensory frame, a null observation: MRPT's height grids
