@@ -8,6 +8,7 @@
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/rtti/CObject.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
@@ -67,16 +68,18 @@ struct RefusedEntry : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-/** Reads one object under the read budget; a refused allocation or content the stream guard
- * refused becomes an error saying so (built after the budget ends: the budget is spent by then). */
-mrpt::serialization::CSerializable::Ptr readBounded(mrpt::serialization::CArchive& arch,
-                                                    const RawlogStreamGuard& guard,
-                                                    uint64_t bytesLeft, const std::string& where) {
+/** Runs `read` (one entry) under the read budget; a refused allocation or content the stream
+ * guard refused becomes an error saying so (built after the budget ends: the budget is spent by
+ * then). */
+template <class Read>
+mrpt::serialization::CSerializable::Ptr readBounded(const RawlogStreamGuard& guard,
+                                                    uint64_t bytesLeft, const std::string& where,
+                                                    const Read& read) {
     uint64_t asked = 0;
     {
         ReadBudget budget(ReadBudget::limitFor(bytesLeft));
         try {
-            return arch.ReadObject();
+            return read();
         } catch (const std::exception&) {
             asked = ReadBudget::largestRefused();
             if (asked == 0 && guard.refusal().empty()) throw;
@@ -86,6 +89,56 @@ mrpt::serialization::CSerializable::Ptr readBounded(mrpt::serialization::CArchiv
     throw RefusedEntry(where + " declares more data than the file holds: reading it asked for " +
                        gigabytes(asked) + " in all, more than 64 MiB + 16 x the " +
                        std::to_string(bytesLeft) + " bytes left");
+}
+
+bool isActionCollection(const RawlogStreamGuard::Header& h) {
+    return h.complete && h.className != "nullptr" &&
+           mrpt::rtti::findRegisteredClass(h.className) == CLASS_ID(mrpt::obs::CActionCollection);
+}
+
+/** A top-level action collection (its header peeked as `h`), read here action by action: MRPT
+ * assigns each action it reads to a pointer that clones through it unchecked, so a slot that
+ * holds a null object or another class is refused before MRPT reads it (finding 14). */
+mrpt::serialization::CSerializable::Ptr readActionCollection(mrpt::serialization::CArchive& arch,
+                                                             RawlogStreamGuard& guard,
+                                                             const RawlogStreamGuard::Header& h,
+                                                             uint64_t bytesLeft,
+                                                             const std::string& where) {
+    guard.dropPeeked();
+    if (h.version != 0)
+        throw std::runtime_error("an action collection of unknown serialization version " +
+                                 std::to_string(h.version));
+    uint32_t n = 0;
+    arch >> n;
+    if (n > bytesLeft)
+        throw RefusedEntry(where + " (an action collection) declares " + std::to_string(n) +
+                           " actions, more than the " + std::to_string(bytesLeft) +
+                           " bytes left can hold");
+    auto acts = mrpt::obs::CActionCollection::Create();
+    for (uint32_t k = 0; k < n; k++) {
+        const RawlogStreamGuard::Header slot = guard.peekHeader();
+        if (!slot.complete)
+            throw std::runtime_error("action " + std::to_string(k) + " is cut short");
+        const bool null = slot.className == "nullptr";
+        const auto* cls = null ? nullptr : mrpt::rtti::findRegisteredClass(slot.className);
+        if (!cls || !cls->derivedFrom(CLASS_ID(mrpt::obs::CAction)))
+            throw RefusedEntry(where + " (an action collection): action " + std::to_string(k) +
+                               (null  ? " is null"
+                                : cls ? std::string(" is a ") + cls->className
+                                      : " is of an unregistered class") +
+                               ", not an action");
+        guard.allowNextAction();
+        const auto action = std::dynamic_pointer_cast<mrpt::obs::CAction>(arch.ReadObject());
+        if (!action) throw std::runtime_error("action " + std::to_string(k) + " is not an action");
+        acts->insert(*action);
+    }
+    if (!h.oldFraming) {
+        uint8_t endFlag = 0;
+        arch >> endFlag;
+        if (endFlag != 0x88)  // MRPT's SERIALIZATION_END_FLAG
+            throw std::runtime_error("the action collection's end-of-object flag is missing");
+    }
+    return acts;
 }
 
 bool finitePose(const mrpt::poses::CPose3D& p) {
@@ -136,9 +189,15 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
         mrpt::serialization::CSerializable::Ptr obj;
         const uint64_t entryStart = in.getPosition();
         const uint64_t read = entryStart - start;
+        const uint64_t left = sizeBound_bytes > read ? sizeBound_bytes - read : 0;
         try {
-            obj = readBounded(arch, guard, sizeBound_bytes > read ? sizeBound_bytes - read : 0,
-                              entryName());
+            const RawlogStreamGuard::Header h = guard.peekHeader();
+            if (h.bytes == 0) break;  // clean end, between two entries
+            obj = readBounded(guard, left, entryName(), [&] {
+                return isActionCollection(h)
+                           ? readActionCollection(arch, guard, h, left, entryName())
+                           : arch.ReadObject();
+            });
         } catch (const RefusedEntry&) {
             throw;
         } catch (const mrpt::serialization::CExceptionEOF&) {

@@ -1,29 +1,33 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #include "RawlogStreamGuard.h"
 
+#include <mrpt/obs/CAction.h>
+#include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/poses/CPosePDF.h>
 #include <mrpt/rtti/CObject.h>
 
 #include <algorithm>
+#include <cstring>
 #include <stdexcept>
 
 namespace {
-const std::string kActionClass = "CActionRobotMovement2D";  // the name MRPT resolves, any prefix
-constexpr size_t kMaxClassName = 120;                       // MRPT refuses longer names
-constexpr size_t kRecentBytes = 2 * (kMaxClassName + 8);    // an old-framing header fits twice
+constexpr size_t kMaxClassName = 120;  // MRPT refuses longer names
 
-bool isAction(const uint8_t* name, size_t length) {
-    const auto* cls =
-        mrpt::rtti::findRegisteredClass(std::string(reinterpret_cast<const char*>(name), length));
-    return cls == CLASS_ID(mrpt::obs::CActionRobotMovement2D);
+int32_t int32At(const uint8_t* p) {
+    int32_t v;
+    std::memcpy(&v, p, 4);
+    return v;
 }
 }  // namespace
 
 size_t RawlogStreamGuard::Read(void* buffer, size_t count) {
-    const size_t n = m_in.Read(buffer, count);
-    const auto* bytes = static_cast<const uint8_t*>(buffer);
-    for (size_t i = 0; i < n; i++) watch(bytes[i]);
+    auto* out = static_cast<uint8_t*>(buffer);
+    size_t n = std::min(count, m_peeked.size());
+    std::copy_n(m_peeked.begin(), n, out);
+    m_peeked.erase(m_peeked.begin(), m_peeked.begin() + long(n));
+    if (n < count) n += m_in.Read(out + n, count - n);
+    observe(out, n);
     return n;
 }
 
@@ -32,75 +36,121 @@ size_t RawlogStreamGuard::Write(const void*, size_t) {
 }
 
 uint64_t RawlogStreamGuard::Seek(int64_t offset, TSeekOrigin origin) {
-    m_recent.clear();
-    m_readingPoseChange = false;
+    m_peeked.clear();
+    m_step = Step::Idle;
+    m_expect = Expect::Nothing;
     return m_in.Seek(offset, origin);
 }
 
-void RawlogStreamGuard::watch(uint8_t byte) {
-    if (m_recent.size() >= 2 * kRecentBytes)
-        m_recent.erase(m_recent.begin(), m_recent.end() - kRecentBytes);
-    m_recent.push_back(byte);
-    if (m_readingPoseChange) {
-        m_poseChange.push_back(byte);
-        checkPoseChangeHeader();
-    } else if (byte <= 1 && endsOldActionHeader()) {
-        m_readingPoseChange = true;
-        m_poseChange.clear();
-    }
-}
-
-bool RawlogStreamGuard::endsOldActionHeader() {
-    const size_t n = m_recent.size();
-    const uint8_t* r = m_recent.data();
-    const size_t s = kActionClass.size();
-    auto nameEndsAt = [&](size_t end) {
-        return end >= s && std::equal(kActionClass.begin(), kActionClass.end(), r + end - s);
+RawlogStreamGuard::Header RawlogStreamGuard::peekHeader() {
+    Header h;
+    // Appends k bytes of the stream to m_peeked; false if it ends first.
+    auto take = [&](size_t k) {
+        const size_t start = m_peeked.size();
+        m_peeked.resize(start + k);
+        const size_t got = k ? m_in.Read(m_peeked.data() + start, k) : 0;
+        m_peeked.resize(start + got);
+        h.bytes = m_peeked.size();
+        return got == k;
     };
-    // MRPT >= 0.5.5: [0x80 | name length] [name] [int8 version]
-    if (nameEndsAt(n - 1)) {
-        for (size_t len = s; len <= kMaxClassName && len + 2 <= n; len++)
-            if (r[n - 2 - len] == (0x80 | len) && isAction(r + n - 1 - len, len)) {
-                m_actionVersion = r[n - 1];
-                return true;
-            }
+    const size_t at = m_peeked.size();
+    if (!take(1)) return h;
+    const uint8_t first = m_peeked[at];
+    h.oldFraming = !(first & 0x80);
+    const size_t length = first & 0x7F;
+    if (length == 0 || length > kMaxClassName) return h;
+    if (h.oldFraming &&
+        (!take(3) || m_peeked[at + 1] != 0 || m_peeked[at + 2] != 0 || m_peeked[at + 3] != 0))
+        return h;
+    const size_t nameAt = m_peeked.size();
+    if (!take(length)) return h;
+    h.className.assign(m_peeked.begin() + long(nameAt), m_peeked.end());
+    if (h.oldFraming) {
+        if (!take(4)) return h;
+        h.version = int32At(m_peeked.data() + m_peeked.size() - 4);
+    } else if (h.className != "nullptr") {
+        if (!take(1)) return h;
+        h.version = int8_t(m_peeked.back());
     }
-    // Before: [name length as int32] [name] [int32 version]
-    if (n >= 4 && r[n - 1] == 0 && r[n - 2] == 0 && r[n - 3] == 0 && r[n - 4] <= 1 &&
-        nameEndsAt(n - 4)) {
-        for (size_t len = s; len <= kMaxClassName && len + 8 <= n; len++) {
-            const uint8_t* h = r + n - 8 - len;
-            if (h[0] == len && h[1] == 0 && h[2] == 0 && h[3] == 0 && isAction(h + 4, len)) {
-                m_actionVersion = r[n - 4];
-                return true;
-            }
-        }
-    }
-    return false;
+    h.complete = true;
+    return h;
 }
 
-void RawlogStreamGuard::checkPoseChangeHeader() {
-    const std::vector<uint8_t>& h = m_poseChange;
-    const bool newFraming = h[0] & 0x80;
-    const size_t nameLength = newFraming ? (h[0] & 0x7F) : h[0];
-    const size_t nameStart = newFraming ? 1 : 4;
-    if (!newFraming && h.size() >= 2 && h.size() <= 4 && h.back() != 0) {
-        m_readingPoseChange = false;  // not an object header: MRPT refuses it
+void RawlogStreamGuard::observe(const uint8_t* d, size_t n) {
+    // Version >= 2 of a CActionRobotMovement2D: its first field, the estimation method, says
+    // whether a pose change object follows (not for odometry, 0).
+    if (m_expect == Expect::EstimationMethod && m_step == Step::Idle) {
+        m_expect = n == 4 && int32At(d) != 0 ? Expect::PoseChange : Expect::Nothing;
+        if (n == 4) return;
+    }
+    const Step step = m_step;
+    m_step = Step::Idle;
+    switch (step) {
+        case Step::NewName:
+        case Step::OldName:
+            if (n == m_nameLength) {
+                m_name.assign(reinterpret_cast<const char*>(d), n);
+                if (step == Step::OldName)
+                    m_step = Step::OldVersion;
+                else if (m_name == "nullptr")
+                    headerRead(m_name, -1);
+                else
+                    m_step = Step::NewVersion;
+                return;
+            }
+            break;
+        case Step::OldZeros:
+            if (n == 3 && d[0] == 0 && d[1] == 0 && d[2] == 0) {
+                m_step = Step::OldName;
+                return;
+            }
+            break;
+        case Step::NewVersion:
+            if (n == 1) return headerRead(m_name, int8_t(d[0]));
+            break;
+        case Step::OldVersion:
+            if (n == 4) return headerRead(m_name, int32At(d));
+            break;
+        case Step::Idle:
+            break;
+    }
+    // Not the next step of a header: perhaps the first byte of one.
+    m_nameLength = n == 1 ? d[0] & 0x7F : 0;
+    if (m_nameLength > 0 && m_nameLength <= kMaxClassName)
+        m_step = (d[0] & 0x80) ? Step::NewName : Step::OldZeros;
+    else if (m_expect == Expect::PoseChange)
+        m_expect = Expect::Nothing;  // not a header where one was due: MRPT fails on it
+}
+
+void RawlogStreamGuard::headerRead(const std::string& className, int version) {
+    const Expect expect = m_expect;
+    const bool allowed = m_actionAllowed;
+    m_expect = Expect::Nothing;
+    m_actionAllowed = false;
+    const bool null = className == "nullptr";
+    const auto* cls = null ? nullptr : mrpt::rtti::findRegisteredClass(className);
+    if (expect == Expect::PoseChange) {
+        const std::string what = "a 2D odometry action of serialization version " +
+                                 std::to_string(m_actionVersion) + " ";
+        if (null) refuse(what + "has no pose change (a null object)");
+        if (cls && !cls->derivedFrom(CLASS_ID(mrpt::poses::CPosePDF)))
+            refuse(what + "holds a " + cls->className + " where its pose change PDF belongs");
         return;
     }
-    if (nameLength > kMaxClassName) m_readingPoseChange = false;  // MRPT refuses it
-    if (!m_readingPoseChange || h.size() < nameStart + nameLength) return;
-    m_readingPoseChange = false;
-    const std::string name(h.begin() + nameStart, h.end());
-    const std::string what =
-        "a 2D odometry action of serialization version " + std::to_string(m_actionVersion) + " ";
-    if (name == "nullptr") {
-        m_refusal = what + "has no pose change (a null object)";
-        throw std::runtime_error(m_refusal);
+    if (!cls) return;  // null, or not registered (MRPT refuses it)
+    const bool action = cls->derivedFrom(CLASS_ID(mrpt::obs::CAction));
+    if (!action && cls != CLASS_ID(mrpt::obs::CActionCollection)) return;
+    if (!allowed || !action)
+        refuse(std::string("a ") + cls->className +
+               " where no action belongs (actions are read only as the entries of a rawlog's "
+               "action collections)");
+    if (cls == CLASS_ID(mrpt::obs::CActionRobotMovement2D)) {
+        m_actionVersion = version;
+        m_expect = version <= 1 ? Expect::PoseChange : Expect::EstimationMethod;
     }
-    const auto* cls = mrpt::rtti::findRegisteredClass(name);
-    if (cls && !cls->derivedFrom(CLASS_ID(mrpt::poses::CPosePDF))) {
-        m_refusal = what + "holds a " + cls->className + " where its pose change PDF belongs";
-        throw std::runtime_error(m_refusal);
-    }
+}
+
+void RawlogStreamGuard::refuse(const std::string& why) {
+    m_refusal = why;
+    throw std::runtime_error(why);
 }

@@ -7,18 +7,23 @@
 #include <string>
 #include <vector>
 
-/** A read-only view of a stream that refuses, before MRPT dereferences it, the content that
- * crashes MRPT 2.5's deserializers (doc/reliability.md, finding 14): a CActionRobotMovement2D of
- * serialization version 0 or 1 whose pose change is null or not a pose PDF. For those versions
- * MRPT's serializeFrom reads the pose change and then calls getMean() on it, null or not.
+/** The stream MRPT reads rawlogs and simplemaps through: it refuses, before MRPT dereferences
+ * it, the content that crashes MRPT 2.5's deserializers (doc/reliability.md, finding 14). MRPT
+ * assigns what it read for an action of a CActionCollection, and for the pose change of a
+ * CActionRobotMovement2D, to a deepcopy_poly_ptr, whose assignment clones through the pointer
+ * without checking it: an object there that is null or of another class (cast to null) is a
+ * SIGSEGV. MRPT reads any class wherever an object is stored, so such an action can sit in a
+ * sensory frame or a simplemap too.
  *
- * The bytes are watched as MRPT reads them, so the action is caught wherever it sits (an action
- * collection, an observation slot of a sensory frame, a simplemap): on an object header of that
- * class (any class name MRPT resolves to it, new or pre-0.5.5 framing) with version 0 or 1, the
- * next object header is parsed; if it names no pose PDF the read throws, before MRPT gets the
- * bytes. MRPT replaces the text of errors inside nested objects by "EOF", so refusal() keeps it.
- * A false alarm needs the exact header bytes (24 or more) inside other data, followed by bytes
- * that are no pose PDF header. */
+ * The guard sees every object header MRPT reads (MRPT reads one as a 1-byte read of the name
+ * length, a read of that many bytes of name, the version; or the pre-0.5.5 framing) and refuses:
+ * - an action or action collection except the actions RawlogSource reads itself, one by one, as
+ *   the entries of a top-level action collection (allowNextAction());
+ * - a CActionRobotMovement2D whose pose change object (read for serialization versions 0 and 1,
+ *   and for later ones when the estimation method is not odometry) is null or not a CPosePDF.
+ * A refusal throws from Read(), before MRPT has the bytes; refusal() keeps its text (MRPT
+ * replaces the text of errors inside nested objects by "EOF"). A false alarm needs a 1-byte
+ * read followed by a read of exactly that many bytes that name an action class. */
 class RawlogStreamGuard : public mrpt::io::CStream {
 public:
     explicit RawlogStreamGuard(mrpt::io::CStream& in) : m_in(in) {}
@@ -27,22 +32,43 @@ public:
     size_t Write(const void* buffer, size_t count) override;  // throws: read-only
     uint64_t Seek(int64_t offset, TSeekOrigin origin = sFromBeginning) override;
     uint64_t getTotalBytesCount() const override { return m_in.getTotalBytesCount(); }
-    uint64_t getPosition() const override { return m_in.getPosition(); }
+    /** The position of the next byte MRPT will get (peeked bytes not yet served excluded). */
+    uint64_t getPosition() const override { return m_in.getPosition() - m_peeked.size(); }
+
+    /** The header of the next object, read ahead and served again by the next reads. */
+    struct Header {
+        size_t bytes = 0;         //!< header bytes available (0: the stream ended)
+        bool complete = false;    //!< a whole header was read
+        bool oldFraming = false;  //!< MRPT before 0.5.5: no end-of-object flag
+        std::string className;    //!< "nullptr" for a null object
+        int version = -1;
+    };
+    Header peekHeader();
+    /** Drops the peeked bytes (the caller parsed the header itself). */
+    void dropPeeked() { m_peeked.clear(); }
+    /** The next object header may be an action (RawlogSource reads the actions of a top-level
+     * collection one by one). */
+    void allowNextAction() { m_actionAllowed = true; }
 
     /** Why the last read was refused ("" if none was). */
     const std::string& refusal() const { return m_refusal; }
 
 private:
-    void watch(uint8_t byte);
-    /** Whether the bytes just read end an object header of CActionRobotMovement2D whose version
-     * is 0 or 1; sets m_actionVersion. */
-    bool endsOldActionHeader();
-    void checkPoseChangeHeader();
+    void observe(const uint8_t* data, size_t n);
+    void headerRead(const std::string& className, int version);
+    [[noreturn]] void refuse(const std::string& why);
 
     mrpt::io::CStream& m_in;
-    std::vector<uint8_t> m_recent;      // the last bytes read (at least 128 of them)
-    bool m_readingPoseChange = false;   // inside the pose change's object header
-    std::vector<uint8_t> m_poseChange;  // its header bytes so far
+    std::vector<uint8_t> m_peeked;  // read ahead by peekHeader(), served first
+    // Header recognition over the sequence of reads.
+    enum class Step { Idle, NewName, OldZeros, OldName, NewVersion, OldVersion };
+    Step m_step = Step::Idle;
+    size_t m_nameLength = 0;
+    std::string m_name;
+    // What the next reads must be.
+    enum class Expect { Nothing, EstimationMethod, PoseChange };
+    Expect m_expect = Expect::Nothing;
     int m_actionVersion = 0;
+    bool m_actionAllowed = false;
     std::string m_refusal;
 };

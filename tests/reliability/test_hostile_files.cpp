@@ -82,18 +82,9 @@ struct RunResult {
     double seconds;
 };
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define MULTIBIN_TEST_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(MULTIBIN_TEST_ASAN)
-// ASan reserves terabytes of shadow address space: no address-space limit there (the read
-// budget works the same, through ASan's allocator).
-const std::string kLimit = "";
-#else
-const std::string kLimit = "ulimit -v 1048576; ";  // 1 GB address space
-#endif
+/** The shell prefix that applies the address-space limit (ulimit -v counts KiB). */
+const std::string kLimit =
+    kAddressSpaceLimit ? "ulimit -v " + std::to_string(kAddressSpaceLimit_bytes >> 10) + "; " : "";
 
 /** elevation-mapper with `ini` (default: the shipped walk.ini) on `input`, under a 1 GB
  * address-space limit. */
@@ -165,12 +156,15 @@ TEST(HostileFiles, NullOrNonFiniteOdometryIsAnError) {
     expectOneLineError(runMapper("--rawlog", inf, dir), inf, "the odometry is not finite");
 }
 
-// A 2D odometry action of serialization version 0 or 1 whose pose change is null or not a pose
-// PDF: MRPT 2.5's CActionRobotMovement2D::serializeFrom calls getMean() on the null pointer
-// (finding 14, SIGSEGV inside MRPT before). Refused wherever the action sits: in an action
-// collection, in a sensory frame's observation slot, in a simplemap; new and old framing.
-TEST(HostileFiles, AnOldOdometryActionWithoutAPosePdfIsAnErrorNotACrash) {
-    const fs::path dir = scratchDir("hostile_old_odometry");
+// MRPT 2.5 assigns the object it read for an action of an action collection, and for the pose
+// change of a 2D odometry action, to a deepcopy_poly_ptr that clones through it unchecked: a
+// null object or one of another class there was a SIGSEGV inside MRPT (finding 14). Refused
+// before MRPT reads it: an action slot holding a null, a pose or another collection; a pose
+// change that is null or a pose (versions 0 and 1 always read one; later versions when the
+// estimation method is not odometry), new and pre-0.5.5 framing, the class named with or without
+// its namespace; an action where only observations belong (a sensory frame, a simplemap).
+TEST(HostileFiles, AnActionOrPoseChangeThatIsNullOrOfAnotherClassIsAnErrorNotACrash) {
+    const fs::path dir = scratchDir("hostile_actions");
     mrpt::obs::CActionRobotMovement2D move;
     move.computeFromOdometry(mrpt::poses::CPose2D(0.1, 0, 0), {});
     mrpt::obs::CActionCollection acts;
@@ -178,57 +172,69 @@ TEST(HostileFiles, AnOldOdometryActionWithoutAPosePdfIsAnErrorNotACrash) {
     const Bytes moveBytes =
         bytesOf(mrpt::obs::CAction::Ptr(std::make_shared<mrpt::obs::CActionRobotMovement2D>(move)));
     const Bytes good = bytesOf(acts) + sensoryFrameWith(scan(50));
-    const std::string cls = move.GetRuntimeClass()->className;
-    const Bytes odometry(4, '\0');  // int32 0: emOdometry, the branch that dereferences
-    // version byte, pose change object, estimation method, MRPT's end-of-object flag (0x88)
-    auto v0 = [&](const std::string& name, char version, const Bytes& pdf) {
-        return Bytes(1, char(0x80 | name.size())) + name + Bytes(1, version) + pdf + odometry +
-               Bytes(1, char(0x88));
+    auto inCollection = [&](const Bytes& action) {
+        return good + spliced(bytesOf(acts), moveBytes, action) + sensoryFrameWith(scan(50));
     };
-    // MRPT before 0.5.5: length as int32 (high bit clear), int32 version, no end flag.
-    const Bytes oldFraming = Bytes(1, char(cls.size())) + Bytes(3, '\0') + cls + Bytes(4, '\0') +
-                             nullObject() + odometry;
-    const std::string shortName = "CActionRobotMovement2D";  // MRPT also finds it without namespace
-    const std::vector<std::pair<std::string, Bytes>> actions = {
-        {"null", v0(cls, 0, nullObject())},
-        {"pose", v0(cls, 1, poseObject())},
-        {"short", v0(shortName, 0, nullObject())},
-        {"old", oldFraming}};
-    for (const auto& [name, action] : actions) {
+    const std::string cls = move.GetRuntimeClass()->className;
+    const Bytes int32Zero(4, '\0');      // the estimation method 0: odometry
+    const Bytes endFlag(1, char(0x88));  // MRPT's end-of-object flag
+    // Versions 0 and 1: the pose change object, then the estimation method.
+    auto v0 = [&](const std::string& name, char version, const Bytes& pdf) {
+        return Bytes(1, char(0x80 | name.size())) + name + Bytes(1, version) + pdf + int32Zero +
+               endFlag;
+    };
+    // Version 7, estimation method 1 (scan matching): the pose change object follows; then no
+    // velocities, no encoders, a timestamp.
+    const Bytes v7 = Bytes(1, char(0x80 | cls.size())) + cls + Bytes(1, 7) + Bytes(1, 1) +
+                     Bytes(3, '\0') + nullObject() + Bytes(2, '\0') + Bytes(8, '\0') + endFlag;
+    // MRPT before 0.5.5: the name length as int32 (high bit clear), int32 version, no end flag.
+    const Bytes oldFraming =
+        Bytes(1, char(cls.size())) + Bytes(3, '\0') + cls + int32Zero + nullObject() + int32Zero;
+    const std::string shortName = "CActionRobotMovement2D";  // MRPT also finds it so
+    const std::vector<std::tuple<std::string, Bytes, std::string>> cases = {
+        {"slot_null", inCollection(nullObject()), "action 0 is null, not an action"},
+        {"slot_pose", inCollection(poseObject()), "action 0 is a mrpt::poses::CPose3D"},
+        {"slot_collection", inCollection(bytesOf(mrpt::obs::CActionCollection())),
+         "action 0 is a mrpt::obs::CActionCollection"},
+        {"v0_null", inCollection(v0(cls, 0, nullObject())),
+         "2D odometry action of serialization version 0 has no pose change"},
+        {"v1_pose", inCollection(v0(cls, 1, poseObject())),
+         "version 1 holds a mrpt::poses::CPose3D where its pose change PDF belongs"},
+        {"v0_short_name", inCollection(v0(shortName, 0, nullObject())),
+         "version 0 has no pose change"},
+        {"v0_old_framing", inCollection(oldFraming), "version 0 has no pose change"},
+        {"v7_null", inCollection(v7), "version 7 has no pose change"}};
+    for (const auto& [name, bytes, what] : cases) {
         SCOPED_TRACE(name);
         const fs::path f = dir / (name + ".rawlog");
-        write(f, good + spliced(bytesOf(acts), moveBytes, action) + sensoryFrameWith(scan(50)));
-        expectOneLineError(runMapper("--rawlog", f, dir), f,
-                           "2D odometry action of serialization version");
+        write(f, bytes);
+        expectOneLineError(runMapper("--rawlog", f, dir), f, what);
     }
-    // The same action where an observation belongs (MRPT reads any class there first).
+    // An action where an observation belongs (MRPT reads any class there, then casts).
     const auto obs = scan(50);
-    const Bytes frame = sensoryFrameWith(obs);
+    const Bytes obsBytes = bytesOf(mrpt::obs::CObservation::Ptr(obs));
     const fs::path inFrame = dir / "in_frame.rawlog";
-    write(inFrame, good + spliced(frame, bytesOf(mrpt::obs::CObservation::Ptr(obs)),
-                                  v0(cls, 0, nullObject())));
+    write(inFrame, good + spliced(sensoryFrameWith(obs), obsBytes, v0(cls, 0, nullObject())));
     expectOneLineError(runMapper("--rawlog", inFrame, dir), inFrame,
-                       "2D odometry action of serialization version 0");
+                       "entry 2: a mrpt::obs::CActionRobotMovement2D where no action belongs");
     auto sf = mrpt::obs::CSensoryFrame::Create();
     sf->insert(obs);
     mrpt::maps::CSimpleMap sm;
     sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), sf);
     const fs::path inSimplemap = dir / "in.simplemap";
-    write(inSimplemap, spliced(bytesOf(sm), bytesOf(mrpt::obs::CObservation::Ptr(obs)),
-                               v0(cls, 0, nullObject())));
+    write(inSimplemap, spliced(bytesOf(sm), obsBytes, bytesOf(acts)));
     expectOneLineError(runMapper("--simplemap", inSimplemap, dir), inSimplemap,
-                       "2D odometry action of serialization version 0");
-    // Control: a version-0 action with a pose PDF is read (and used as odometry).
-    const fs::path withPdf = dir / "with_pdf.rawlog";
-    write(withPdf,
-          good +
-              spliced(bytesOf(acts), moveBytes,
-                      v0(cls, 0,
-                         bytesOf(mrpt::poses::CPosePDF::Ptr(mrpt::poses::CPosePDFGaussian::Create(
-                             mrpt::poses::CPose2D(0.1, 0, 0)))))) +
-              sensoryFrameWith(scan(50)));
-    const RunResult ok = runMapper("--rawlog", withPdf, dir);
-    EXPECT_EQ(ok.exitCode, 0) << ok.stderrText;
+                       "a mrpt::obs::CActionCollection where no action belongs");
+    // Controls: a version-0 action with a pose PDF, and a version-7 one, are read and mapped.
+    const Bytes pdf = bytesOf(mrpt::poses::CPosePDF::Ptr(
+        mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.1, 0, 0))));
+    for (const auto& [name, action] :
+         {std::pair{"v0_pdf", v0(cls, 0, pdf)}, {"v7_odometry", moveBytes}}) {
+        const fs::path f = dir / (std::string(name) + ".rawlog");
+        write(f, inCollection(action));
+        const RunResult ok = runMapper("--rawlog", f, dir);
+        EXPECT_EQ(ok.exitCode, 0) << name << ": " << ok.stderrText;
+    }
 }
 
 // A fixed window that cannot hold the data is an error naming the window, never a silent empty
