@@ -30,7 +30,9 @@ thread_local uint64_t t_largestRefused = 0;
  * too, and the sum bounds the peak. */
 inline bool refused(std::size_t n) {
     if (t_limit == 0) return false;
-    if (n <= t_limit && t_requested + n <= t_limit) {
+    const uint64_t slack = n <= ReadBudget::kSmallBytes ? ReadBudget::kSlackBytes : 0;
+    const uint64_t limit = t_limit > UINT64_MAX - slack ? UINT64_MAX : t_limit + slack;
+    if (n <= limit && t_requested + n <= limit) {
         t_requested += n;
         return false;
     }
