@@ -121,11 +121,13 @@ mrpt::serialization::CSerializable::Ptr readActionCollection(mrpt::serialization
             throw std::runtime_error("action " + std::to_string(k) + " is cut short");
         const bool null = slot.className == "nullptr";
         const auto* cls = null ? nullptr : mrpt::rtti::findRegisteredClass(slot.className);
-        if (!cls || !cls->derivedFrom(CLASS_ID(mrpt::obs::CAction)))
+        if (!cls || !cls->ptrCreateObject || !cls->derivedFrom(CLASS_ID(mrpt::obs::CAction)))
             throw RefusedEntry(where + " (an action collection): action " + std::to_string(k) +
-                               (null  ? " is null"
-                                : cls ? std::string(" is a ") + cls->className
-                                      : " is of an unregistered class") +
+                               (null   ? " is null"
+                                : !cls ? " is of an unregistered class"
+                                : !cls->ptrCreateObject
+                                    ? std::string(" is of the abstract class ") + cls->className
+                                    : std::string(" is a ") + cls->className) +
                                ", not an action");
         guard.allowNextAction();
         const auto action = std::dynamic_pointer_cast<mrpt::obs::CAction>(arch.ReadObject());

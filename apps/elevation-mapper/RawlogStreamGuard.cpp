@@ -14,6 +14,12 @@
 namespace {
 constexpr size_t kMaxClassName = 120;  // MRPT refuses longer names
 
+/** A class name as MRPT takes it: up to the first NUL of the bytes read. */
+std::string nameOf(const uint8_t* bytes, size_t n) {
+    const auto* c = reinterpret_cast<const char*>(bytes);
+    return std::string(c, std::find(c, c + n, '\0'));
+}
+
 int32_t int32At(const uint8_t* p) {
     int32_t v;
     std::memcpy(&v, p, 4);
@@ -64,7 +70,7 @@ RawlogStreamGuard::Header RawlogStreamGuard::peekHeader() {
         return h;
     const size_t nameAt = m_peeked.size();
     if (!take(length)) return h;
-    h.className.assign(m_peeked.begin() + long(nameAt), m_peeked.end());
+    h.className = nameOf(m_peeked.data() + nameAt, length);
     if (h.oldFraming) {
         if (!take(4)) return h;
         h.version = int32At(m_peeked.data() + m_peeked.size() - 4);
@@ -89,7 +95,7 @@ void RawlogStreamGuard::observe(const uint8_t* d, size_t n) {
         case Step::NewName:
         case Step::OldName:
             if (n == m_nameLength) {
-                m_name.assign(reinterpret_cast<const char*>(d), n);
+                m_name = nameOf(d, n);
                 if (step == Step::OldName)
                     m_step = Step::OldVersion;
                 else if (m_name == "nullptr")
@@ -129,6 +135,9 @@ void RawlogStreamGuard::headerRead(const std::string& className, int version) {
     m_actionAllowed = false;
     const bool null = className == "nullptr";
     const auto* cls = null ? nullptr : mrpt::rtti::findRegisteredClass(className);
+    // MRPT reads an object of an abstract class as null (and prints a line): never in a file.
+    if (cls && !cls->ptrCreateObject)
+        refuse(std::string("an object of the abstract class ") + cls->className);
     if (expect == Expect::PoseChange) {
         const std::string what = "a 2D odometry action of serialization version " +
                                  std::to_string(m_actionVersion) + " ";

@@ -19,6 +19,7 @@
  * length, a read of that many bytes of name, the version; or the pre-0.5.5 framing) and refuses:
  * - an action or action collection except the actions RawlogSource reads itself, one by one, as
  *   the entries of a top-level action collection (allowNextAction());
+ * - an object of an abstract class (MRPT reads it as null);
  * - a CActionRobotMovement2D whose pose change object (read for serialization versions 0 and 1,
  *   and for later ones when the estimation method is not odometry) is null or not a CPosePDF.
  * A refusal throws from Read(), before MRPT has the bytes; refusal() keeps its text (MRPT

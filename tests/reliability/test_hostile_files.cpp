@@ -203,7 +203,13 @@ TEST(HostileFiles, AnActionOrPoseChangeThatIsNullOrOfAnotherClassIsAnErrorNotACr
         {"v0_short_name", inCollection(v0(shortName, 0, nullObject())),
          "version 0 has no pose change"},
         {"v0_old_framing", inCollection(oldFraming), "version 0 has no pose change"},
-        {"v7_null", inCollection(v7), "version 7 has no pose change"}};
+        {"v7_null", inCollection(v7), "version 7 has no pose change"},
+        // MRPT takes a class name up to its first NUL, and reads an abstract class as null.
+        {"v0_nul_padded_name", inCollection(v0(cls + std::string("\0xyz", 4), 0, nullObject())),
+         "version 0 has no pose change"},
+        {"slot_abstract",
+         inCollection(Bytes(1, char(0x80 | 18)) + "mrpt::obs::CAction" + Bytes(1, 0) + endFlag),
+         "action 0 is of the abstract class mrpt::obs::CAction"}};
     for (const auto& [name, bytes, what] : cases) {
         SCOPED_TRACE(name);
         const fs::path f = dir / (name + ".rawlog");
