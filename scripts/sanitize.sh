@@ -10,25 +10,13 @@ build_dir=${MULTIBIN_ASAN_BUILD_DIR:-$root/build-asan}
 fuzz_seconds=${FUZZ_SECONDS:-30}
 jobs=$(nproc)
 
-# The build's packages, plus clang with its sanitizer/libFuzzer runtimes and llvm-symbolizer
-# (readable stack traces). Only missing ones are installed.
-source "$root/scripts/install-packages.sh"
-install_missing_packages "${multibin_build_packages[@]}" clang libclang-rt-14-dev llvm
-
-# Google Benchmark programs are left out (CMAKE_DISABLE_FIND_PACKAGE_benchmark): they are not run
-# here and are among the heaviest files to compile.
-# -O1 -g without NDEBUG: Eigen's and the library's assertions stay on. Every sanitizer finding is
-# fatal (-fno-sanitize-recover), so a test that triggers one fails.
+# Every sanitizer finding is fatal (-fno-sanitize-recover), so a test that triggers one fails.
+source "$root/scripts/clang-sanitizer-build.sh"
 san="-fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=all -fno-omit-frame-pointer"
-CC=clang CXX=clang++ cmake -S "$root" -B "$build_dir" -G Ninja \
-  -DCMAKE_BUILD_TYPE=Sanitize \
-  -DCMAKE_C_FLAGS_SANITIZE="-O1 -g $san" -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g $san" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DMULTIBIN_BUILD_APPS=ON -DMULTIBIN_FUZZ=ON -DCMAKE_DISABLE_FIND_PACKAGE_benchmark=ON >/dev/null
+configure_sanitizer_build "$root" "$build_dir" Sanitize "$san" "-fsanitize=address,undefined" \
+  -DMULTIBIN_BUILD_APPS=ON -DMULTIBIN_FUZZ=ON
 cmake --build "$build_dir" -j "$jobs"
 
-export ASAN_SYMBOLIZER_PATH=${ASAN_SYMBOLIZER_PATH:-$(command -v llvm-symbolizer || true)}
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/tests/reliability/lsan.supp:print_suppressions=0}
@@ -56,10 +44,6 @@ for target in map_deserialize ini_options observation_insert rawlog_read; do
     { tail -n 40 "$log"; exit 1; }
   grep -E '^#[0-9]+.*DONE' "$log" || true
   seconds=$fuzz_seconds
-  # fuzz_rawlog_read: replay only. Fuzzing it finds a crash inside MRPT 2.5 itself
-  # (CActionRobotMovement2D::serializeFrom dereferences null on a corrupt action; finding 14 in
-  # doc/reliability.md) that the reading path does not guard yet.
-  [ "$target" = rawlog_read ] && seconds=0
   if [ "$seconds" -gt 0 ]; then
     echo "== fuzz_$target: fuzz ${seconds} s"
     "$exe" -max_total_time="$seconds" -print_final_stats=1 \

@@ -8,6 +8,7 @@
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/rtti/CObject.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <stdexcept>
 
 #include "RawlogSourceGuard.h"
+#include "RawlogStreamGuard.h"
 #include "multibin/io/ErrorMessage.h"
 
 namespace {
@@ -60,24 +62,85 @@ std::string gigabytes(uint64_t bytes) {
     return b;
 }
 
-/** Reads one object under the read budget; a refused allocation becomes an error saying so
- * (built after the budget ends: the budget is spent by then). */
-mrpt::serialization::CSerializable::Ptr readBounded(mrpt::serialization::CArchive& arch,
-                                                    uint64_t bytesLeft, const std::string& where) {
+/** An entry refused by the reading path itself (its message already names the file and the
+ * entry), as opposed to an error of MRPT's to be prefixed. */
+struct RefusedEntry : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/** Runs `read` (one entry) under the read budget; a refused allocation or content the stream
+ * guard refused becomes an error saying so (built after the budget ends: the budget is spent by
+ * then). */
+template <class Read>
+mrpt::serialization::CSerializable::Ptr readBounded(const RawlogStreamGuard& guard,
+                                                    uint64_t bytesLeft, const std::string& where,
+                                                    const Read& read) {
     uint64_t asked = 0;
     {
         ReadBudget budget(ReadBudget::limitFor(bytesLeft));
         try {
-            return arch.ReadObject();
+            return read();
         } catch (const std::exception&) {
             asked = ReadBudget::largestRefused();
-            if (asked == 0) throw;
+            if (asked == 0 && guard.refusal().empty()) throw;
         }
     }
-    throw std::runtime_error(where +
-                             " declares more data than the file holds: reading it asked for " +
-                             gigabytes(asked) + " in all, more than 64 MiB + 16 x the " +
-                             std::to_string(bytesLeft) + " bytes left");
+    if (asked == 0) throw RefusedEntry(where + ": " + guard.refusal());
+    throw RefusedEntry(where + " declares more data than the file holds: reading it asked for " +
+                       gigabytes(asked) + " in all, more than 64 MiB + 16 x the " +
+                       std::to_string(bytesLeft) + " bytes left");
+}
+
+bool isActionCollection(const RawlogStreamGuard::Header& h) {
+    return h.complete && h.className != "nullptr" &&
+           mrpt::rtti::findRegisteredClass(h.className) == CLASS_ID(mrpt::obs::CActionCollection);
+}
+
+/** A top-level action collection (its header peeked as `h`), read here action by action: MRPT
+ * assigns each action it reads to a pointer that clones through it unchecked, so a slot that
+ * holds a null object or another class is refused before MRPT reads it (finding 14). */
+mrpt::serialization::CSerializable::Ptr readActionCollection(mrpt::serialization::CArchive& arch,
+                                                             RawlogStreamGuard& guard,
+                                                             const RawlogStreamGuard::Header& h,
+                                                             uint64_t bytesLeft,
+                                                             const std::string& where) {
+    guard.dropPeeked();
+    if (h.version != 0)
+        throw std::runtime_error("an action collection of unknown serialization version " +
+                                 std::to_string(h.version));
+    uint32_t n = 0;
+    arch >> n;
+    if (n > bytesLeft)
+        throw RefusedEntry(where + " (an action collection) declares " + std::to_string(n) +
+                           " actions, more than the " + std::to_string(bytesLeft) +
+                           " bytes left can hold");
+    auto acts = mrpt::obs::CActionCollection::Create();
+    for (uint32_t k = 0; k < n; k++) {
+        const RawlogStreamGuard::Header slot = guard.peekHeader();
+        if (!slot.complete)
+            throw std::runtime_error("action " + std::to_string(k) + " is cut short");
+        const bool null = slot.className == "nullptr";
+        const auto* cls = null ? nullptr : mrpt::rtti::findRegisteredClass(slot.className);
+        if (!cls || !cls->ptrCreateObject || !cls->derivedFrom(CLASS_ID(mrpt::obs::CAction)))
+            throw RefusedEntry(where + " (an action collection): action " + std::to_string(k) +
+                               (null   ? " is null"
+                                : !cls ? " is of an unregistered class"
+                                : !cls->ptrCreateObject
+                                    ? std::string(" is of the abstract class ") + cls->className
+                                    : std::string(" is a ") + cls->className) +
+                               ", not an action");
+        guard.allowNextAction();
+        const auto action = std::dynamic_pointer_cast<mrpt::obs::CAction>(arch.ReadObject());
+        if (!action) throw std::runtime_error("action " + std::to_string(k) + " is not an action");
+        acts->insert(*action);
+    }
+    if (!h.oldFraming) {
+        uint8_t endFlag = 0;
+        arch >> endFlag;
+        if (endFlag != 0x88)  // MRPT's SERIALIZATION_END_FLAG
+            throw std::runtime_error("the action collection's end-of-object flag is missing");
+    }
+    return acts;
 }
 
 bool finitePose(const mrpt::poses::CPose3D& p) {
@@ -102,7 +165,8 @@ size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& vis
 size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& name,
                                      uint64_t sizeBound_bytes, const Visitor& visit,
                                      const Progress& progress) {
-    auto arch = mrpt::serialization::archiveFrom(in);
+    RawlogStreamGuard guard(in);
+    auto arch = mrpt::serialization::archiveFrom(guard);
     const uint64_t start = in.getPosition();
     mrpt::poses::CPose3DPDFGaussian pose;  // latest CObservationRobotPose, or odometry
     bool poseHasCov = false;
@@ -127,17 +191,21 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
         mrpt::serialization::CSerializable::Ptr obj;
         const uint64_t entryStart = in.getPosition();
         const uint64_t read = entryStart - start;
+        const uint64_t left = sizeBound_bytes > read ? sizeBound_bytes - read : 0;
         try {
-            obj =
-                readBounded(arch, sizeBound_bytes > read ? sizeBound_bytes - read : 0, entryName());
+            const RawlogStreamGuard::Header h = guard.peekHeader();
+            if (h.bytes == 0) break;  // clean end, between two entries
+            obj = readBounded(guard, left, entryName(), [&] {
+                return isActionCollection(h)
+                           ? readActionCollection(arch, guard, h, left, entryName())
+                           : arch.ReadObject();
+            });
+        } catch (const RefusedEntry&) {
+            throw;
         } catch (const mrpt::serialization::CExceptionEOF&) {
             if (in.getPosition() == entryStart) break;  // clean end, between two entries
             throw std::runtime_error(name + " is truncated inside entry " +
                                      std::to_string(entries));
-        } catch (const std::runtime_error& e) {
-            if (ReadBudget::largestRefused() > 0) throw;  // already names the entry
-            throw std::runtime_error(name + " is truncated or corrupt at entry " +
-                                     std::to_string(entries) + ": " + multibin::oneLineMessage(e));
         } catch (const std::exception& e) {
             throw std::runtime_error(name + " is truncated or corrupt at entry " +
                                      std::to_string(entries) + ": " + multibin::oneLineMessage(e));
@@ -207,18 +275,21 @@ mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const 
                                                    uint64_t sizeBound_bytes) {
     mrpt::maps::CSimpleMap sm;
     uint64_t asked = 0;
+    RawlogStreamGuard guard(in);
     try {
         ReadBudget budget(ReadBudget::limitFor(sizeBound_bytes));
         try {
-            auto arch = mrpt::serialization::archiveFrom(in);
+            auto arch = mrpt::serialization::archiveFrom(guard);
             arch >> sm;
         } catch (const std::exception&) {
             asked = ReadBudget::largestRefused();
-            if (asked == 0) throw;
+            if (asked == 0 && guard.refusal().empty()) throw;
         }
     } catch (const std::exception& e) {
         throw std::runtime_error(name + " is truncated or corrupt: " + multibin::oneLineMessage(e));
     }
+    if (asked == 0 && !guard.refusal().empty())
+        throw std::runtime_error(name + ": " + guard.refusal());
     if (asked > 0)
         throw std::runtime_error(name +
                                  " declares more data than the file holds: reading it asked for " +

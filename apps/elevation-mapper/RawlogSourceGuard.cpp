@@ -24,18 +24,28 @@ namespace {
 thread_local uint64_t t_limit = 0;      // 0: no budget on this thread
 thread_local uint64_t t_requested = 0;  // sum of the requests since the budget began
 thread_local uint64_t t_largestRefused = 0;
+thread_local bool t_errorPathRoom = false;  // the first refusal raised the limit
 
 /** Whether a request of n bytes is refused (and records it). The sum of all requests is
  * bounded, frees not subtracted: containers that grow in small blocks (std::deque) are bounded
- * too, and the sum bounds the peak. */
+ * too, and the sum bounds the peak. MRPT allocates on its error path where std::bad_alloc is
+ * std::terminate (inside throw expressions, in what()): small requests get kSlackBytes more,
+ * and the first refusal gives the error path kSlackBytes beyond what was taken (once). */
 inline bool refused(std::size_t n) {
     if (t_limit == 0) return false;
-    if (n <= t_limit && t_requested + n <= t_limit) {
+    auto plus = [](uint64_t a, uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; };
+    const uint64_t limit =
+        n <= ReadBudget::kSmallBytes ? plus(t_limit, ReadBudget::kSlackBytes) : t_limit;
+    if (n <= limit && t_requested + n <= limit) {
         t_requested += n;
         return false;
     }
     const uint64_t asked = t_requested + n;
     if (asked > t_largestRefused) t_largestRefused = asked;
+    if (!t_errorPathRoom) {
+        t_errorPathRoom = true;
+        t_limit = plus(t_limit > t_requested ? t_limit : t_requested, ReadBudget::kSlackBytes);
+    }
     return true;
 }
 }  // namespace
@@ -48,6 +58,7 @@ ReadBudget::ReadBudget(uint64_t limitBytes) : m_previous(t_limit) {
     t_limit = limitBytes == 0 ? 1 : limitBytes;
     t_requested = 0;
     t_largestRefused = 0;
+    t_errorPathRoom = false;
 }
 ReadBudget::~ReadBudget() { t_limit = m_previous; }
 uint64_t ReadBudget::largestRefused() { return t_largestRefused; }

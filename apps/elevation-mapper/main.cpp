@@ -157,6 +157,14 @@ std::string insertSummary(const multibin::InsertStats& s) {
     return buf;
 }
 
+/** The grid window's extent, for messages. */
+std::string windowText(const CMultiBinElevationMap& map) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "x %.6g..%.6g m, y %.6g..%.6g m", map.getXMin(), map.getXMax(),
+                  map.getYMin(), map.getYMax());
+    return buf;
+}
+
 /** The matplotlib script that draws the figures: beside the sources, or installed. */
 std::string plotScript() {
     for (const fs::path& p :
@@ -307,9 +315,18 @@ int run(const Arguments& args) {
     }
     bar.finish("done");
     std::cout << tally.report();
-    if (elevation->insertStats().accepted == 0)
-        throw std::runtime_error(inputName + ": " +
-                                 tally.whyNothingFused(elevation->insertStats()));
+    const multibin::InsertStats& fused = elevation->insertStats();
+    if (fused.accepted == 0 && fused.outsideMap > 0)
+        throw std::runtime_error(inputName + ": the map's window (" + windowText(*elevation) +
+                                 ") does not hold the data: " + std::to_string(fused.outsideMap) +
+                                 " points fell outside it, none inside (check grow, max_size_m, "
+                                 "min_x_m..max_y_m, resolution_m); " +
+                                 tally.whyNothingFused(fused));
+    if (fused.accepted == 0)
+        throw std::runtime_error(inputName + ": " + tally.whyNothingFused(fused));
+    if (!elevation->creationOptions.grow && fused.outsideMap > 0)
+        std::cout << "note: " << fused.outsideMap << " points fell outside the fixed window ("
+                  << windowText(*elevation) << ")\n";
 
     elevation->flushLocalToGlobal();  // dual grid: the global grid holds the whole run
     const auto fill0 = Clock::now();

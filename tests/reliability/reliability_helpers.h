@@ -9,6 +9,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -19,7 +20,24 @@
 #include "../core/test_scenes.h"
 #include "multibin/map/BinGrid.h"
 
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define MULTIBIN_TEST_ASAN 1
+#endif
+#endif
+
 namespace reliability {
+
+/** Whether the memory-bomb tests limit the address space: not under ASan, which reserves
+ * terabytes of shadow address space (the Release build tests the limit; ASan still sees every
+ * allocation, and the read budget works the same through its allocator). */
+#if defined(__SANITIZE_ADDRESS__) || defined(MULTIBIN_TEST_ASAN)
+constexpr bool kAddressSpaceLimit = false;
+#else
+constexpr bool kAddressSpaceLimit = true;
+#endif
+/** The address-space limit of those tests [bytes]: 1 GB. */
+constexpr uint64_t kAddressSpaceLimit_bytes = uint64_t(1) << 30;
 
 /** An empty scratch directory build/test_reliability/NAME for a test's files. */
 inline std::filesystem::path scratchDir(const std::string& name) {
@@ -44,6 +62,15 @@ inline std::vector<uint8_t> serialize(const Map& map) {
     arch << map;
     const auto* p = static_cast<const uint8_t*>(mem.getRawBufferData());
     return std::vector<uint8_t>(p, p + mem.getTotalBytesCount());
+}
+
+/** Reads serialized `bytes` into `map` through CArchive, as a program loads a map file (throws
+ * what MRPT or the map throw). */
+inline void deserializeInto(Map& map, const std::vector<uint8_t>& bytes) {
+    mrpt::io::CMemoryStream mem;
+    mem.assignMemoryNotOwn(bytes.data(), bytes.size());
+    auto arch = mrpt::serialization::archiveFrom(mem);
+    arch >> map;
 }
 
 /** One bin with the cell it belongs to: (grid, ix, iy, index, height, variance, certainty). */
@@ -89,6 +116,14 @@ inline Map::TCreationOptions fixedTwoMetreMap() {
     c.grow = false;
     c.min_x = -1, c.max_x = 1, c.min_y = -1, c.max_y = 1;
     return c;
+}
+
+/** A map holding other data than mapWithData(): what serialized maps are read into, so that a
+ * read that changes it shows. */
+inline Map mapWithOtherData() {
+    Map map;
+    map.insertObservation(*floorScan(200), posePdf(0.5, 0.5));
+    return map;
 }
 
 /** A map that already holds a floor seen by one good scan. */

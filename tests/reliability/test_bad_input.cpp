@@ -10,8 +10,10 @@
 #include <mrpt/obs/CObservationStereoImages.h>
 
 #include <chrono>
+#include <functional>
 #include <limits>
 #include <string>
+#include <tuple>
 
 #include "multibin/map/BinGrid.h"
 #include "multibin/sensors/SensorDispatch.h"
@@ -219,11 +221,28 @@ TEST(BadInputScans, SingleBeamScanWithApertureIsHandled) {
     EXPECT_EQ(insertIntoMapWithData(*scan).core.notFinite, 1u);
 }
 
-TEST(BadInputScans, NaNApertureGivesNonFinitePointsOnly) {
-    // Aperture is a property the beam angles derive from: NaN makes every beam direction NaN.
+// The beam angles derive from the aperture: NaN made every beam NaN (counted as notFinite),
+// 0 put every beam on one line, 100 rad wrapped the beams round 16 times; both were used.
+TEST(BadInputScans, AnApertureThatIsNaNZeroOrOverATurnIsAnErrorAndCounted) {
+    for (const double aperture : {double(kNaN), 0.0, -1.0, 100.0}) {
+        SCOPED_TRACE(aperture);
+        auto scan = scanOfRanges(0.5f, 50);
+        scan->sensorLabel = "LASER";
+        scan->aperture = float(aperture);
+        Map map = mapWithData();
+        const auto before = serialize(map);
+        const size_t refused0 = map.sensorModelStats().laser.badAperture;
+        expectErrorMentioning([&] { map.insertObservation(*scan, posePdf()); },
+                              {"LASER", "aperture"});
+        EXPECT_EQ(map.sensorModelStats().laser.badAperture - refused0, 50u);
+        EXPECT_EQ(serialize(map), before);
+    }
+    // A full turn is a valid aperture.
     auto scan = scanOfRanges(0.5f, 50);
-    scan->aperture = kNaN;
-    EXPECT_EQ(insertIntoMapWithData(*scan).core.notFinite, 50u);
+    scan->aperture = float(2 * M_PI);
+    Map map = mapWithData();
+    EXPECT_NO_THROW(map.insertObservation(*scan, posePdf()));
+    EXPECT_EQ(map.sensorModelStats().laser.badAperture, 0u);
 }
 
 // Found by this test (was an out-of-bounds read of points3D_y/z); fixed in DepthModel.cpp.
@@ -339,6 +358,32 @@ TEST(BadInputExtent, PointsFarOutsideAFixedMapAreCounted) {
     EXPECT_EQ(serialize(map), before);
 }
 
+// A window that cannot hold the data is never a silent empty map. A growth limit smaller than
+// the growth margin put the window beside the data (max_size_m = 1 m: 0 fused), one 30 m cell
+// likewise; a fixed window far away fuses nothing and counts every point as outsideMap.
+TEST(BadInputExtent, AWindowSmallerThanItsMarginHoldsTheDataItCan) {
+    for (const auto& [maxSize_m, resolution_m] :
+         {std::pair{1.0, 0.02}, {2.0, 0.02}, {40.0, 30.0}}) {
+        SCOPED_TRACE(std::to_string(maxSize_m) + " m at " + std::to_string(resolution_m) + " m");
+        Map::TCreationOptions c;
+        c.max_size_m = maxSize_m;
+        c.resolution_m = resolution_m;
+        Map map(c);
+        map.insertObservation(*floorScan(), posePdf());
+        const multibin::InsertStats& s = map.insertStats();
+        EXPECT_GT(s.accepted, 0u) << "outside " << s.outsideMap;  // on the data, not beside it
+        EXPECT_EQ(s.accepted + s.outsideMap, map.sensorModelStats().laser.kept);
+    }
+    Map::TCreationOptions far = fixedTwoMetreMap();
+    far.resolution_m = 30;
+    far.min_x = 5e7, far.max_x = 5e7 + 1;  // within the +-1e8 m of map coordinates
+    Map map(far);
+    map.insertObservation(*floorScan(), posePdf());
+    EXPECT_EQ(map.insertStats().accepted, 0u);
+    EXPECT_EQ(map.insertStats().outsideMap, map.sensorModelStats().laser.kept);
+    EXPECT_GT(map.insertStats().outsideMap, 0u);
+}
+
 TEST(BadInputExtent, AStrayFarPointDoesNotStretchAGrowingMap) {
     Map map = mapWithData();
     const multibin::CellWindow w = map.grid().window();
@@ -445,6 +490,36 @@ TEST(BadInputStereo, ZeroCalibrationSizeIsAnError) {
     const auto before = serialize(map);
     expectErrorMentioning([&] { map.insertObservation(*obs, posePdf()); }, {"leftCamera", "zero"});
     EXPECT_EQ(serialize(map), before);
+}
+
+// A NaN principal point turned every pixel's ray to NaN: the pair was processed and its pixels
+// lost without a count. Non-finite or absurd intrinsics are an error, counted per pair.
+TEST(BadInputStereo, NonFiniteOrAbsurdIntrinsicsAreAnErrorAndCounted) {
+    const double inf = std::numeric_limits<double>::infinity();
+    const std::vector<
+        std::tuple<std::string, std::function<void(mrpt::img::TCamera&)>, std::string>>
+        cases = {{"NaN cx", [](mrpt::img::TCamera& c) { c.cx(kNaN); }, "principal point"},
+                 {"NaN cy", [](mrpt::img::TCamera& c) { c.cy(kNaN); }, "principal point"},
+                 {"cx 1e9 px", [](mrpt::img::TCamera& c) { c.cx(1e9); }, "principal point"},
+                 {"inf fx", [&](mrpt::img::TCamera& c) { c.fx(inf); }, "focal"},
+                 {"NaN fy", [](mrpt::img::TCamera& c) { c.fy(kNaN); }, "focal"}};
+    for (const auto& [name, spoil, what] : cases) {
+        SCOPED_TRACE(name);
+        auto obs = stereoPair(32, 24);
+        spoil(obs->leftCamera);
+        spoil(obs->rightCamera);
+        Map map = mapWithData();
+        const auto before = serialize(map);
+        expectErrorMentioning([&] { map.insertObservation(*obs, posePdf()); }, {what});
+        EXPECT_EQ(map.sensorModelStats().stereo.badCalibration, 1u);
+        EXPECT_EQ(map.sensorModelStats().stereo.pixels, 0u) << "no pixel is visited";
+        EXPECT_EQ(serialize(map), before);
+    }
+    auto obs = stereoPair(32, 24);
+    obs->rightCamera.cx(kNaN);
+    Map map = mapWithData();
+    expectErrorMentioning([&] { map.insertObservation(*obs, posePdf()); },
+                          {"rightCamera", "principal point"});
 }
 
 TEST(BadInputStereo, MatchingSizesAreInserted) {

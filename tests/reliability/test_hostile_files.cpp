@@ -82,25 +82,17 @@ struct RunResult {
     double seconds;
 };
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define MULTIBIN_TEST_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(MULTIBIN_TEST_ASAN)
-// ASan reserves terabytes of shadow address space: no address-space limit there (the read
-// budget works the same, through ASan's allocator).
-const std::string kLimit = "";
-#else
-const std::string kLimit = "ulimit -v 1048576; ";  // 1 GB address space
-#endif
+/** The shell prefix that applies the address-space limit (ulimit -v counts KiB). */
+const std::string kLimit =
+    kAddressSpaceLimit ? "ulimit -v " + std::to_string(kAddressSpaceLimit_bytes >> 10) + "; " : "";
 
-/** elevation-mapper with the shipped walk.ini on `input`, under a 1 GB address-space limit. */
-RunResult runMapper(const std::string& flag, const fs::path& input, const fs::path& dir) {
+/** elevation-mapper with `ini` (default: the shipped walk.ini) on `input`, under a 1 GB
+ * address-space limit. */
+RunResult runMapper(const std::string& flag, const fs::path& input, const fs::path& dir,
+                    const fs::path& ini = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini") {
     const fs::path err = dir / "stderr.txt";
-    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " +
-                            (fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini").string() +
-                            " " + flag + " " + input.string() + " --no-plots --out " +
+    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " + ini.string() + " " +
+                            flag + " " + input.string() + " --no-plots --out " +
                             (dir / "out").string() + " > " + (dir / "stdout.txt").string() +
                             " 2> " + err.string() + " < /dev/null";
     const auto t0 = std::chrono::steady_clock::now();
@@ -162,6 +154,110 @@ TEST(HostileFiles, NullOrNonFiniteOdometryIsAnError) {
     const fs::path inf = dir / "inf.rawlog";
     write(inf, good + bytesOf(infActs) + sensoryFrameWith(scan(50)));
     expectOneLineError(runMapper("--rawlog", inf, dir), inf, "the odometry is not finite");
+}
+
+// MRPT 2.5 assigns the object it read for an action of an action collection, and for the pose
+// change of a 2D odometry action, to a deepcopy_poly_ptr that clones through it unchecked: a
+// null object or one of another class there was a SIGSEGV inside MRPT (finding 14). Refused
+// before MRPT reads it: an action slot holding a null, a pose or another collection; a pose
+// change that is null or a pose (versions 0 and 1 always read one; later versions when the
+// estimation method is not odometry), new and pre-0.5.5 framing, the class named with or without
+// its namespace; an action where only observations belong (a sensory frame, a simplemap).
+TEST(HostileFiles, AnActionOrPoseChangeThatIsNullOrOfAnotherClassIsAnErrorNotACrash) {
+    const fs::path dir = scratchDir("hostile_actions");
+    mrpt::obs::CActionRobotMovement2D move;
+    move.computeFromOdometry(mrpt::poses::CPose2D(0.1, 0, 0), {});
+    mrpt::obs::CActionCollection acts;
+    acts.insert(move);
+    const Bytes moveBytes =
+        bytesOf(mrpt::obs::CAction::Ptr(std::make_shared<mrpt::obs::CActionRobotMovement2D>(move)));
+    const Bytes good = bytesOf(acts) + sensoryFrameWith(scan(50));
+    auto inCollection = [&](const Bytes& action) {
+        return good + spliced(bytesOf(acts), moveBytes, action) + sensoryFrameWith(scan(50));
+    };
+    const std::string cls = move.GetRuntimeClass()->className;
+    const Bytes int32Zero(4, '\0');      // the estimation method 0: odometry
+    const Bytes endFlag(1, char(0x88));  // MRPT's end-of-object flag
+    // Versions 0 and 1: the pose change object, then the estimation method.
+    auto v0 = [&](const std::string& name, char version, const Bytes& pdf) {
+        return Bytes(1, char(0x80 | name.size())) + name + Bytes(1, version) + pdf + int32Zero +
+               endFlag;
+    };
+    // Version 7, estimation method 1 (scan matching): the pose change object follows; then no
+    // velocities, no encoders, a timestamp.
+    const Bytes v7 = Bytes(1, char(0x80 | cls.size())) + cls + Bytes(1, 7) + Bytes(1, 1) +
+                     Bytes(3, '\0') + nullObject() + Bytes(2, '\0') + Bytes(8, '\0') + endFlag;
+    // MRPT before 0.5.5: the name length as int32 (high bit clear), int32 version, no end flag.
+    const Bytes oldFraming =
+        Bytes(1, char(cls.size())) + Bytes(3, '\0') + cls + int32Zero + nullObject() + int32Zero;
+    const std::string shortName = "CActionRobotMovement2D";  // MRPT also finds it so
+    const std::vector<std::tuple<std::string, Bytes, std::string>> cases = {
+        {"slot_null", inCollection(nullObject()), "action 0 is null, not an action"},
+        {"slot_pose", inCollection(poseObject()), "action 0 is a mrpt::poses::CPose3D"},
+        {"slot_collection", inCollection(bytesOf(mrpt::obs::CActionCollection())),
+         "action 0 is a mrpt::obs::CActionCollection"},
+        {"v0_null", inCollection(v0(cls, 0, nullObject())),
+         "2D odometry action of serialization version 0 has no pose change"},
+        {"v1_pose", inCollection(v0(cls, 1, poseObject())),
+         "version 1 holds a mrpt::poses::CPose3D where its pose change PDF belongs"},
+        {"v0_short_name", inCollection(v0(shortName, 0, nullObject())),
+         "version 0 has no pose change"},
+        {"v0_old_framing", inCollection(oldFraming), "version 0 has no pose change"},
+        {"v7_null", inCollection(v7), "version 7 has no pose change"},
+        // MRPT takes a class name up to its first NUL, and reads an abstract class as null.
+        {"v0_nul_padded_name", inCollection(v0(cls + std::string("\0xyz", 4), 0, nullObject())),
+         "version 0 has no pose change"},
+        {"slot_abstract",
+         inCollection(Bytes(1, char(0x80 | 18)) + "mrpt::obs::CAction" + Bytes(1, 0) + endFlag),
+         "action 0 is of the abstract class mrpt::obs::CAction"}};
+    for (const auto& [name, bytes, what] : cases) {
+        SCOPED_TRACE(name);
+        const fs::path f = dir / (name + ".rawlog");
+        write(f, bytes);
+        expectOneLineError(runMapper("--rawlog", f, dir), f, what);
+    }
+    // An action where an observation belongs (MRPT reads any class there, then casts).
+    const auto obs = scan(50);
+    const Bytes obsBytes = bytesOf(mrpt::obs::CObservation::Ptr(obs));
+    const fs::path inFrame = dir / "in_frame.rawlog";
+    write(inFrame, good + spliced(sensoryFrameWith(obs), obsBytes, v0(cls, 0, nullObject())));
+    expectOneLineError(runMapper("--rawlog", inFrame, dir), inFrame,
+                       "entry 2: a mrpt::obs::CActionRobotMovement2D where no action belongs");
+    auto sf = mrpt::obs::CSensoryFrame::Create();
+    sf->insert(obs);
+    mrpt::maps::CSimpleMap sm;
+    sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), sf);
+    const fs::path inSimplemap = dir / "in.simplemap";
+    write(inSimplemap, spliced(bytesOf(sm), obsBytes, bytesOf(acts)));
+    expectOneLineError(runMapper("--simplemap", inSimplemap, dir), inSimplemap,
+                       "a mrpt::obs::CActionCollection where no action belongs");
+    // Controls: a version-0 action with a pose PDF, and a version-7 one, are read and mapped.
+    const Bytes pdf = bytesOf(mrpt::poses::CPosePDF::Ptr(
+        mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.1, 0, 0))));
+    for (const auto& [name, action] :
+         {std::pair{"v0_pdf", v0(cls, 0, pdf)}, {"v7_odometry", moveBytes}}) {
+        const fs::path f = dir / (std::string(name) + ".rawlog");
+        write(f, inCollection(action));
+        const RunResult ok = runMapper("--rawlog", f, dir);
+        EXPECT_EQ(ok.exitCode, 0) << name << ": " << ok.stderrText;
+    }
+}
+
+// A fixed window that cannot hold the data is an error naming the window, never a silent empty
+// map: before, "no point fused ..." only listed "outside map N" among the rejections.
+TEST(HostileFiles, AFixedWindowThatDoesNotHoldTheDataIsAnErrorSayingSo) {
+    const fs::path dir = scratchDir("hostile_window");
+    const fs::path ini = dir / "far.ini";
+    std::string text = readAll(fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini");
+    const std::string creation = "_creationOpts]\n";
+    text.insert(text.find(creation) + creation.size(),
+                "grow = false\nmin_x_m = 1000\nmax_x_m = 1001\nmin_y_m = -1\n"
+                "max_y_m = 1\n");
+    write(ini, text);
+    const fs::path walk = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog";
+    const RunResult r = runMapper("--rawlog", walk, dir, ini);
+    expectOneLineError(r, walk, "does not hold the data");
+    EXPECT_NE(r.stderrText.find("points fell outside it"), std::string::npos) << r.stderrText;
 }
 
 // Keyframes with a null pose, a null sensory frame, a null observation: MRPT's height grids

@@ -21,14 +21,10 @@ enum class Outcome { Unchanged, Loaded, ChangedSilently, ChangedWithError };
 
 /** Reads `bytes` into a map holding other data. */
 Outcome readInto(const std::vector<uint8_t>& bytes, const std::vector<uint8_t>& original) {
-    Map target;
-    target.insertObservation(*floorScan(100), posePdf(0.5, 0.5));
+    Map target = mapWithOtherData();
     const auto before = serialize(target);
-    mrpt::io::CMemoryStream mem;
-    mem.assignMemoryNotOwn(bytes.data(), bytes.size());
-    auto arch = mrpt::serialization::archiveFrom(mem);
     try {
-        arch >> target;
+        deserializeInto(target, bytes);
     } catch (const std::exception&) {
         const auto after = serialize(target);
         if (after == before) return Outcome::Unchanged;

@@ -67,19 +67,6 @@ std::string iniWith(const std::string& creation, const std::string& insertion = 
            "\n[map_multiBinElevationMap_00_insertOpts]\n" + insertion + "\n";
 }
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define MULTIBIN_TEST_ASAN 1
-#endif
-#endif
-#if defined(__SANITIZE_ADDRESS__) || defined(MULTIBIN_TEST_ASAN)
-// ASan reserves terabytes of shadow address space: no address-space limit there (the limit is
-// tested by the Release build; ASan still sees every allocation).
-constexpr bool kAddressSpaceLimit = false;
-#else
-constexpr bool kAddressSpaceLimit = true;
-#endif
-
 /** Runs f in a child process limited to 1 GB of address space; returns its error message
  * ("" if it returned normally, "crash" if it died). */
 std::string inChildUnderOneGigabyte(const std::function<void()>& f) {
@@ -88,7 +75,7 @@ std::string inChildUnderOneGigabyte(const std::function<void()>& f) {
     const pid_t pid = fork();
     if (pid == 0) {
         close(fds[0]);
-        const rlimit lim{rlim_t(1) << 30, rlim_t(1) << 30};
+        const rlimit lim{rlim_t(kAddressSpaceLimit_bytes), rlim_t(kAddressSpaceLimit_bytes)};
         if (kAddressSpaceLimit) setrlimit(RLIMIT_AS, &lim);
         std::string msg;
         try {

@@ -47,7 +47,7 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
         fuse(bin.height_m, bin.variance_m2, other.height_m, other.variance_m2);
         mergePlaneMoments(bin.plane, other.plane);
         bin.certainty += other.certainty;
-        bin.pointCount += other.pointCount;
+        util::addSaturating(bin.pointCount, other.pointCount);
     }
     m_index.noteHeight(ix, iy, bin.height_m);
 }
@@ -183,7 +183,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
             bin.variance_m2 = static_cast<float>(run.sum.variance_m2());
         }
         for (uint32_t k = 0; k < run.points; k++) bin.certainty += params.certaintyIncrement;
-        bin.pointCount += run.points;
+        util::addSaturating(bin.pointCount, run.points);
         m_index.noteUpdate(run.slot, run.ix, run.iy, run.maxHeight_m, run.points);
         run.bin = kNoBin;
     };

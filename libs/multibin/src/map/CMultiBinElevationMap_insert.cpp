@@ -163,10 +163,15 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     obs.load();  // externally stored observations
 
     multibin::sensors::SensorPoints sensed;
-    if (!multibin::sensors::observationToSensorPoints(
-            obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-            insertionOptions.max_range_m, m_impl->sensorState, sensed))
-        return false;  // not an observation this map models
+    try {
+        if (!multibin::sensors::observationToSensorPoints(
+                obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
+                insertionOptions.max_range_m, m_impl->sensorState, sensed))
+            return false;  // not an observation this map models
+    } catch (const std::invalid_argument&) {
+        m_impl->sensorState.stats += sensed.stats;  // the refusal's counter (badAperture, ...)
+        throw;
+    }
     fixOriginNear(posePdf.mean.x(), posePdf.mean.y());
     const PointsWithCov& sensorPoints = sensed.points;
     const mrpt::poses::CPose3D& sensorPose = sensed.sensorPose;
@@ -312,8 +317,12 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
     const int maxCells =
         std::max(1, static_cast<int>(std::floor(c.max_size_m / m_impl->grid.cellSize_m())));
     auto clampAxis = [&](int curLo, int curN, int lo, int hi, int& outLo, int& outN) {
-        lo -= margin;
-        hi += margin;
+        // The margin only where the size limit leaves room: a window of max_size_m that is
+        // mostly margin lay beside the data (max_size_m = 1 m, or one 30 m cell).
+        const int room = maxCells - (hi - lo + 1);
+        const int m = std::clamp(room / 2, 0, margin);
+        lo -= m;
+        hi += m;
         if (haveWindow) {
             lo = std::min(lo, curLo);
             hi = std::max(hi, curLo + curN - 1);

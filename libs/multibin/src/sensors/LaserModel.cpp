@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "multibin/geometry/PosePropagation.h"
 
@@ -61,6 +63,15 @@ void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
     out.clear();
     out.reserve(n);
     stats.beams += n;
+    // The beam angles derive from the aperture: NaN, zero (every beam on one line), negative or
+    // more than a turn is a corrupt scan, refused whole (one beam has no spacing to derive).
+    constexpr double kFullTurn_rad = 6.283185307179586;
+    if (n >= 2 && !(scan.aperture > 0 && scan.aperture <= kFullTurn_rad * (1 + 1e-6))) {
+        stats.badAperture += n;
+        throw std::invalid_argument("CObservation2DRangeScan '" + scan.sensorLabel +
+                                    "': aperture " + std::to_string(scan.aperture) +
+                                    " rad must be in (0, 2 pi] rad");
+    }
 
     // Ranges for the mixed-pixel clustering: +inf = no return, NaN = unusable reading.
     std::vector<float> ranges(n);

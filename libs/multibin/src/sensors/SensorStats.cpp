@@ -7,15 +7,16 @@ namespace multibin::sensors {
 LaserStats& LaserStats::operator+=(const LaserStats& o) {
     return util::addMembers(*this, o, &LaserStats::beams, &LaserStats::noReturn,
                             &LaserStats::notFinite, &LaserStats::outOfRange,
-                            &LaserStats::lowIntensity, &LaserStats::mixedPixel, &LaserStats::kept);
+                            &LaserStats::lowIntensity, &LaserStats::mixedPixel, &LaserStats::kept,
+                            &LaserStats::badAperture);
 }
 
 StereoStats& StereoStats::operator+=(const StereoStats& o) {
-    return util::addMembers(*this, o, &StereoStats::pairs, &StereoStats::tableBuilds,
-                            &StereoStats::pixels, &StereoStats::notFinite,
-                            &StereoStats::noDisparity, &StereoStats::halo,
-                            &StereoStats::nearCluster, &StereoStats::tooNear,
-                            &StereoStats::outOfRange, &StereoStats::kept);
+    return util::addMembers(
+        *this, o, &StereoStats::pairs, &StereoStats::tableBuilds, &StereoStats::pixels,
+        &StereoStats::notFinite, &StereoStats::noDisparity, &StereoStats::halo,
+        &StereoStats::nearCluster, &StereoStats::tooNear, &StereoStats::outOfRange,
+        &StereoStats::kept, &StereoStats::badCalibration);
 }
 
 DepthStats& DepthStats::operator+=(const DepthStats& o) {

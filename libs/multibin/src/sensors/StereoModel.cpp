@@ -72,7 +72,21 @@ StereoGeometry StereoGeometry::fromObservation(const mrpt::obs::CObservationSter
     if (!(g.width > 0 && g.height > 0)) notRectified("leftCamera", "image size is zero");
     if (R.ncols != L.ncols || R.nrows != L.nrows)
         notRectified("rightCamera", "image size differs from leftCamera");
-    if (!(g.fx > 0 && g.fy > 0)) notRectified("leftCamera", "focal lengths must be positive");
+    if (!(g.fx > 0 && g.fy > 0 && std::isfinite(g.fx) && std::isfinite(g.fy)))
+        notRectified("leftCamera", "focal lengths must be positive and finite");
+    // A principal point that is NaN or far off the image turns every pixel's ray to NaN or into
+    // nonsense: within one image size of the image, or refused.
+    auto nearImage = [](double c_px, int size_px) {
+        return c_px >= -size_px && c_px <= 2 * size_px;
+    };
+    if (!nearImage(g.cx, g.width) || !nearImage(g.cy, g.height))
+        notRectified("leftCamera",
+                     "principal point (cx, cy) must be finite and within one image "
+                     "size of the image");
+    if (!nearImage(g.cxRight, g.width))
+        notRectified("rightCamera",
+                     "principal point cx must be finite and within one image size "
+                     "of the image");
     if (!close(R.fx(), g.fx) || !close(R.fy(), g.fy) || !close(R.cy(), g.cy))
         notRectified("rightCamera", "fx, fy and cy must equal leftCamera's");
     for (double k : L.dist)
@@ -460,7 +474,13 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
                     double minRange_m, double maxRange_m,
                     std::shared_ptr<const StereoCovarianceTable>& table, PointsWithCov& out,
                     StereoStats& stats) {
-    const StereoGeometry g = StereoGeometry::fromObservation(obs);
+    StereoGeometry g;
+    try {
+        g = StereoGeometry::fromObservation(obs);
+    } catch (const std::invalid_argument&) {
+        stats.badCalibration++;
+        throw;
+    }
     DisparityImage disp;
     if (obs.hasImageDisparity) {
         disp = decodeDisparityImage(obs.imageDisparity);

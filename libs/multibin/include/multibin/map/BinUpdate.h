@@ -6,6 +6,7 @@
 
 #include "multibin/map/Bin.h"
 #include "multibin/map/MapTypes.h"
+#include "multibin/util/Counters.h"
 
 namespace multibin {
 
@@ -56,7 +57,7 @@ inline void addMeasurement(BinEstimate& bin, double height_m, double variance_m2
     } else {
         fuse(bin.height_m, bin.variance_m2, height_m, variance_m2);
     }
-    bin.pointCount++;
+    util::addSaturating(bin.pointCount, 1u);
 }
 
 /** Adds a point at (dx_m, dy_m) from its cell's centre, height z_m, weight w = 1/var_z to the

@@ -14,6 +14,8 @@ struct LaserStats {
     size_t lowIntensity = 0;  //!< restored intensity under the threshold within the check range
     size_t mixedPixel = 0;    //!< mixed measurement at a depth discontinuity
     size_t kept = 0;          //!< turned into points
+    /** Beams of scans refused whole (an error) for their aperture: NaN, <= 0 or over a turn. */
+    size_t badAperture = 0;
     LaserStats& operator+=(const LaserStats& o);
 };
 
@@ -29,6 +31,9 @@ struct StereoStats {
     size_t tooNear = 0;      //!< depth under stereo_min_depth_m (out of the horopter)
     size_t outOfRange = 0;   //!< range outside [min_range, max_range]
     size_t kept = 0;         //!< turned into points
+    /** Pairs refused whole (an error) for their calibration: sizes, non-finite or absurd
+     * intrinsics (focal lengths, principal points), not a rectified pair. */
+    size_t badCalibration = 0;
     StereoStats& operator+=(const StereoStats& o);
 };
 
