@@ -14,7 +14,7 @@ StereoStats& StereoStats::operator+=(const StereoStats& o) {
     return util::addMembers(*this, o, &StereoStats::pairs, &StereoStats::tableBuilds,
                             &StereoStats::pixels, &StereoStats::notFinite,
                             &StereoStats::noDisparity, &StereoStats::halo,
-                            &StereoStats::nearCluster, &StereoStats::tooNear,
+                            &StereoStats::nearCluster, &StereoStats::textureless, &StereoStats::tooNear,
                             &StereoStats::outOfRange, &StereoStats::kept);
 }
 
