@@ -32,19 +32,31 @@ struct Score {
     size_t commonCells = 0;    //!< held by both
     double naiveSumSq_m2 = 0;  //!< on the common cells
     double mapSumSq_m2 = 0;
-    size_t mapWithin3Sigma = 0;  //!< common cells whose truth is within 3 sigma of the map
+    size_t mapWithin3Sigma = 0;         //!< common cells whose truth is within 3 sigma of the map
+    size_t naiveGood = 0, mapGood = 0;  //!< cells held within kGood_m of the truth (all held)
+    static constexpr double kGood_m = 0.03;
     double naiveRmse_m() const { return std::sqrt(naiveSumSq_m2 / double(commonCells)); }
     double mapRmse_m() const { return std::sqrt(mapSumSq_m2 / double(commonCells)); }
     double naiveCoverage() const { return double(naiveCells) / double(truthCells); }
     double mapCoverage() const { return double(mapCells) / double(truthCells); }
+    double naiveGoodCoverage() const { return double(naiveGood) / double(truthCells); }
+    double mapGoodCoverage() const { return double(mapGood) / double(truthCells); }
     double mapWithin3() const { return double(mapWithin3Sigma) / double(commonCells); }
 };
 
 /** Scores scenario `prefix` (terrain-sim output: PREFIX.simplemap, PREFIX.ini, PREFIX_gt.asc); the
  * map takes the scenario's ini with `edit` applied to its insertion options. Disparity images in
  * the simplemap are dropped: both sides match the rendered pairs with SGBM. */
+/** Scored area [m, map frame]; the default takes every cell of the ground truth. */
+struct Area {
+    double xMin_m = -1e9, xMax_m = 1e9, yMin_m = -1e9, yMax_m = 1e9;
+    bool contains(double x, double y) const {
+        return x >= xMin_m && x <= xMax_m && y >= yMin_m && y <= yMax_m;
+    }
+};
+
 template <class EditOptions>
-Score compare(const std::string& prefix, EditOptions edit) {
+Score compare(const std::string& prefix, EditOptions edit, const Area& area = {}) {
     mrpt::maps::CSimpleMap sm;
     {
         mrpt::io::CFileGZInputStream f(prefix + ".simplemap");
@@ -98,8 +110,8 @@ Score compare(const std::string& prefix, EditOptions edit) {
     for (int r = 0; r < gt.rows(); r++)
         for (int k = 0; k < gt.cols(); k++) {
             const double truth = gt.heights_m(r, k);
-            if (!std::isfinite(truth)) continue;
             const double x = gt.xllcenter_m + k * cell_m, y = gt.yllcenter_m + r * cell_m;
+            if (!std::isfinite(truth) || !area.contains(x, y)) continue;
             s.truthCells++;
             const auto* nc = naive.cellByPos(x, y);
             const bool hasNaive = nc && nc->w > 0;
@@ -109,6 +121,8 @@ Score compare(const std::string& prefix, EditOptions edit) {
                                     : map.getHeight(x, y, h, sigma);
             s.naiveCells += hasNaive;
             s.mapCells += hasMap;
+            s.naiveGood += hasNaive && std::abs(nc->h - truth) <= Score::kGood_m;
+            s.mapGood += hasMap && std::abs(h - truth) <= Score::kGood_m;
             if (dump && hasNaive != hasMap)
                 std::fprintf(dump, "X %g %g %g %d %g %u\n", x, y, truth, int(hasNaive),
                              hasNaive ? double(nc->h) : h, hasNaive ? nc->w : 0u);

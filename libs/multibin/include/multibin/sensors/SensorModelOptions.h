@@ -122,7 +122,7 @@ struct StereoModelOptions {
      * is below textureMinStd_grey have no match of their own (SGBM's smoothing carries a
      * neighbour's disparity into them) and are removed; 0 turns it off (keys
      * `stereo_texture_min_std_grey`, `stereo_texture_radius_px`; doc/sensor-models.md). */
-    double textureMinStd_grey = 3.0;
+    double textureMinStd_grey = 1.5;
     int textureRadius_px = 2;
 };
 
