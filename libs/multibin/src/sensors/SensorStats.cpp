@@ -14,8 +14,8 @@ StereoStats& StereoStats::operator+=(const StereoStats& o) {
     return util::addMembers(*this, o, &StereoStats::pairs, &StereoStats::tableBuilds,
                             &StereoStats::pixels, &StereoStats::notFinite,
                             &StereoStats::noDisparity, &StereoStats::halo,
-                            &StereoStats::nearCluster, &StereoStats::textureless, &StereoStats::tooNear,
-                            &StereoStats::outOfRange, &StereoStats::kept);
+                            &StereoStats::nearCluster, &StereoStats::textureless,
+                            &StereoStats::tooNear, &StereoStats::outOfRange, &StereoStats::kept);
 }
 
 DepthStats& DepthStats::operator+=(const DepthStats& o) {
