@@ -6,6 +6,7 @@
 #include <mrpt/obs/CObservationStereoImages.h>
 
 #include <cmath>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
@@ -196,6 +197,38 @@ TEST(StereoArtefacts, HaloOnTheNearSideOfAnEdgeIsRemovedFarSideKept) {
     for (int v = 0; v < 10; v++)
         for (int u = 0; u < 40; u++) slope.at(u, v) = 5.f + 1.f * float(u);
     EXPECT_EQ(removeHalos(slope, o), 0u);
+}
+
+TEST(StereoArtefacts, TexturelessPixelsRemovedTexturedKept) {
+    // Left half: alternating 0/255 columns (grey std 127.5); right half: uniform 100 with a
+    // +-1 checkerboard (std exactly 1 in any 5 x 5 window: 13 of one sign and 12 of the other
+    // give a variance of 1 - (1/25)^2 = 0.9984).
+    const int W = 40, H = 20;
+    cv::Mat img(H, W, CV_8UC1);
+    for (int v = 0; v < H; v++)
+        for (int u = 0; u < W; u++)
+            img.at<uint8_t>(v, u) =
+                u < W / 2 ? uint8_t(u % 2 ? 255 : 0) : uint8_t((u + v) % 2 ? 101 : 99);
+    const mrpt::img::CImage left(img, mrpt::img::SHALLOW_COPY);
+    DisparityImage d(W, H);
+    for (float& x : d.disparity_px) x = 10.f;
+    d.at(35, 10) = std::numeric_limits<float>::quiet_NaN();  // already invalid: not counted
+    StereoModelOptions o;
+    o.textureMinStd_grey = 1.5;
+    DisparityImage out = d;
+    // Windows reaching a textured column (u <= W/2 - 1 + 2) keep their pixels.
+    const size_t expected = size_t(H) * size_t(W / 2 - 2) - 1;
+    EXPECT_EQ(removeTextureless(out, left, o), expected);
+    for (int v = 0; v < H; v++)
+        for (int u = 0; u < W; u++) EXPECT_EQ(out.valid(u, v), u < W / 2 + 2) << u << "," << v;
+    o.textureMinStd_grey = 0.9;  // below the checkerboard's std: nothing removed
+    out = d;
+    EXPECT_EQ(removeTextureless(out, left, o), 0u);
+    o.textureMinStd_grey = 0;  // off
+    EXPECT_EQ(removeTextureless(out, left, o), 0u);
+    o.textureMinStd_grey = 1.5;
+    DisparityImage small(W - 1, H);
+    EXPECT_THROW(removeTextureless(small, left, o), std::invalid_argument);
 }
 
 TEST(StereoArtefacts, SmallNearClusterRemovedLargeOrFarKept) {

@@ -206,6 +206,8 @@ void visitKeys(Options& o, Visit&& visit) {
           positive("px"));
     visit({"stereo_near_cluster_jump_px", "stereo_near_cluster_jump"}, stereo.nearClusterJump_px,
           positive("px"));
+    visit("stereo_texture_min_std_grey", stereo.textureMinStd_grey, atLeast(0));
+    visit("stereo_texture_radius_px", stereo.textureRadius_px, atLeast(1, "px"));
     visit({"stereo_cloud_focal_length_px", "stereo_cloud_focal_length"}, stereo.cloudFocalLength_px,
           positive("px"));
     visit({"stereo_cloud_baseline_m", "stereo_cloud_baseline"}, stereo.cloudBaseline_m,

@@ -15,8 +15,8 @@ StereoStats& StereoStats::operator+=(const StereoStats& o) {
     return util::addMembers(
         *this, o, &StereoStats::pairs, &StereoStats::tableBuilds, &StereoStats::pixels,
         &StereoStats::notFinite, &StereoStats::noDisparity, &StereoStats::halo,
-        &StereoStats::nearCluster, &StereoStats::tooNear, &StereoStats::outOfRange,
-        &StereoStats::kept, &StereoStats::badCalibration);
+        &StereoStats::nearCluster, &StereoStats::textureless, &StereoStats::tooNear,
+        &StereoStats::outOfRange, &StereoStats::kept, &StereoStats::badCalibration);
 }
 
 DepthStats& DepthStats::operator+=(const DepthStats& o) {

@@ -85,6 +85,36 @@ DisparityImage computeDisparitySGBM(const mrpt::img::CImage& left, const mrpt::i
     return out;
 }
 
+size_t removeTextureless(DisparityImage& d, const mrpt::img::CImage& left,
+                         const StereoModelOptions& o) {
+    if (o.textureMinStd_grey <= 0) return 0;
+    const cv::Mat& l = left.asCvMatRef();
+    if (l.cols != d.width || l.rows != d.height)
+        throw std::invalid_argument(
+            "removeTextureless: left image and disparity image differ in size");
+    cv::Mat grey = l, g, g2, mean, mean2;
+    if (l.channels() == 3) cv::cvtColor(l, grey, cv::COLOR_BGR2GRAY);
+    grey.convertTo(g, CV_32F);
+    g2 = g.mul(g);
+    const int k = 2 * o.textureRadius_px + 1;
+    cv::boxFilter(g, mean, CV_32F, cv::Size(k, k));
+    cv::boxFilter(g2, mean2, CV_32F, cv::Size(k, k));
+    const float minVar = float(o.textureMinStd_grey * o.textureMinStd_grey);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    size_t removed = 0;
+    for (int v = 0; v < d.height; v++) {
+        float* row = d.disparity_px.data() + size_t(v) * size_t(d.width);
+        const float* m = mean.ptr<float>(v);
+        const float* m2 = mean2.ptr<float>(v);
+        for (int u = 0; u < d.width; u++) {
+            const bool flat = std::isfinite(row[u]) && (m2[u] - m[u] * m[u] < minVar);
+            removed += flat;
+            row[u] = flat ? nan : row[u];
+        }
+    }
+    return removed;
+}
+
 size_t removeHalos(DisparityImage& d, const StereoModelOptions& o) {
     // Smallest valid disparity in the window: erosion with invalid pixels set to +large.
     cv::Mat m(d.height, d.width, CV_32F);

@@ -490,6 +490,7 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
                 "CObservationStereoImages '" + obs.sensorLabel +
                 "': neither a disparity image nor a right image (hasImageRight = false)");
         disp = computeDisparitySGBM(obs.imageLeft, obs.imageRight, opts);
+        stats.textureless += removeTextureless(disp, obs.imageLeft, opts);
     }
     if (disp.width != g.width || disp.height != g.height)
         throw std::invalid_argument("CObservationStereoImages '" + obs.sensorLabel +

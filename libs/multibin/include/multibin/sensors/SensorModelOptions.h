@@ -118,6 +118,12 @@ struct StereoModelOptions {
     int nearClusterMaxArea_px = 400;
     double nearClusterStep_px = 2.0;
     double nearClusterJump_px = 2.0;
+    /** SGBM only: pixels whose left-image grey standard deviation over a textureRadius_px window
+     * is below textureMinStd_grey have no match of their own (SGBM's smoothing carries a
+     * neighbour's disparity into them) and are removed; 0 turns it off (keys
+     * `stereo_texture_min_std_grey`, `stereo_texture_radius_px`; doc/sensor-models.md). */
+    double textureMinStd_grey = 1.5;
+    int textureRadius_px = 2;
 };
 
 /** Structured-light depth camera model (Nguyen, Izadi, Lovell 2012):

@@ -28,6 +28,7 @@ struct StereoStats {
     size_t noDisparity = 0;  //!< no valid disparity (matching failed or invalid)
     size_t halo = 0;         //!< removed by the halo filter (full-resolution pixels)
     size_t nearCluster = 0;  //!< removed by the near-cluster filter (full-resolution pixels)
+    size_t textureless = 0;  //!< SGBM pixels removed by the texture filter (full resolution)
     size_t tooNear = 0;      //!< depth under stereo_min_depth_m (out of the horopter)
     size_t outOfRange = 0;   //!< range outside [min_range, max_range]
     size_t kept = 0;         //!< turned into points

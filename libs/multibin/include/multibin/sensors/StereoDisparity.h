@@ -52,4 +52,12 @@ size_t removeHalos(DisparityImage& disparity, const StereoModelOptions& opts);
  * removed. */
 size_t removeNearClusters(DisparityImage& disparity, const StereoModelOptions& opts);
 
+/** Texture filter for disparities computed by SGBM from `left` (8-bit grey or colour): invalidates
+ * every pixel whose grey standard deviation over the (2 opts.textureRadius_px + 1)^2 window of
+ * the left image is below opts.textureMinStd_grey. Such a pixel has no match of its own; SGBM's
+ * smoothness term carries a neighbour's disparity into it. Returns the number of pixels removed
+ * (none if opts.textureMinStd_grey is 0). Throws std::invalid_argument if the sizes differ. */
+size_t removeTextureless(DisparityImage& disparity, const mrpt::img::CImage& left,
+                         const StereoModelOptions& opts);
+
 }  // namespace multibin::sensors
