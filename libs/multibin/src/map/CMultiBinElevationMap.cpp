@@ -441,39 +441,28 @@ bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                : cellHeight(x_m, y_m, height_m, sigma_m);
 }
 
-namespace {
-/** Height and sigma from one of CellSurface.h's estimators (heightAt or surfaceAt). */
-using SurfaceEstimator = bool (*)(const multibin::BinGrid&, const multibin::BinGrid*, double,
-                                  double, const multibin::BinUpdateParams&, bool,
-                                  multibin::CellSurface&);
-bool answer(SurfaceEstimator estimate, const multibin::BinGrid& grid,
-            const multibin::BinGrid* local, double x_m, double y_m,
-            const multibin::BinUpdateParams& p, bool reliefSigma, double& height_m,
-            double& sigma_m) {
+bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, double& height_m,
+                                         double& sigma_m) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    const Eigen::Vector2d& o = m_impl->origin_m;
+    const auto estimate = subCell ? multibin::heightAt : multibin::surfaceAt;
     multibin::CellSurface c;
-    if (!estimate(grid, local, x_m, y_m, p, reliefSigma, c)) return false;
+    if (!estimate(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m - o.x(), y_m - o.y(),
+                  binUpdateParams(), insertionOptions.relief_sigma, c))
+        return false;
     height_m = c.height_m;
     sigma_m = std::sqrt(c.variance_m2);
     return true;
 }
-}  // namespace
 
 bool CMultiBinElevationMap::heightAt(double x_m, double y_m, double& height_m,
                                      double& sigma_m) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    const Eigen::Vector2d& o = m_impl->origin_m;
-    return answer(multibin::heightAt, m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
-                  x_m - o.x(), y_m - o.y(), binUpdateParams(), insertionOptions.relief_sigma,
-                  height_m, sigma_m);
+    return surfaceQuery(true, x_m, y_m, height_m, sigma_m);
 }
 
 bool CMultiBinElevationMap::cellHeight(double x_m, double y_m, double& height_m,
                                        double& sigma_m) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    const Eigen::Vector2d& o = m_impl->origin_m;
-    return answer(multibin::surfaceAt, m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
-                  x_m - o.x(), y_m - o.y(), binUpdateParams(), insertionOptions.relief_sigma,
-                  height_m, sigma_m);
+    return surfaceQuery(false, x_m, y_m, height_m, sigma_m);
 }
 
 bool CMultiBinElevationMap::isEmpty() const {

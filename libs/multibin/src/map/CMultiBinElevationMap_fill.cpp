@@ -34,25 +34,22 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         double& height_m,
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    const bool measured = getHeight(x_m, y_m, height_m, sigma_m);
-    return measuredOrFilled(measured, includeFilled, x_m, y_m, height_m, sigma_m);
+    return elevationQuery(insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane,
+                          x_m, y_m, height_m, sigma_m, includeFilled);
 }
 
 CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double x_m, double y_m,
                                                                          double& height_m,
                                                                          double& sigma_m,
                                                                          bool includeFilled) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    const bool measured = cellHeight(x_m, y_m, height_m, sigma_m);
-    return measuredOrFilled(measured, includeFilled, x_m, y_m, height_m, sigma_m);
+    return elevationQuery(false, x_m, y_m, height_m, sigma_m, includeFilled);
 }
 
-CMultiBinElevationMap::HeightSource CMultiBinElevationMap::measuredOrFilled(bool measured,
-                                                                            bool includeFilled,
-                                                                            double x_m, double y_m,
-                                                                            double& height_m,
-                                                                            double& sigma_m) const {
+CMultiBinElevationMap::HeightSource CMultiBinElevationMap::elevationQuery(
+    bool subCell, double x_m, double y_m, double& height_m, double& sigma_m,
+    bool includeFilled) const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    const bool measured = surfaceQuery(subCell, x_m, y_m, height_m, sigma_m);
     if (measured) return HeightSource::Measured;
     if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
     const int ix = m_impl->grid.cellIndex(x_m - m_impl->origin_m.x()),

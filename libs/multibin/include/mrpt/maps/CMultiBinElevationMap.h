@@ -348,10 +348,13 @@ private:
     bool internal_canComputeObservationLikelihood(
         const mrpt::obs::CObservation& obs) const override;
 
-    /** Measured if `measured`; else, with includeFilled, the last gap filling's height where it
-     * filled the cell of (x, y) (the caller holds the lock). */
-    HeightSource measuredOrFilled(bool measured, bool includeFilled, double x_m, double y_m,
-                                  double& height_m, double& sigma_m) const;
+    /** heightAt() (subCell) or cellHeight(): the map's surface at (x, y) in the pose frame. */
+    bool surfaceQuery(bool subCell, double x_m, double y_m, double& height_m,
+                      double& sigma_m) const;
+    /** surfaceQuery() where measured; else, with includeFilled, the last gap filling's height
+     * where it filled the cell of (x, y). */
+    HeightSource elevationQuery(bool subCell, double x_m, double y_m, double& height_m,
+                                double& sigma_m, bool includeFilled) const;
     /** Observation -> sensor-frame points -> map frame -> grid. */
     bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);
