@@ -290,6 +290,7 @@ TEST(BadInputPose, NaNInThePoseMeanIsAnErrorNamingTheObservation) {
     expectErrorMentioning([&] { map.insertObservation(*floorScan(), pdf); }, {"LASER", "NaN"});
     expectErrorMentioning([&] { map.insertObservation(*floorScan(), pdf.mean); }, {"LASER", "NaN"});
     EXPECT_EQ(serialize(map), before);
+    EXPECT_EQ(map.nonFinitePoseCount(), 2u);  // refused and counted
 }
 
 TEST(BadInputPose, NaNInThePoseCovarianceRejectsEveryPoint) {

@@ -374,6 +374,7 @@ const multibin::VisibilityStats& CMultiBinElevationMap::visibilityStats() const 
 }
 size_t CMultiBinElevationMap::poseFallbackCount() const { return m_impl->poseFallbacks; }
 size_t CMultiBinElevationMap::skippedByLabelCount() const { return m_impl->skippedByLabel; }
+size_t CMultiBinElevationMap::nonFinitePoseCount() const { return m_impl->nonFinitePoses; }
 const multibin::sensors::SensorModelStats& CMultiBinElevationMap::sensorModelStats() const {
     return m_impl->sensorState.stats;
 }
@@ -417,6 +418,7 @@ void CMultiBinElevationMap::internal_clear() {
     m_impl->visibilityStats = {};
     m_impl->poseFallbacks = 0;
     m_impl->skippedByLabel = 0;
+    m_impl->nonFinitePoses = 0;
     m_impl->lastRobotPose.reset();
     m_impl->sensorState.reset();
     m_impl->fill = {};

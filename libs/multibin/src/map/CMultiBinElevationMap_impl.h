@@ -26,6 +26,7 @@ struct CMultiBinElevationMap::Impl {
     multibin::VisibilityStats visibilityStats;
     size_t poseFallbacks = 0;
     size_t skippedByLabel = 0;
+    size_t nonFinitePoses = 0;  //!< observations refused for a NaN or infinite robot pose
     /** The latest CObservationRobotPose: its PDF and timestamp. */
     std::optional<mrpt::poses::CPose3DPDFGaussian> lastRobotPose;
     mrpt::Clock::time_point lastRobotPoseTime;

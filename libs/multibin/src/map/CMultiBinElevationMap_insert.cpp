@@ -3,6 +3,7 @@
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/system/datetime.h>
 #include "CMultiBinElevationMap_impl.h"
+#include "multibin/util/Counters.h"
 
 #include <algorithm>
 #include <chrono>
@@ -150,9 +151,11 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
         return false;
     }
     for (int i = 0; i < 6; i++)
-        if (!std::isfinite(posePdf.mean[i]))
+        if (!std::isfinite(posePdf.mean[i])) {
+            multibin::util::addSaturating(m_impl->nonFinitePoses, size_t(1));
             throw std::invalid_argument("CMultiBinElevationMap: robot pose of observation '" +
                                         obs.sensorLabel + "' has a NaN or infinite component");
+        }
     // From here on the pose is relative to the map origin (in double), so the single-precision
     // geometry after it stays small at any georeferenced coordinate.
     // An automatic origin is fixed once the observation is known good.

@@ -295,6 +295,9 @@ public:
     bool acceptsLabel(const std::string& label) const;
     /** Observations skipped because their sensor label is not in insertionOptions.sensor_labels. */
     size_t skippedByLabelCount() const;
+    /** Observations refused (with an error) because their robot pose has a NaN or infinite
+     * component. */
+    size_t nonFinitePoseCount() const;
     /** What the sensor models did (per sensor kind), since the last clear(). */
     const multibin::sensors::SensorModelStats& sensorModelStats() const;
     /** @} */
