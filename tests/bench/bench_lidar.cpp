@@ -96,10 +96,16 @@ void BM_MapInsertVlp16Revolution(benchmark::State& state) {
     map->insertionOptions.visibility.enabled = state.range(0) != 0;
     map->insertObservation(cloud, pose);  // grows the map: not timed
     const size_t before = map->insertStats().accepted;
+    const VisibilityStats visBefore = map->visibilityStats();
     for (auto _ : state) benchmark::DoNotOptimize(map->insertObservation(cloud, pose));
+    const double n = double(state.iterations());
+    const VisibilityStats& vis = map->visibilityStats();
     state.counters["returns"] = double(cloud.pointcloud->size());
-    state.counters["fused_per_scan"] =
-        double(map->insertStats().accepted - before) / double(state.iterations());
+    state.counters["fused_per_scan"] = double(map->insertStats().accepted - before) / n;
+    state.counters["rays"] = double(vis.raysCast - visBefore.raysCast) / n;
+    state.counters["cells_tested"] = double(vis.cellsVisited - visBefore.cellsVisited) / n;
+    state.counters["bins_removed"] = double(vis.binsRemoved - visBefore.binsRemoved) / n;
+    state.counters["bins_weakened"] = double(vis.binsWeakened - visBefore.binsWeakened) / n;
 }
 BENCHMARK(BM_MapInsertVlp16Revolution)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 

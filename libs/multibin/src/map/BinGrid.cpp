@@ -30,7 +30,7 @@ void BinGrid::growToInclude(const CellWindow& w) {
 
 void BinGrid::appendBin(int ix, int iy, const BinEstimate& bin) {
     BinStore::appendBin(ix, iy, bin);
-    m_index.noteHeight(ix, iy, bin.height_m);
+    m_index.noteHeight(slot(ix, iy), ix, iy, bin.height_m);
 }
 
 void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateParams& params) {
@@ -39,7 +39,8 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
     int16_t n;
     if (!binIndexOf(other.height_m, params.binHeight_m, n)) return;
     bool added;
-    Bin& bin = BinStore::bin(findOrAddBin(slot(ix, iy), n, added));
+    const size_t s = slot(ix, iy);
+    Bin& bin = BinStore::bin(findOrAddBin(s, n, added));
     if (added) {
         static_cast<BinEstimate&>(bin) = other;
         bin.index = n;
@@ -49,7 +50,7 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
         bin.certainty += other.certainty;
         util::addSaturating(bin.pointCount, other.pointCount);
     }
-    m_index.noteHeight(ix, iy, bin.height_m);
+    m_index.noteHeight(s, ix, iy, bin.height_m);
 }
 
 const Bin* BinGrid::winningBin(int ix, int iy) const {

@@ -55,11 +55,12 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const double above = b.height_m - lineHeight_m;
         return above > minConflictMargin && above > conflictMargin(b);
     };
-    // Local height bound: a block whose bound lies no more than minConflictMargin above the line
-    // holds no conflicting bin. The tolerance covers the rounding of bins' float heights.
-    auto blockMayConflict = [&](float blockMax_m, double lineHeight_m) {
-        return blockMax_m > -std::numeric_limits<float>::infinity() &&
-               double(blockMax_m) + 1e-6 * (1.0 + std::abs(double(blockMax_m))) >
+    // Local height bounds: a block or a cell whose bound lies no more than minConflictMargin
+    // above the line holds no conflicting bin. The tolerance covers the rounding of bins' float
+    // heights.
+    auto boundMayConflict = [&](float max_m, double lineHeight_m) {
+        return max_m > -std::numeric_limits<float>::infinity() &&
+               double(max_m) + 1e-6 * (1.0 + std::abs(double(max_m))) >
                    lineHeight_m + minConflictMargin;
     };
     const double block_m = BinGrid::kBlockCells * cell;
@@ -121,7 +122,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             stopHeight =
                 std::min(stopHeight,
                          double(bound_m) + 1e-6 * (1.0 + std::abs(double(bound_m))) + vis.margin_m);
-            if (!blockMayConflict(bound_m, lowest_m)) {
+            if (!boundMayConflict(bound_m, lowest_m)) {
                 // As the walk counts them (length >= cell), the square root only near the edge.
                 const double cell2Lo = cell * cell * (1 - 1e-9), cell2Hi = cell * cell * (1 + 1e-9);
                 for (const BinGrid::UpdatedCell& u : updated) {
@@ -190,7 +191,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         };
 
         // Bins of the updated cell above all that was measured in it now.
-        if (blockMayConflict(blockBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)), tz)) {
+        if (boundMayConflict(grid.cellMaxHeight_m(u.ix, u.iy), tz)) {
             target();
             grid.editBins(u.ix, u.iy, [&](Bin& b) {
                 if (!conflicts(b, tz)) return true;
@@ -208,6 +209,17 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const double length = std::sqrt(dx * dx + dy * dy);  // libm hypot is several times slower
         if (length < cell) continue;
         stats.raysCast++;
+        // The whole ray at once: its samples lie between the cell and the sensor, so over blocks
+        // no farther (Chebyshev, one block spare for rounding) from the sensor's block than the
+        // cell's, and no lower than its lower end. If none of those blocks can conflict there,
+        // the walk below would edit nothing (most floor rays of a lidar revolution in a room).
+        if (!ringBound.empty()) {
+            const size_t j = size_t(std::max(std::abs(BinGrid::blockOf(u.ix) - sensorBx),
+                                             std::abs(BinGrid::blockOf(u.iy) - sensorBy))) +
+                             1;
+            const float rayBound_m = j < ringBound.size() ? ringBound[j] : ringBound.back();
+            if (!boundMayConflict(rayBound_m, std::min(tz, sensor_m.z()) - kSlack_m)) continue;
+        }
 
         // Sweep the ray's block columns (rows if it runs more along y), with its direction and
         // slope to rounding (the slack covers it): over each, the blocks the line can touch and
@@ -242,7 +254,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                         j < double(ringBound.size() - 1) ? ringBound[size_t(j)] : ringBound.back();
                     const double restLowest_m =
                         std::min(startZ_m, tz + aSlope * (length + kSlack_m) - kSlack_m);
-                    if (!blockMayConflict(restBound_m, restLowest_m)) break;
+                    if (!boundMayConflict(restBound_m, restLowest_m)) break;
                 }
                 const double exit = ((da0 > 0 ? ka + 1 : ka) * block_m - a0) * invUa;
                 const double db = std::min(exit, length);
@@ -255,7 +267,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     bound_m = std::max(bound_m, xMajor ? blockBound(ka, kb) : blockBound(kb, ka));
                 const double lowest_m =
                     aSlope > 0 ? startZ_m : tz + aSlope * (db + kSlack_m) - kSlack_m;
-                if (blockMayConflict(bound_m, lowest_m + aRise)) {
+                if (boundMayConflict(bound_m, lowest_m + aRise)) {
                     reach = db + kSlack_m;
                     if (!stretches.empty() && stretches.back().second >= da - kSlack_m)
                         stretches.back().second = reach;  // joins the previous column's
@@ -326,10 +338,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 lastIy = iy;
                 const double rayHigh = rayZ + inCellRise;
                 // The block bound first: a small table, and most cells stop here.
-                if (!blockMayConflict(blockBound(BinGrid::blockOf(ix), BinGrid::blockOf(iy)),
+                if (!boundMayConflict(blockBound(BinGrid::blockOf(ix), BinGrid::blockOf(iy)),
                                       rayHigh))
                     continue;
-                if (!w.contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
+                // Then the cell's own bound (outside the window: -infinity), before its bins.
+                if (!boundMayConflict(grid.cellMaxHeight_m(ix, iy), rayHigh) ||
+                    grid.updatedThisCycle(ix, iy))
+                    continue;
                 stats.cellsVisited++;
                 grid.editBins(ix, iy, [&](Bin& b) {
                     if (!conflicts(b, rayHigh)) return true;

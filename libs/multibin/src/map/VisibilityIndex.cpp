@@ -21,7 +21,8 @@ void VisibilityIndex::regrow(const BinStore& store) {
     m_stamps.assign(w.cellCount(), CellStamp{});
     m_updated.clear();
     m_blocks.assign(size_t(m_blockNx) * size_t(m_blockNy), BlockSlot{});
-    store.forEachStoredBin([&](int ix, int iy, const Bin& b) { raiseBlock(ix, iy, b.height_m); });
+    store.forEachStoredBin(
+        [&](int ix, int iy, const Bin& b) { noteHeight(store.slot(ix, iy), ix, iy, b.height_m); });
 }
 
 void VisibilityIndex::setWindow(const CellWindow& w) {

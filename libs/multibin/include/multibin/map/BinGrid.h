@@ -21,7 +21,7 @@ class PosePropagator;
  * update rule applied to points (the gates of eqs 13-14 and the Kalman update of eq 15 from
  * BinUpdate.h) and the visibility index kept in step with both (VisibilityIndex: update cycles,
  * block height bounds), as OctoMap's OccupancyOcTreeBase adds its update rule to the storage of
- * OcTreeBaseImpl. Memory: 12 B per cell of the window (4 B store, 8 B index), 12 B per block of
+ * OcTreeBaseImpl. Memory: 16 B per cell of the window (4 B store, 12 B index), 12 B per block of
  * 256 cells and 64 B per bin (Bin.h). */
 class BinGrid : private BinStore {
 public:
@@ -112,6 +112,11 @@ public:
     const std::vector<UpdatedCell>& updatedCells() const { return m_index.updatedCells(); }
     bool updatedThisCycle(int ix, int iy) const {
         return window().contains(ix, iy) && m_index.updatedThisCycle(slot(ix, iy));
+    }
+    /** See VisibilityIndex::cellMaxHeight_m; -infinity outside the window. */
+    float cellMaxHeight_m(int ix, int iy) const {
+        return window().contains(ix, iy) ? m_index.cellMaxHeight_m(slot(ix, iy))
+                                         : -std::numeric_limits<float>::infinity();
     }
     /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
     double maxHeight_m() const { return m_index.maxHeight_m(); }

@@ -14,10 +14,10 @@ namespace multibin {
 class BinStore;
 
 /** What the visibility constraint needs to know about a grid beyond its bins: which cells the
- * current observation updated (update cycles) and an upper bound on the bins' heights per block
- * of cells. Kept beside a BinStore with the same window and slot numbering; BinGrid keeps the
- * two in step. Memory: 8 B per cell of the window (update-cycle stamp and index), 12 B per block
- * of 256 cells. */
+ * current observation updated (update cycles) and upper bounds on the bins' heights, per cell
+ * and per block of cells. Kept beside a BinStore with the same window and slot numbering;
+ * BinGrid keeps the two in step. Memory: 12 B per cell of the window (update-cycle stamp and
+ * index, height bound), 12 B per block of 256 cells. */
 class VisibilityIndex {
 public:
     /** A cell updated in the current cycle, with the highest height accepted into it [m]. */
@@ -34,8 +34,8 @@ public:
     void moveWindow(const CellWindow& w) { setWindow(w); }
     /** The store's window grew: fresh stamps, no updated cell, bounds rebuilt from every bin. */
     void regrow(const BinStore& store);
-    /** A cell entered the window at `slot`: it was not updated in this cycle. */
-    void forgetSlot(size_t slot) { m_stamps[slot].cycle = 0; }
+    /** A cell entered the window at `slot`: it was not updated in this cycle and holds no bin. */
+    void forgetSlot(size_t slot) { m_stamps[slot] = CellStamp{}; }
 
     /** @name Update cycles: which cells one observation updated.
      * @{ */
@@ -46,14 +46,22 @@ public:
     /** Records `points` accepted points into cell (ix, iy) at `slot`, the highest at
      * `height_m` [m]; raises the bounds. */
     void noteUpdate(size_t slot, int ix, int iy, double height_m, uint32_t points);
-    /** A bin of cell (ix, iy) now holds `height_m` [m] (stored or fused from elsewhere). */
-    void noteHeight(int ix, int iy, double height_m) {
+    /** A bin of cell (ix, iy) at `slot` now holds `height_m` [m] (stored or fused from
+     * elsewhere). */
+    void noteHeight(size_t slot, int ix, int iy, double height_m) {
         m_maxHeight_m = std::max(m_maxHeight_m, height_m);
         raiseBlock(ix, iy, height_m);
+        float& cellMax_m = m_stamps[slot].maxHeight_m;
+        cellMax_m = std::max(cellMax_m, static_cast<float>(height_m));
     }
     /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
     double maxHeight_m() const { return m_maxHeight_m; }
     /** @} */
+
+    /** An upper bound on the height of every bin of the cell at `slot` [m], as
+     * blockMaxHeight_m's for its block (the same rounding and the same conservative removal):
+     * the visibility constraint tests a cell's bins only where this says they may conflict. */
+    float cellMaxHeight_m(size_t slot) const { return m_stamps[slot].maxHeight_m; }
 
     /** @name Local height bound: blocks of kBlockCells x kBlockCells cells. Block (bx, by) holds
      * cells bx kBlockCells .. bx kBlockCells + kBlockCells - 1 (and likewise in y), so a cell's
@@ -97,6 +105,7 @@ private:
     struct CellStamp {
         uint32_t cycle = 0;         //!< the update cycle that last updated the cell
         uint32_t updatedIndex = 0;  //!< its entry in m_updated, valid in that cycle
+        float maxHeight_m = -std::numeric_limits<float>::infinity();  //!< cellMaxHeight_m
     };
     std::vector<CellStamp> m_stamps;     //!< per slot of the store
     std::vector<UpdatedCell> m_updated;  //!< cells updated in this cycle, in first-update order
@@ -144,7 +153,7 @@ inline void VisibilityIndex::raiseBlock(int ix, int iy, double height_m) {
 
 inline void VisibilityIndex::noteUpdate(size_t s, int ix, int iy, double height_m,
                                         uint32_t points) {
-    noteHeight(ix, iy, height_m);
+    noteHeight(s, ix, iy, height_m);
     CellStamp& cs = m_stamps[s];
     if (cs.cycle == m_cycle) {
         UpdatedCell& u = m_updated[cs.updatedIndex];
