@@ -14,19 +14,10 @@
 namespace multibin::sensors {
 
 namespace {
-void appendDepthPoint(const Eigen::Vector3f& p_m, const DepthModelOptions& opts, double minRange_m,
-                      double maxRange_m, PointsWithCov& out, DepthStats& stats) {
-    stats.points++;
-    count(appendRayPoint(p_m, minRange_m, maxRange_m, opts.raySigmas(), out), stats);
-}
-}  // namespace
-
-namespace {
 void appendPointsMap(const mrpt::maps::CPointsMap& pts, const DepthModelOptions& opts,
                      double minRange_m, double maxRange_m, PointsWithCov& out, DepthStats& stats) {
-    forEachCloudPoint(pts, out, [&](const Eigen::Vector3f& p) {
-        appendDepthPoint(p, opts, minRange_m, maxRange_m, out, stats);
-    });
+    stats.points += pts.size();
+    count(appendCloudPoints(pts, minRange_m, maxRange_m, opts.raySigmas(), out), stats);
 }
 }  // namespace
 
@@ -42,11 +33,11 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
                 "CObservation3DRangeScan '" + scan.sensorLabel +
                 "': points3D_x, points3D_y and points3D_z have different sizes (" +
                 std::to_string(nx) + ", " + std::to_string(ny) + ", " + std::to_string(nz) + ")");
-        out.reserve(nx);
-        for (size_t i = 0; i < scan.points3D_x.size(); i++)
-            appendDepthPoint(
-                Eigen::Vector3f(scan.points3D_x[i], scan.points3D_y[i], scan.points3D_z[i]), opts,
-                minRange_m, maxRange_m, out, stats);
+        stats.points += nx;
+        count(
+            appendRayPoints(scan.points3D_x.data(), scan.points3D_y.data(), scan.points3D_z.data(),
+                            nx, minRange_m, maxRange_m, opts.raySigmas(), out),
+            stats);
     } else if (scan.hasRangeImage) {
         mrpt::maps::CSimplePointsMap local;
         mrpt::obs::T3DPointsProjectionParams pp;

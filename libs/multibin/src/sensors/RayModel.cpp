@@ -13,9 +13,9 @@ namespace {
 void countCloud(DepthStats&) {}
 void countCloud(LidarStats& s) { s.scans++; }
 void countCloud(StereoStats& s) { s.pairs++; }
-void countPoint(DepthStats& s) { s.points++; }
-void countPoint(LidarStats& s) { s.returns++; }
-void countPoint(StereoStats& s) { s.pixels++; }
+void countPoints(DepthStats& s, size_t n) { s.points += n; }
+void countPoints(LidarStats& s, size_t n) { s.returns += n; }
+void countPoints(StereoStats& s, size_t n) { s.pixels += n; }
 }  // namespace
 
 template <class Model, class Stats>
@@ -24,11 +24,9 @@ void cloudToPoints(const mrpt::obs::CObservationPointCloud& cloud, const Model& 
     out.clear();
     countCloud(stats);
     if (!cloud.pointcloud) return;
-    const auto sigmas = model.raySigmas();
-    forEachCloudPoint(*cloud.pointcloud, out, [&](const Eigen::Vector3f& p) {
-        countPoint(stats);
-        count(appendRayPoint(p, minRange_m, maxRange_m, sigmas, out), stats);
-    });
+    countPoints(stats, cloud.pointcloud->size());
+    count(appendCloudPoints(*cloud.pointcloud, minRange_m, maxRange_m, model.raySigmas(), out),
+          stats);
 }
 
 template void cloudToPoints(const mrpt::obs::CObservationPointCloud&, const DepthModelOptions&,

@@ -5,6 +5,10 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/RayModel.h"
 
@@ -12,18 +16,102 @@ namespace multibin::sensors {
 
 enum class RayPointFate { kept, notFinite, outOfRange };
 
-/** Appends `p_m` with rayCovariance(p, sigmas(r)) if it is finite and its range r lies in
- * [minRange_m, maxRange_m] (a point at the origin is a missing return: out of range). `sigmas`
- * maps a range [m] to RaySigmas (a model's raySigmas()). */
+/** The arithmetic of one ray point, without a branch (loops over points vectorise): the
+ * covariance rayCovariance(p, sigmas(|p|)) of p = (x, y, z) [m] into `cov` (meaningless unless
+ * kept) and the point's fate: not finite, or out of range if |p| is 0 or outside
+ * [minRange_m, maxRange_m] (a point at the origin is a missing return). `sigmas` maps a range [m]
+ * to RaySigmas (a model's raySigmas()). The same operations in the same order as Eigen's
+ * allFinite(), norm() and rayCovariance(), so the results are bit-identical to them. */
+template <class Sigmas>
+inline RayPointFate rayPoint(float x, float y, float z, double minRange_m, double maxRange_m,
+                             const Sigmas& sigmas, SymmetricCov3& cov) {
+    const int finite = (x - x == x - x) & (y - y == y - y) & (z - z == z - z);
+    const float r = std::sqrt(x * x + y * y + z * z);
+    const int inRange = (r > 0) & !(r < minRange_m) & !(r > maxRange_m);
+    const double xd = x, yd = y, zd = z;
+    const double n = std::sqrt(xd * xd + yd * yd + zd * zd);
+    const RaySigmas s = sigmas(n);
+    const double dx = xd / n, dy = yd / n, dz = zd / n;
+    const double l2 = s.lateral_m * s.lateral_m, k = s.axial_m * s.axial_m - l2;
+    cov = {float(k * dx * dx + l2), float(k * dx * dy), float(k * dx * dz),
+           float(k * dy * dy + l2), float(k * dy * dz), float(k * dz * dz + l2)};
+    return RayPointFate((finite ^ 1) * int(RayPointFate::notFinite) |
+                        (finite & (inRange ^ 1)) * int(RayPointFate::outOfRange));
+}
+
+/** Appends `p_m` with its covariance if rayPoint() keeps it. */
 template <class Sigmas>
 RayPointFate appendRayPoint(const Eigen::Vector3f& p_m, double minRange_m, double maxRange_m,
                             const Sigmas& sigmas, PointsWithCov& out) {
-    if (!p_m.allFinite()) return RayPointFate::notFinite;
-    const float r = p_m.norm();
-    if (!(r > 0) || r < minRange_m || r > maxRange_m) return RayPointFate::outOfRange;
-    const RaySigmas s = sigmas(p_m.cast<double>().norm());
-    out.push_back({p_m, rayCovariance(p_m, s.axial_m, s.lateral_m)});
-    return RayPointFate::kept;
+    SymmetricCov3 cov;
+    const RayPointFate fate =
+        rayPoint(p_m.x(), p_m.y(), p_m.z(), minRange_m, maxRange_m, sigmas, cov);
+    if (fate == RayPointFate::kept) out.push_back({p_m, cov});
+    return fate;
+}
+
+/** How many points of a batch met each fate. */
+struct RayPointCounts {
+    size_t kept = 0, notFinite = 0, outOfRange = 0;
+};
+
+/** appendRayPoint() over the n points (xs[i], ys[i], zs[i]), a block of points at a time:
+ * rayPoint() over the block in structure-of-arrays form (vectorised), then the kept points packed
+ * into `out`. */
+template <class Sigmas>
+RayPointCounts appendRayPoints(const float* xs, const float* ys, const float* zs, size_t n,
+                               double minRange_m, double maxRange_m, const Sigmas& sigmas,
+                               PointsWithCov& out) {
+    constexpr size_t kBlock = 256;
+    float c[6][kBlock];
+    int32_t fate[kBlock];
+    RayPointCounts counts;
+    for (size_t begin = 0; begin < n; begin += kBlock) {
+        const size_t m = std::min(kBlock, n - begin);
+        const float *x = xs + begin, *y = ys + begin, *z = zs + begin;
+        for (size_t i = 0; i < m; i++) {
+            SymmetricCov3 cov;
+            fate[i] = int32_t(rayPoint(x[i], y[i], z[i], minRange_m, maxRange_m, sigmas, cov));
+            c[0][i] = cov.xx;
+            c[1][i] = cov.xy;
+            c[2][i] = cov.xz;
+            c[3][i] = cov.yy;
+            c[4][i] = cov.yz;
+            c[5][i] = cov.zz;
+        }
+        // Zero-filled first, then packed in place (as the stereo rows are).
+        const size_t base = out.size();
+        out.resize(base + m);
+        PointWithCov* kept = out.data() + base;
+        size_t k = 0;
+        for (size_t i = 0; i < m; i++) {
+            counts.notFinite += fate[i] == int32_t(RayPointFate::notFinite);
+            counts.outOfRange += fate[i] == int32_t(RayPointFate::outOfRange);
+            if (fate[i] != int32_t(RayPointFate::kept)) continue;
+            kept[k].point_m = Eigen::Vector3f(x[i], y[i], z[i]);
+            kept[k++].cov_m2 = {c[0][i], c[1][i], c[2][i], c[3][i], c[4][i], c[5][i]};
+        }
+        out.resize(base + k);
+        counts.kept += k;
+    }
+    return counts;
+}
+
+/** appendRayPoints() over every point of `pts`. */
+template <class Sigmas>
+RayPointCounts appendCloudPoints(const mrpt::maps::CPointsMap& pts, double minRange_m,
+                                 double maxRange_m, const Sigmas& sigmas, PointsWithCov& out) {
+    return appendRayPoints(pts.getPointsBufferRef_x().data(), pts.getPointsBufferRef_y().data(),
+                           pts.getPointsBufferRef_z().data(), pts.size(), minRange_m, maxRange_m,
+                           sigmas, out);
+}
+
+/** Adds a batch's counts to a statistics struct with notFinite, outOfRange and kept counters. */
+template <class Stats>
+void count(const RayPointCounts& c, Stats& stats) {
+    stats.kept += c.kept;
+    stats.notFinite += c.notFinite;
+    stats.outOfRange += c.outOfRange;
 }
 
 /** Counts a fate in a statistics struct with notFinite, outOfRange and kept counters. */
@@ -40,16 +128,6 @@ void count(RayPointFate fate, Stats& stats) {
             stats.outOfRange++;
             break;
     }
-}
-
-/** Calls fn(Eigen::Vector3f) for each point of `pts`, after reserving room for them in `out`. */
-template <class Fn>
-void forEachCloudPoint(const mrpt::maps::CPointsMap& pts, PointsWithCov& out, const Fn& fn) {
-    const auto& xs = pts.getPointsBufferRef_x();
-    const auto& ys = pts.getPointsBufferRef_y();
-    const auto& zs = pts.getPointsBufferRef_z();
-    out.reserve(out.size() + xs.size());
-    for (size_t i = 0; i < xs.size(); i++) fn(Eigen::Vector3f(xs[i], ys[i], zs[i]));
 }
 
 }  // namespace multibin::sensors
