@@ -191,6 +191,7 @@ static void BM_LaserScansMockup(benchmark::State& state) {
     }
     state.counters["scans"] = double(scans.size());
     state.counters["points_per_scan"] = double(accepted) / double(scans.size());
+    state.counters["rays_per_scan"] = double(rays) / double(scans.size());
     state.counters["cells_tested_per_ray"] = rays ? double(cellsVisited) / double(rays) : 0.0;
     state.counters["scans_per_s"] = benchmark::Counter(
         double(scans.size()) * double(state.iterations()), benchmark::Counter::kIsRate);

@@ -90,11 +90,18 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         return sx < tableNx && sy < tableNy ? regionBound[sx + sy * tableNx]
                                             : grid.blockMaxHeight_m(bx, by);
     };
-    // ringBound[j]: the highest bound of a table block within j blocks (Chebyshev) of the
-    // sensor's block. The rest of a ray, within r of the sensor, lies in such blocks: a walk
-    // ends where the rest of its ray passes above them all.
-    std::vector<float> ringBound;
-    int sensorBx = 0, sensorBy = 0;
+    // towardsSensor[b]: the highest bound of the table blocks in the rectangle spanned by block b
+    // and the sensor's block. The rest of a ray from a point in block b lies in that rectangle
+    // (the exact segment does; rounding can move a sample across a block edge only within
+    // 1e-15 m of the sensor, where the ray is at the sensor's height: checked once, below), so
+    // a ray, or the rest of its walk, ends where it passes above that bound. Empty when the
+    // sensor's block is outside the table or blocks near it are higher than the sensor.
+    std::vector<float> towardsSensor;
+    auto restBound = [&](int bx, int by) {
+        const unsigned sx = unsigned(bx - tableX0), sy = unsigned(by - tableY0);
+        return sx < tableNx && sy < tableNy ? towardsSensor[sx + sy * tableNx]
+                                            : std::numeric_limits<float>::infinity();
+    };
     if (!updated.empty()) {
         int ixLo = grid.cellIndex(sensor_m.x()), ixHi = ixLo;
         int iyLo = grid.cellIndex(sensor_m.y()), iyHi = iyLo;
@@ -140,28 +147,39 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             tableNx = unsigned(bxHi - bxLo + 1);
             tableNy = unsigned(byHi - byLo + 1);
             regionBound.resize(size_t(tableNx) * tableNy);
-            const bool sensorNear = std::abs(sensor_m.x() * invCell) < kNoClamp &&
-                                    std::abs(sensor_m.y() * invCell) < kNoClamp;
-            sensorBx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
-            sensorBy = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
-            if (sensorNear)
-                ringBound.assign(
-                    size_t(std::max({std::abs(bxLo - sensorBx), std::abs(bxHi - sensorBx),
-                                     std::abs(byLo - sensorBy), std::abs(byHi - sensorBy)})) +
-                        1,
-                    -std::numeric_limits<float>::infinity());
             for (int by = byLo; by <= byHi; by++)
-                for (int bx = bxLo; bx <= bxHi; bx++) {
-                    const float b = grid.blockMaxHeight_m(bx, by);
-                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = b;
-                    if (!ringBound.empty()) {
-                        float& r = ringBound[size_t(
-                            std::max(std::abs(bx - sensorBx), std::abs(by - sensorBy)))];
-                        r = std::max(r, b);
+                for (int bx = bxLo; bx <= bxHi; bx++)
+                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] =
+                        grid.blockMaxHeight_m(bx, by);
+            const int sbx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
+            const int sby = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
+            float nearSensor_m = -std::numeric_limits<float>::infinity();
+            for (int by = sby - 1; by <= sby + 1; by++)
+                for (int bx = sbx - 1; bx <= sbx + 1; bx++)
+                    nearSensor_m = std::max(nearSensor_m, blockBound(bx, by));
+            if (sbx >= bxLo && sbx <= bxHi && sby >= byLo && sby <= byHi &&
+                !boundMayConflict(nearSensor_m, sensor_m.z() - 1e-6)) {
+                // Rows, then the blocks of a row, outwards from the sensor's: a block's
+                // rectangle is itself and the rectangles of its neighbours towards the sensor.
+                towardsSensor.resize(regionBound.size());
+                const int rows = std::max(sby - byLo, byHi - sby);
+                const int cols = std::max(sbx - bxLo, bxHi - sbx);
+                for (int ry = 0; ry <= rows; ry++)
+                    for (int by : {sby - ry, sby + ry}) {
+                        if (by < byLo || by > byHi || (ry == 0 && by != sby - ry)) continue;
+                        for (int rx = 0; rx <= cols; rx++)
+                            for (int bx : {sbx - rx, sbx + rx}) {
+                                if (bx < bxLo || bx > bxHi || (rx == 0 && bx != sbx - rx)) continue;
+                                float r = blockBound(bx, by);
+                                if (bx != sbx)
+                                    r = std::max(r, restBound(bx + (bx < sbx ? 1 : -1), by));
+                                if (by != sby)
+                                    r = std::max(r, restBound(bx, by + (by < sby ? 1 : -1)));
+                                towardsSensor[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] =
+                                    r;
+                            }
                     }
-                }
-            for (size_t j = 1; j < ringBound.size(); j++)
-                ringBound[j] = std::max(ringBound[j], ringBound[j - 1]);
+            }
         }
     }
 
@@ -209,17 +227,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const double length = std::sqrt(dx * dx + dy * dy);  // libm hypot is several times slower
         if (length < cell) continue;
         stats.raysCast++;
-        // The whole ray at once: its samples lie between the cell and the sensor, so over blocks
-        // no farther (Chebyshev, one block spare for rounding) from the sensor's block than the
-        // cell's, and no lower than its lower end. If none of those blocks can conflict there,
-        // the walk below would edit nothing (most floor rays of a lidar revolution in a room).
-        if (!ringBound.empty()) {
-            const size_t j = size_t(std::max(std::abs(BinGrid::blockOf(u.ix) - sensorBx),
-                                             std::abs(BinGrid::blockOf(u.iy) - sensorBy))) +
-                             1;
-            const float rayBound_m = j < ringBound.size() ? ringBound[j] : ringBound.back();
-            if (!boundMayConflict(rayBound_m, std::min(tz, sensor_m.z()) - kSlack_m)) continue;
-        }
+        // The whole ray at once: no lower than its lower end, over the rectangle between its
+        // cell's block and the sensor's. If no block there can conflict, the walk below would
+        // edit nothing (most floor rays of a lidar revolution in a room).
+        if (!towardsSensor.empty() &&
+            !boundMayConflict(restBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
+                              std::min(tz, sensor_m.z()) - kSlack_m))
+            continue;
 
         // Sweep the ray's block columns (rows if it runs more along y), with its direction and
         // slope to rounding (the slack covers it): over each, the blocks the line can touch and
@@ -246,29 +260,39 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 const double startZ_m = tz + aSlope * (da - kSlack_m) - kSlack_m;
                 // Past here the samples stop: the ray clears the highest stored bin (below).
                 if (aSlope > 0 && startZ_m - aRise > stopHeight) break;
-                if (!ringBound.empty()) {
-                    // The rest of the ray: no lower than its ends, within (length - da) of the
-                    // sensor, so over blocks at most j away (a cell and a block spare).
-                    const double j = (length - da + 2 * cell) * invBlock + 2;
-                    const float restBound_m =
-                        j < double(ringBound.size() - 1) ? ringBound[size_t(j)] : ringBound.back();
-                    const double restLowest_m =
-                        std::min(startZ_m, tz + aSlope * (length + kSlack_m) - kSlack_m);
-                    if (!boundMayConflict(restBound_m, restLowest_m)) break;
-                }
                 const double exit = ((da0 > 0 ? ka + 1 : ka) * block_m - a0) * invUa;
                 const double db = std::min(exit, length);
                 const double bLo = b0 + ub * (ub > 0 ? da - kSlack_m : db + kSlack_m) - kSlack_m;
                 const double bHi = b0 + ub * (ub > 0 ? db + kSlack_m : da - kSlack_m) + kSlack_m;
                 float bound_m = -std::numeric_limits<float>::infinity();
+                float rest_m = -std::numeric_limits<float>::infinity();
                 for (int kb = BinGrid::floorToInt(bLo * invBlock),
                          kbEnd = BinGrid::floorToInt(bHi * invBlock);
-                     kb <= kbEnd; kb++)
-                    bound_m = std::max(bound_m, xMajor ? blockBound(ka, kb) : blockBound(kb, ka));
+                     kb <= kbEnd; kb++) {
+                    const int bx = xMajor ? ka : kb, by = xMajor ? kb : ka;
+                    bound_m = std::max(bound_m, blockBound(bx, by));
+                    if (!towardsSensor.empty()) rest_m = std::max(rest_m, restBound(bx, by));
+                }
+                // The rest of the ray, this column included: no lower than its ends.
+                if (!towardsSensor.empty() &&
+                    !boundMayConflict(
+                        rest_m, std::min(startZ_m, tz + aSlope * (length + kSlack_m) - kSlack_m)))
+                    break;
                 const double lowest_m =
                     aSlope > 0 ? startZ_m : tz + aSlope * (db + kSlack_m) - kSlack_m;
                 if (boundMayConflict(bound_m, lowest_m + aRise)) {
-                    reach = db + kSlack_m;
+                    // A rising ray clears the column's bound part-way (rocks: mostly within a
+                    // few cells): past that distance every sample's ray, at least
+                    // tz + slope d + inCellRise, lies above the bound by the smallest conflict
+                    // margin (1e-6 m spare for rounding), so the stretch ends there.
+                    double end = db;
+                    if (aSlope > 0) {
+                        const double clearHeight_m = double(bound_m) +
+                                                     1e-6 * (1.0 + std::abs(double(bound_m))) -
+                                                     minConflictMargin - aRise + 1e-6;
+                        end = std::min(db, std::max(da, (clearHeight_m - tz) / aSlope));
+                    }
+                    reach = end + kSlack_m;
                     if (!stretches.empty() && stretches.back().second >= da - kSlack_m)
                         stretches.back().second = reach;  // joins the previous column's
                     else
