@@ -248,9 +248,9 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
         bad("min_x_m/max_x_m/min_y_m/max_y_m", "max must not be below min");
     if (!grow && (max_x <= min_x || max_y <= min_y))
         bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
-    // Refuse before allocating: every cell of a grid's window takes a slot of BinGrid (12 bytes:
-    // first bin, cycle stamp, update index) before any bin is stored.
-    constexpr double kCellBytes = 12, kMaxCells = 2.0e8;  // 2.4 GB of cell slots
+    // Refuse before allocating: every cell of a grid's window takes a slot of BinGrid (16 bytes:
+    // first bin, cycle stamp, update index, height bound) before any bin is stored.
+    constexpr double kCellBytes = 16, kMaxCells = 2.0e8;  // 3.2 GB of cell slots
     auto checkArea = [&](const std::string& key, double side_m, double cell_m) {
         const double side_cells = side_m / cell_m;
         if (side_cells * side_cells <= kMaxCells) return;
