@@ -15,6 +15,7 @@
 #include "multibin/io/StrictConfigSection.h"
 
 #include <Eigen/Dense>
+#include <cstring>
 #include <random>
 
 #include "multibin/geometry/PosePropagation.h"
@@ -232,8 +233,26 @@ TEST(CMultiBinElevationMap, SerializationRoundTripIsBitExactThroughClassRegistry
                 EXPECT_EQ(a->height_m, b->height_m);
                 EXPECT_EQ(a->variance_m2, b->variance_m2);
                 EXPECT_EQ(a->certainty, b->certainty);
+                EXPECT_EQ(std::memcmp(&a->plane, &b->plane, sizeof a->plane), 0)
+                    << "plane moments of cell " << ix << ", " << iy;
             }
         }
+    // The sub-cell surface (from the plane moments, serialized since version 3) answers the same
+    // at any point: before, a loaded map had no moments and answered with flat cells.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> x(0.2, 0.5), y(-0.3, 0.3);
+    int answered = 0;
+    for (int k = 0; k < 500; k++) {
+        const double qx = x(rng), qy = y(rng);
+        double h0, s0, h1, s1;
+        const bool known = map.heightAt(qx, qy, h0, s0);
+        ASSERT_EQ(copy->heightAt(qx, qy, h1, s1), known);
+        if (!known) continue;
+        answered++;
+        EXPECT_EQ(h0, h1) << qx << ", " << qy;
+        EXPECT_EQ(s0, s1) << qx << ", " << qy;
+    }
+    EXPECT_GT(answered, 100);
 }
 
 TEST(CMultiBinElevationMap, CorruptOrUnknownVersionSerializationIsRefused) {

@@ -28,7 +28,15 @@ constexpr uint32_t kMaxOptionsTextBytes = 1u << 20;
 // bin; a cut tag never matches (its high bytes are non-zero).
 constexpr uint32_t kTrailerTag = 0x4D42454D;  // "MBEM"
 
-/** A grid: its window, then each non-empty cell with its bins. */
+/** The plane moments of a bin, in their declaration order (serialization version 3). */
+template <class Moments, class Visit>
+void forEachMoment(Moments& m, Visit&& visit) {
+    for (auto* v :
+         {&m.weight, &m.mx_m, &m.my_m, &m.mz_m, &m.sxx, &m.sxy, &m.syy, &m.sxz, &m.syz, &m.szz})
+        visit(*v);
+}
+
+/** A grid: its window, then each non-empty cell with its bins (each with its plane moments). */
 void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid) {
     const multibin::CellWindow& w = grid.window();
     out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
@@ -48,6 +56,7 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
             out << int32_t(ix) << int32_t(iy) << n;
             grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
                 out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
+                forEachMoment(b.plane, [&](const float& v) { out << v; });
             });
         }
 }
@@ -57,9 +66,10 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
 }
 
 /** Reads a grid whose window may have at most maxSideCells cells per side (the stored options'
- * own limit), checked before anything is allocated. */
+ * own limit), checked before anything is allocated; its bins carry plane moments if
+ * `withPlane` (version 3; before, a loaded bin has none). */
 void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double cellSize_m,
-              double maxSideCells) {
+              double maxSideCells, bool withPlane) {
     int32_t ix0, iy0, nx, ny;
     in >> ix0 >> iy0 >> nx >> ny;
     if (nx < 0 || ny < 0 || double(nx) > maxSideCells || double(ny) > maxSideCells)
@@ -82,6 +92,17 @@ void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double
             in >> b.height_m >> b.variance_m2 >> b.certainty >> b.pointCount >> b.index;
             if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) || !(b.certainty >= 0))
                 corrupt("invalid bin");
+            if (withPlane) {
+                bool finite = true;
+                forEachMoment(b.plane, [&](float& v) {
+                    in >> v;
+                    finite = finite && std::isfinite(v);
+                });
+                // Weights and centred squares are sums of non-negative terms.
+                const multibin::PlaneMoments& m = b.plane;
+                if (!finite || !(m.weight >= 0) || !(m.sxx >= 0) || !(m.syy >= 0) || !(m.szz >= 0))
+                    corrupt("invalid plane moments");
+            }
             grid.appendBin(ix, iy, b);
         }
     }
@@ -96,8 +117,10 @@ struct StoredMap {
     multibin::BinGrid grid, local;
 };
 
-/** The version-0/1 body: options text, grid(s), and (version 1) the bin count and tag. */
+/** The body: options text, grid(s), and (from version 1) the bin count and tag; from version 3
+ * each bin carries its plane moments. */
 StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
+    const bool withPlane = version >= 3;
     StoredMap m;
     // Same layout as MRPT's string (uint32 length, bytes), read with a bound first.
     uint32_t textBytes = 0;
@@ -117,10 +140,12 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
     const auto& c = m.creation;
     const double singleSide_m = std::max({c.max_size_m, c.max_x - c.min_x, c.max_y - c.min_y});
     if (c.dual_grid) {
-        readGrid(in, grid, c.global_resolution_m, c.global_size_m / c.global_resolution_m + 2);
-        readGrid(in, local, c.local_resolution_m, c.local_size_m / c.local_resolution_m + 2);
+        readGrid(in, grid, c.global_resolution_m, c.global_size_m / c.global_resolution_m + 2,
+                 withPlane);
+        readGrid(in, local, c.local_resolution_m, c.local_size_m / c.local_resolution_m + 2,
+                 withPlane);
     } else {
-        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2);
+        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2, withPlane);
     }
     if (version >= 1) {
         uint32_t tag = 0;
@@ -135,11 +160,12 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
 }
 }  // namespace
 
-uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 2; }
+uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 3; }
 
 namespace {
-/** Version 2 wraps the version-1 body (the payload) as: uint64 payload bytes, the payload, the
- * CRC-32 of the payload. A flipped bit anywhere in it is an error before anything is parsed. */
+/** Versions 2 and 3 wrap the body (the payload) as: uint64 payload bytes, the payload, the CRC-32
+ * of the payload. A flipped bit anywhere in it is an error before anything is parsed. Version 3's
+ * body is version 1's with each bin's plane moments after its estimate. */
 constexpr size_t kPayloadChunkBytes = size_t(1) << 20;
 }  // namespace
 
@@ -191,7 +217,8 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
         case 1:
             apply(readBody(in, version));
             break;
-        case 2: {
+        case 2:
+        case 3: {
             uint64_t n = 0;
             in >> n;
             // Read in chunks: the buffer grows only as bytes arrive, whatever length is claimed.
@@ -214,7 +241,7 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
             mrpt::io::CMemoryStream mem;
             mem.assignMemoryNotOwn(payload.data(), payload.size());
             auto body = mrpt::serialization::archiveFrom(mem);
-            StoredMap stored = readBody(body, 1);
+            StoredMap stored = readBody(body, version == 2 ? 1 : version);
             if (mem.getPosition() != payload.size()) corrupt("bytes after the payload's trailer");
             apply(std::move(stored));
         } break;

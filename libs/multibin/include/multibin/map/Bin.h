@@ -29,7 +29,7 @@ struct BinEstimate {
     uint32_t pointCount = 0;
     int16_t index = 0;  //!< vertical bin index n: covers [n, n+1) * binHeight [m]
     uint16_t reserved = 0;
-    PlaneMoments plane;  //!< the slope inside the cell (not serialized: a loaded map has none)
+    PlaneMoments plane;  //!< the slope inside the cell (serialized from version 3)
 };
 
 /** A bin as BinStore keeps it: its estimate and the storage link to the next bin of its cell
