@@ -413,3 +413,47 @@ TEST(Visibility, MovedObjectIsForgottenAndItsSurroundingsKept) {
                   << " mm\n";
     }
 }
+
+TEST(Visibility, SubCellAnswerWeighsWhatTheConstraintTookFromAFace) {
+    // A 20 mm cell crossed by a box's face: 12 ground points over the cell, 40 face points in a
+    // strip 4 mm from its left edge (the scan line swept up the face). While the face stands,
+    // heightAt answers it over the part of the cell its points cover; once the constraint has
+    // taken 32 of its certainty (newer rays saw through it), over less (with the points as the
+    // prior: as much), and the cell value is the ground.
+    BinGrid g(0.02);
+    g.reset(0.02, CellWindow{-5, -5, 10, 10});
+    BinUpdateParams p;
+    g.beginCycle();
+    PointsWithCov pts;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 3; j++)
+            pts.push_back(pointAt(0.0025 + 0.005 * i, 0.004 + 0.006 * j, 0.01, 0.002));
+    for (int k = 0; k < 40; k++)
+        pts.push_back(pointAt(0.004, 0.001 + 0.00045 * k, 0.055 + 0.001 * k, 0.002));
+    g.insertPoints(pts, p);
+    // The share of a 10 x 10 lattice over the cell where heightAt answers the face.
+    auto faceShare = [&]() {
+        int face = 0;
+        for (int i = 0; i < 10; i++)
+            for (int j = 0; j < 10; j++) {
+                CellSurface s;
+                EXPECT_TRUE(
+                    heightAt(g, nullptr, 0.001 + 0.002 * i, 0.001 + 0.002 * j, p, false, s));
+                face += s.height_m > 0.04;
+            }
+        return face / 100.0;
+    };
+    const double standing = faceShare();
+    g.editBins(0, 0, [](Bin& b) {
+        if (b.index == 1) b.certainty -= 32;  // as applyVisibilityConstraint's decrement does
+        return true;
+    });
+    const double weakened = faceShare();
+    CellSurface cell;
+    ASSERT_TRUE(cellSurface(g, 0, 0, p, cell));
+    EXPECT_NEAR(cell.height_m, 0.01, 0.002) << "the cell value: the most certain surface";
+    std::cout << "the face answers heightAt over " << standing << " of the cell while it stands, "
+              << weakened << " once weakened\n";
+    EXPECT_GE(standing, 0.2);
+    EXPECT_LT(weakened, standing);
+}
