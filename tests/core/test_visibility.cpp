@@ -369,14 +369,19 @@ TEST(Visibility, MovedObjectIsForgottenAndItsSurroundingsKept) {
         EXPECT_NEAR(h, 0.12, 0.01) << "the box is mapped in the first pass";
         terrain.boxPresent = false;
         drive(map, terrain);
-        // Inside the old footprint and around it: height within 2 sigma of the true ground.
-        size_t cells = 0, within2Sigma = 0, around = 0, aroundOk = 0;
+        // Inside the old footprint and around it: height within 2 sigma of the true ground; and
+        // over every cell, those the faces cross included, the RMSE from the ground.
+        size_t cells = 0, within2Sigma = 0, around = 0, aroundOk = 0, all = 0;
+        double sumSquares_m2 = 0;
         for (double x = 0.55; x < 0.80; x += 0.015)
             for (double y = -0.15; y < 0.15; y += 0.015) {
                 if (!map.getHeight(x, y, h, s)) continue;
                 const double truth = terrain(x, y);
-                // Cells wholly inside the box's footprint. The cells its faces cross also
-                // fused face points into their ground bin; see doc/visibility.md.
+                all++;
+                sumSquares_m2 += (h - truth) * (h - truth);
+                // The 2 sigma test on cells wholly inside the box's footprint. The cells its
+                // faces cross also fused the faces' low points into their ground bin: they are
+                // judged by the RMSE above (tests/sim/test_moved_object.cpp: with noise).
                 const bool onFaces = (x > 0.585 && x < 0.615) || (x > 0.735 && x < 0.765) ||
                                      std::abs(std::abs(y) - 0.10) < 0.015;
                 const bool inFootprint = x > 0.615 && x < 0.735 && std::abs(y) < 0.085;
@@ -390,7 +395,9 @@ TEST(Visibility, MovedObjectIsForgottenAndItsSurroundingsKept) {
                     aroundOk += ok;
                 }
             }
+        const double rmse_m = std::sqrt(sumSquares_m2 / double(std::max<size_t>(all, 1)));
         if (constraint) {
+            EXPECT_LE(rmse_m, 0.015) << "faces included (issue 18's bound)";
             EXPECT_GT(cells, 50u);
             EXPECT_EQ(within2Sigma, cells) << "footprint cells back on the ground";
             EXPECT_GE(double(aroundOk), 0.95 * double(around)) << "surroundings unharmed";
@@ -398,9 +405,55 @@ TEST(Visibility, MovedObjectIsForgottenAndItsSurroundingsKept) {
         } else {
             // Without the constraint the box lingers: this is what the constraint fixes.
             EXPECT_LT(within2Sigma, cells);
+            EXPECT_GT(rmse_m, 0.015);
         }
         std::cout << (constraint ? "with" : "without") << " visibility constraint: " << within2Sigma
                   << " / " << cells << " footprint cells within 2 sigma, " << aroundOk << " / "
-                  << around << " around\n";
+                  << around << " around; RMSE over all " << all << " cells " << 1e3 * rmse_m
+                  << " mm\n";
     }
+}
+
+TEST(Visibility, SubCellAnswerWeighsWhatTheConstraintTookFromAFace) {
+    // A 20 mm cell crossed by a box's face: 12 ground points over the cell, 40 face points in a
+    // strip 4 mm from its left edge (the scan line swept up the face). While the face stands,
+    // heightAt answers it over the part of the cell its points cover; once the constraint has
+    // taken 32 of its certainty (newer rays saw through it), over less (with the points as the
+    // prior: as much), and the cell value is the ground.
+    BinGrid g(0.02);
+    g.reset(0.02, CellWindow{-5, -5, 10, 10});
+    BinUpdateParams p;
+    g.beginCycle();
+    PointsWithCov pts;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 3; j++)
+            pts.push_back(pointAt(0.0025 + 0.005 * i, 0.004 + 0.006 * j, 0.01, 0.002));
+    for (int k = 0; k < 40; k++)
+        pts.push_back(pointAt(0.004, 0.001 + 0.00045 * k, 0.055 + 0.001 * k, 0.002));
+    g.insertPoints(pts, p);
+    // The share of a 10 x 10 lattice over the cell where heightAt answers the face.
+    auto faceShare = [&]() {
+        int face = 0;
+        for (int i = 0; i < 10; i++)
+            for (int j = 0; j < 10; j++) {
+                CellSurface s;
+                EXPECT_TRUE(
+                    heightAt(g, nullptr, 0.001 + 0.002 * i, 0.001 + 0.002 * j, p, false, s));
+                face += s.height_m > 0.04;
+            }
+        return face / 100.0;
+    };
+    const double standing = faceShare();
+    g.editBins(0, 0, [](Bin& b) {
+        if (b.index == 1) b.certainty -= 32;  // as applyVisibilityConstraint's decrement does
+        return true;
+    });
+    const double weakened = faceShare();
+    CellSurface cell;
+    ASSERT_TRUE(cellSurface(g, 0, 0, p, cell));
+    EXPECT_NEAR(cell.height_m, 0.01, 0.002) << "the cell value: the most certain surface";
+    std::cout << "the face answers heightAt over " << standing << " of the cell while it stands, "
+              << weakened << " once weakened\n";
+    EXPECT_GE(standing, 0.2);
+    EXPECT_LT(weakened, standing);
 }

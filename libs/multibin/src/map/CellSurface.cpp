@@ -154,7 +154,8 @@ int cellPlanes(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p,
 
 /** Which of a cell's surfaces holds the point (dx_m, dy_m) from the cell's centre: the most
  * likely under a Gaussian of each surface's points' footprint (weighted mean and covariance,
- * widened by a tenth of the cell), its prior the surface's share of the points. */
+ * widened by a tenth of the cell), its prior the surface's share of the cell's certainty (its
+ * share of the points, less what contradicting data took away). */
 int surfaceHolding(const CellPlane* planes, int count, double dx_m, double dy_m, double cell_m) {
     int best = 0;
     double bestScore = std::numeric_limits<double>::infinity();
@@ -167,7 +168,9 @@ int surfaceHolding(const CellPlane* planes, int count, double dx_m, double dy_m,
         const double det = a * c - b * b;
         const double ex = dx_m - m.mx_m, ey = dy_m - m.my_m;
         const double d2 = (c * ex * ex - 2 * b * ex * ey + a * ey * ey) / det;
-        const double score = d2 + std::log(det) - 2 * std::log(planes[k].points);
+        // The prior is the surface's certainty, not its points: what a bin lost to the
+        // visibility constraint (newer data saw through it) counts against it here too.
+        const double score = d2 + std::log(det) - 2 * std::log(planes[k].surface.certainty);
         if (score < bestScore) {
             bestScore = score;
             best = k;
