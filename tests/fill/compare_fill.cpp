@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <map>
 #include <opencv2/photo.hpp>
@@ -412,9 +413,23 @@ int mapper(const std::string& mapPath, const std::string& truthPath) {
     map.dem_update_map();
     const FillResult& fill = map.lastFill();
     std::map<HeightSource, std::vector<Err>> bySource;
+    // FILL_DUMP=FILE: every filled cell as "column row height sigma truth source" [m], to look at.
+    std::FILE* dump =
+        std::getenv("FILL_DUMP") ? std::fopen(std::getenv("FILL_DUMP"), "w") : nullptr;
     multibin::filltest::forEachFilledCellWithTruth(fill, truthPath, [&](size_t k, double t) {
         bySource[fill.source[k]].push_back({fill.height_m[k] - t, fill.sigma_m[k]});
+        if (dump)
+            std::fprintf(dump, "%d %d %.4f %.4f %.4f %d\n", int(k % size_t(fill.nx())),
+                         int(k / size_t(fill.nx())), fill.height_m[k], fill.sigma_m[k], t,
+                         int(fill.source[k]));
     });
+    if (dump) {
+        for (size_t k = 0; k < fill.source.size(); k++)
+            if (fill.source[k] == HeightSource::Measured)
+                std::fprintf(dump, "%d %d %.4f %.4f nan 0\n", int(k % size_t(fill.nx())),
+                             int(k / size_t(fill.nx())), fill.height_m[k], fill.sigma_m[k]);
+        std::fclose(dump);
+    }
     std::printf(
         "| filled by | - | cells | within 1 sigma [%%] | within 2 sigma [%%] | within 3 sigma [%%] "
         "| RMSE [mm] | mean sigma [mm] |\n|---|---|---|---|---|---|---|---|\n");
@@ -427,6 +442,8 @@ int mapper(const std::string& mapPath, const std::string& truthPath) {
         all.insert(all.end(), e.begin(), e.end());
     }
     coverageRow("filled only, all", 0, all);
+    std::printf("shadows behind a step: %d gaps, %d cells (in the harmonic row)\n",
+                fill.stats.shadowGaps, fill.stats.shadowCells);
     std::printf("support areas %d, moving neighbourhoods %d, rim check -> harmonic %d, m:",
                 fill.stats.supportAreas, fill.stats.movingNeighbourhoods,
                 fill.stats.rimCheckHarmonic);

@@ -6,6 +6,7 @@
 #include "multibin/fill/HarmonicFill.h"
 #include "multibin/fill/KrigingFill.h"
 #include "multibin/fill/ModelSelection.h"
+#include "multibin/fill/ShadowOccluders.h"
 #include "multibin/fill/detail/MedianFiller.h"
 #include "multibin/fill/detail/ResultSetup.h"
 
@@ -36,6 +37,24 @@ bool fillWithGaussianSurface(const HeightRaster& r, const FillOptions& o,
     return true;
 }
 
+/** A shadow behind a step (ShadowOccluders.h): `masked` no longer holds the occluders, and the
+ * gap is the harmonic interpolation of the hidden side's rim (eq 16 with m = 0 plus harmonic
+ * rim residuals), the occluders' place a no-flux boundary: the far surface carried up to the
+ * edge. Not the kriging: its covariance reaches the occluder's top beyond the masked cells.
+ * Sigma: the surface path's (semivariogram at the distance to the data). False if too little
+ * data. */
+bool fillShadow(const HeightRaster& masked, const FillOptions& o, const std::vector<int>& cells,
+                FillResult& out) {
+    const SupportArea area(masked, o, cells);
+    if (area.samples.size() < 12) return false;
+    const GaussianSurface flat =
+        fitGaussianSurfaceFixed(area.samples, area.side, 0, o.gaussianFitOptions());
+    FillOptions harmonic = o;
+    harmonic.residualModel = ResidualModel::Harmonic;
+    fillByHarmonic(masked, harmonic, area, flat, out);
+    return true;
+}
+
 }  // namespace
 
 FillResult fillGaps(const HeightRaster& r, const FillOptions& o) {
@@ -58,6 +77,15 @@ FillResult fillGaps(const HeightRaster& r, const FillOptions& o) {
         if (gap.medianReach) {
             for (int k : gap.cells) median.fillCell(k % r.nx(), k / r.nx(), out, usable);
             continue;
+        }
+        if (o.gaussianEnabled && o.shadowOccluders) {
+            // A shadow behind a step: the step's top is not data of the hidden surface.
+            const ShadowOccluders occ = findShadowOccluders(r, gap.cells, o);
+            if (!occ.cells.empty() && fillShadow(withoutOccluders(r, occ), o, gap.cells, out)) {
+                out.stats.shadowGaps++;
+                out.stats.shadowCells += int(gap.cells.size());
+                continue;
+            }
         }
         if (o.gaussianEnabled && fillWithGaussianSurface(r, o, gap.cells, out)) continue;
         // Fallback: rim-inwards median; its intermediate cells must not leak into other gaps.

@@ -120,6 +120,17 @@ struct FillOptions {
      * filled that way (the kriging sigma kept). A step hidden in a long shadow is what the
      * smooth kriging carries too far. */
     bool movingRimCheck = true;
+    /** [fill_shadow_occluders] a gap whose rim holds the top of a step that hides it (a shadow
+     * behind a raised edge, see ShadowOccluders.h) is filled without the step's top: from the
+     * hidden side only. */
+    bool shadowOccluders = true;
+    /** [fill_shadow_step_sigmas] a rim cell is an occluder when it stands above the cells across
+     * the gap by more than this many standard deviations of what their sigmas and the visible
+     * slopes explain [-]. */
+    double shadowStepSigmas = 3.0;
+    /** [fill_shadow_reach_cells] an occluder's top is hidden from the fill up to this many cells
+     * from its rim cell [cells]. */
+    int shadowReach_cells = 4;
     /** [fill_model_averaging] kriging only: average the fills of the m visited by the search
      * with Akaike weights exp(-dAIC/2) (and add their spread to the variance) instead of
      * keeping the single best m. */

@@ -14,8 +14,10 @@ namespace multibin::fill {
  *  1. gaps = 4-connected components of cells that are not measured (GapLabelling.h);
  *  2. a gap whose every cell has >= medianMinKnown measured cells in its window is filled by the
  *     weighted median (small gaps; WeightedMedianFill.h);
- *  3. a larger gap (<= maxGapCells) gets a square support area (SupportArea.h) and is filled by
- *     eq 16 fitted there: as the trend of a universal kriging (KrigingFill.h, default) or plus
+ *  3. a larger gap (<= maxGapCells) that is a shadow behind a step (ShadowOccluders.h) is
+ *     filled from its hidden side only: harmonic interpolation of the rim without the occluder;
+ *     another larger gap (<= maxGapCells) gets a square support area (SupportArea.h) and is filled
+ * by eq 16 fitted there: as the trend of a universal kriging (KrigingFill.h, default) or plus
  *     harmonic / biharmonic rim residuals (HarmonicFill.h), m chosen as in ModelSelection.h; by
  *     the repeated median if gaussianEnabled is false or the area has too little data;
  *  4. larger gaps stay Unknown.

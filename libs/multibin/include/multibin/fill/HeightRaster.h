@@ -69,6 +69,9 @@ struct FillResult {
         /** m of the eq 16 surface whose heights those gaps took (AICc on independent residuals;
          * termsChosen keeps the kriging's m for them), one per rimCheckHarmonic gap */
         std::vector<int> rimCheckTerms;
+        /** gaps filled as shadows behind a step, from their hidden side (ShadowOccluders.h), and
+         * their cells (FilledHarmonic) */
+        int shadowGaps = 0, shadowCells = 0;
     } stats;
 
     int nx() const { return lattice.nx(); }
