@@ -5,24 +5,14 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
+
+#include "../core/test_files.h"
 
 namespace mapper_run {
 
-/** An empty folder `name` under the build tree's `group` folder. */
-inline std::filesystem::path scratchDir(const std::string& group, const std::string& name) {
-    const std::filesystem::path d = std::filesystem::path(MULTIBIN_BINARY_DIR) / group / name;
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    return d;
-}
-
-inline std::string readAll(const std::filesystem::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
+using test_files::readAll;
+using test_files::scratchDir;
 
 struct RunResult {
     int exitCode;

@@ -8,19 +8,13 @@
 
 #include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/map/BinGrid.h"
+#include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 
 namespace {
 CMultiBinElevationMap fixedMap(double cell_m) {
-    CMultiBinElevationMap::TCreationOptions c;
-    c.resolution_m = cell_m;
-    c.grow = false;
-    c.min_x = c.min_y = 0;
-    c.max_x = c.max_y = 1;
-    CMultiBinElevationMap map(c);
-    map.insertionOptions.height_sigma_floor_m = 0.001;
-    return map;
+    return test_scenes::fixedSquareMap(cell_m, 1.0, 0.001);
 }
 void insert(CMultiBinElevationMap& map, double x, double y, double z, double sigma) {
     CMultiBinElevationMap::TPointInsertParams ip;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <mrpt/core/bits_math.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/poses/CPose3D.h>
 
@@ -69,6 +70,20 @@ mrpt::obs::CObservation2DRangeScan::Ptr pitchedScanOver(const Terrain& terrain,
         scan->setScanRangeValidity(i, range > 0);
     }
     return scan;
+}
+
+/** A map of fixed extent [0, side_m] x [0, side_m] (no growth) with cells of `cell_m` and a
+ * height sigma floor of `sigmaFloor_m`. */
+inline mrpt::maps::CMultiBinElevationMap fixedSquareMap(double cell_m, double side_m,
+                                                        double sigmaFloor_m) {
+    mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
+    c.resolution_m = cell_m;
+    c.grow = false;
+    c.min_x = c.min_y = 0;
+    c.max_x = c.max_y = side_m;
+    mrpt::maps::CMultiBinElevationMap map(c);
+    map.insertionOptions.height_sigma_floor_m = sigmaFloor_m;
+    return map;
 }
 
 }  // namespace test_scenes

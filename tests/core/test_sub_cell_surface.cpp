@@ -9,6 +9,7 @@
 #include <random>
 
 #include "SurfaceAccuracy.h"
+#include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 
@@ -24,16 +25,7 @@ double terrain(double x, double y) {
            0.008 * std::sin(2 * kPi * (x + 0.6 * y) / 0.05) + (x >= kStepX_m ? kStep_m : 0.0);
 }
 
-CMultiBinElevationMap fixedMap() {
-    CMultiBinElevationMap::TCreationOptions c;
-    c.resolution_m = kCell_m;
-    c.grow = false;
-    c.min_x = c.min_y = 0;
-    c.max_x = c.max_y = 0.6;
-    CMultiBinElevationMap map(c);
-    map.insertionOptions.height_sigma_floor_m = 0.0005;
-    return map;
-}
+CMultiBinElevationMap fixedMap() { return test_scenes::fixedSquareMap(kCell_m, 0.6, 0.0005); }
 
 /** `perCell` points per cell on average, uniformly placed, each displaced by its covariance
  * (1 mm horizontally, 2 mm vertically): the map is told the truth about its noise. */

@@ -11,12 +11,12 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include "../core/test_files.h"
 #include "../core/test_scenes.h"
 #include "multibin/map/BinGrid.h"
 
@@ -41,17 +41,10 @@ constexpr uint64_t kAddressSpaceLimit_bytes = uint64_t(1) << 30;
 
 /** An empty scratch directory build/test_reliability/NAME for a test's files. */
 inline std::filesystem::path scratchDir(const std::string& name) {
-    const auto d = std::filesystem::path(MULTIBIN_BINARY_DIR) / "test_reliability" / name;
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    return d;
+    return test_files::scratchDir("test_reliability", name);
 }
 
-/** A file's bytes. */
-inline std::string readAll(const std::filesystem::path& p) {
-    std::ifstream f(p, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
+using test_files::readAll;
 
 using Map = mrpt::maps::CMultiBinElevationMap;
 
