@@ -57,11 +57,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     };
     // Local height bounds: a block or a cell whose bound lies no more than minConflictMargin
     // above the line holds no conflicting bin. The tolerance covers the rounding of bins' float
-    // heights.
+    // heights: no bin lies above tolerantBound_m(bound).
+    auto tolerantBound_m = [](float max_m) {
+        return double(max_m) + 1e-6 * (1.0 + std::abs(double(max_m)));
+    };
     auto boundMayConflict = [&](float max_m, double lineHeight_m) {
         return max_m > -std::numeric_limits<float>::infinity() &&
-               double(max_m) + 1e-6 * (1.0 + std::abs(double(max_m))) >
-                   lineHeight_m + minConflictMargin;
+               tolerantBound_m(max_m) > lineHeight_m + minConflictMargin;
     };
     const double block_m = BinGrid::kBlockCells * cell;
     const double invBlock = 1.0 / block_m;
@@ -126,9 +128,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 for (int bx = bxLo; bx <= bxHi; bx++)
                     bound_m = std::max(bound_m, grid.blockMaxHeight_m(bx, by));
             // Every sample lies in this region: its bound caps what a ray can meet.
-            stopHeight =
-                std::min(stopHeight,
-                         double(bound_m) + 1e-6 * (1.0 + std::abs(double(bound_m))) + vis.margin_m);
+            stopHeight = std::min(stopHeight, tolerantBound_m(bound_m) + vis.margin_m);
             if (!boundMayConflict(bound_m, lowest_m)) {
                 // As the walk counts them (length >= cell), the square root only near the edge.
                 const double cell2Lo = cell * cell * (1 - 1e-9), cell2Hi = cell * cell * (1 + 1e-9);
@@ -161,23 +161,22 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 !boundMayConflict(nearSensor_m, sensor_m.z() - 1e-6)) {
                 // Rows, then the blocks of a row, outwards from the sensor's: a block's
                 // rectangle is itself and the rectangles of its neighbours towards the sensor.
+                auto outwards = [](int from, int lo, int hi) {
+                    std::vector<int> order{from};
+                    for (int k = 1; from - k >= lo || from + k <= hi; k++) {
+                        if (from - k >= lo) order.push_back(from - k);
+                        if (from + k <= hi) order.push_back(from + k);
+                    }
+                    return order;
+                };
                 towardsSensor.resize(regionBound.size());
-                const int rows = std::max(sby - byLo, byHi - sby);
-                const int cols = std::max(sbx - bxLo, bxHi - sbx);
-                for (int ry = 0; ry <= rows; ry++)
-                    for (int by : {sby - ry, sby + ry}) {
-                        if (by < byLo || by > byHi || (ry == 0 && by != sby - ry)) continue;
-                        for (int rx = 0; rx <= cols; rx++)
-                            for (int bx : {sbx - rx, sbx + rx}) {
-                                if (bx < bxLo || bx > bxHi || (rx == 0 && bx != sbx - rx)) continue;
-                                float r = blockBound(bx, by);
-                                if (bx != sbx)
-                                    r = std::max(r, restBound(bx + (bx < sbx ? 1 : -1), by));
-                                if (by != sby)
-                                    r = std::max(r, restBound(bx, by + (by < sby ? 1 : -1)));
-                                towardsSensor[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] =
-                                    r;
-                            }
+                const std::vector<int> columns = outwards(sbx, bxLo, bxHi);
+                for (int by : outwards(sby, byLo, byHi))
+                    for (int bx : columns) {
+                        float r = blockBound(bx, by);
+                        if (bx != sbx) r = std::max(r, restBound(bx + (bx < sbx ? 1 : -1), by));
+                        if (by != sby) r = std::max(r, restBound(bx, by + (by < sby ? 1 : -1)));
+                        towardsSensor[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = r;
                     }
             }
         }
@@ -287,9 +286,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     // margin (1e-6 m spare for rounding), so the stretch ends there.
                     double end = db;
                     if (aSlope > 0) {
-                        const double clearHeight_m = double(bound_m) +
-                                                     1e-6 * (1.0 + std::abs(double(bound_m))) -
-                                                     minConflictMargin - aRise + 1e-6;
+                        const double clearHeight_m =
+                            tolerantBound_m(bound_m) - minConflictMargin - aRise + 1e-6;
                         end = std::min(db, std::max(da, (clearHeight_m - tz) / aSlope));
                     }
                     reach = end + kSlack_m;
