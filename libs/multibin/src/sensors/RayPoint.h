@@ -31,10 +31,7 @@ inline RayPointFate rayPoint(float x, float y, float z, double minRange_m, doubl
     const double xd = x, yd = y, zd = z;
     const double n = std::sqrt(xd * xd + yd * yd + zd * zd);
     const RaySigmas s = sigmas(n);
-    const double dx = xd / n, dy = yd / n, dz = zd / n;
-    const double l2 = s.lateral_m * s.lateral_m, k = s.axial_m * s.axial_m - l2;
-    cov = {float(k * dx * dx + l2), float(k * dx * dy), float(k * dx * dz),
-           float(k * dy * dy + l2), float(k * dy * dz), float(k * dz * dz + l2)};
+    cov = rayCovarianceAlong(xd / n, yd / n, zd / n, s.axial_m, s.lateral_m);
     return RayPointFate((finite ^ 1) * int(RayPointFate::notFinite) |
                         (finite & (inRange ^ 1)) * int(RayPointFate::outOfRange));
 }

@@ -12,14 +12,20 @@ class CObservationPointCloud;  // in mrpt::maps, not in obs_frwds.h
 
 namespace multibin::sensors {
 
-/** Covariance [m^2] of a point `p_m` measured along its ray from the sensor origin:
- * axial_m^2 d d^T + lateral_m^2 (I - d d^T), d = p / |p|. */
-inline SymmetricCov3 rayCovariance(const Eigen::Vector3f& p_m, double axial_m, double lateral_m) {
+/** Covariance [m^2] of a point measured along the unit ray (dx, dy, dz) from the sensor origin:
+ * axial_m^2 d d^T + lateral_m^2 (I - d d^T). */
+inline SymmetricCov3 rayCovarianceAlong(double dx, double dy, double dz, double axial_m,
+                                        double lateral_m) {
     // = (axial^2 - lateral^2) d d^T + lateral^2 I: six entries, no 3x3 temporaries.
-    const Eigen::Vector3d d = p_m.cast<double>() / p_m.cast<double>().norm();
     const double l2 = lateral_m * lateral_m, k = axial_m * axial_m - l2;
-    return {float(k * d.x() * d.x() + l2), float(k * d.x() * d.y()), float(k * d.x() * d.z()),
-            float(k * d.y() * d.y() + l2), float(k * d.y() * d.z()), float(k * d.z() * d.z() + l2)};
+    return {float(k * dx * dx + l2), float(k * dx * dy), float(k * dx * dz),
+            float(k * dy * dy + l2), float(k * dy * dz), float(k * dz * dz + l2)};
+}
+
+/** The same for a point `p_m` on the ray: d = p / |p|. */
+inline SymmetricCov3 rayCovariance(const Eigen::Vector3f& p_m, double axial_m, double lateral_m) {
+    const Eigen::Vector3d d = p_m.cast<double>() / p_m.cast<double>().norm();
+    return rayCovarianceAlong(d.x(), d.y(), d.z(), axial_m, lateral_m);
 }
 
 /** Sensor-frame covariance [m^2] of a point at `p_m` (sensor origin at 0) under a ray model: a
