@@ -24,30 +24,9 @@ Eigen::Matrix3d toEigen(const mrpt::math::CMatrixDouble33& m) {
 constexpr int kEntryRow[6] = {0, 0, 0, 1, 1, 2};
 constexpr int kEntryCol[6] = {0, 1, 2, 1, 2, 2};
 
-/** Points per block of the structure-of-arrays kernel: small enough that a block's inputs,
- * monomials and outputs (about 25 floats a point) stay in the L1 cache. */
-constexpr size_t kBlock = 128;
+constexpr size_t kBlock = PointBlock::kCapacity;
 
-/** One block of points as separate arrays: x, y, z, then the six covariance entries. */
-struct SoaBlock {
-    alignas(64) float v[9][kBlock];
-};
-
-void gather(const PointWithCov* in, size_t n, SoaBlock& b) {
-    for (size_t i = 0; i < n; i++) {
-        b.v[0][i] = in[i].point_m.x();
-        b.v[1][i] = in[i].point_m.y();
-        b.v[2][i] = in[i].point_m.z();
-        b.v[3][i] = in[i].cov_m2.xx;
-        b.v[4][i] = in[i].cov_m2.xy;
-        b.v[5][i] = in[i].cov_m2.xz;
-        b.v[6][i] = in[i].cov_m2.yy;
-        b.v[7][i] = in[i].cov_m2.yz;
-        b.v[8][i] = in[i].cov_m2.zz;
-    }
-}
-
-void scatter(const SoaBlock& b, size_t n, PointWithCov* out) {
+void scatter(const PointBlock& b, size_t n, PointWithCov* out) {
     for (size_t i = 0; i < n; i++) {
         out[i].point_m = Eigen::Vector3f(b.v[0][i], b.v[1][i], b.v[2][i]);
         out[i].cov_m2 =
@@ -60,8 +39,8 @@ void scatter(const SoaBlock& b, size_t n, PointWithCov* out) {
  * x86-64 SSE2, chosen at load time); neither uses fused multiply-add and every lane does the same
  * operations in the same order, so results are bit-identical whichever runs. */
 MULTIBIN_VECTOR_CLONES
-void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const SoaBlock& in,
-                    SoaBlock& out) {
+void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const PointBlock& in,
+                    PointBlock& out) {
     const float* __restrict x = in.v[0];
     const float* __restrict y = in.v[1];
     const float* __restrict z = in.v[2];
@@ -202,12 +181,31 @@ void PosePropagator::apply(const PointsWithCov& in, PointsWithCov& out) const {
     apply(in.data(), out.data(), in.size());
 }
 
+void PointBlock::gather(const PointWithCov* in, size_t n) {
+    for (size_t i = 0; i < n; i++) {
+        v[0][i] = in[i].point_m.x();
+        v[1][i] = in[i].point_m.y();
+        v[2][i] = in[i].point_m.z();
+        v[3][i] = in[i].cov_m2.xx;
+        v[4][i] = in[i].cov_m2.xy;
+        v[5][i] = in[i].cov_m2.xz;
+        v[6][i] = in[i].cov_m2.yy;
+        v[7][i] = in[i].cov_m2.yz;
+        v[8][i] = in[i].cov_m2.zz;
+    }
+}
+
+void PosePropagator::applyBlock(const PointWithCov* in, size_t n, PointBlock& out) const {
+    PointBlock src;
+    src.gather(in, n);
+    propagateBlock(m_k, n, src, out);
+}
+
 void PosePropagator::apply(const PointWithCov* in, PointWithCov* out, size_t n) const {
-    SoaBlock src, dst;
+    PointBlock dst;
     for (size_t begin = 0; begin < n; begin += kBlock) {
         const size_t m = std::min(kBlock, n - begin);
-        gather(in + begin, m, src);
-        propagateBlock(m_k, m, src, dst);
+        applyBlock(in + begin, m, dst);  // reads in[begin ..) before out[begin ..) is written
         scatter(dst, m, out + begin);
     }
 }

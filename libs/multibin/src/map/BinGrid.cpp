@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <stdexcept>
 
 #include "multibin/geometry/PosePropagation.h"
@@ -78,23 +79,21 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
         return false;
     }
     return fuseMeasurement(slot(ix, iy), ix, iy, n, height_m, variance_m2, params,
-                           continuityBound_m, stats, nullptr);
+                           continuityBound_m, stats, std::nanf(""), std::nanf(""));
 }
 
 bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height_m,
                               double variance_m2, const BinUpdateParams& params,
-                              double continuityBound_m, InsertStats& stats,
-                              const PointWithCov* point) {
+                              double continuityBound_m, InsertStats& stats, float x_m, float y_m) {
     Bin& bin = BinStore::bin(findOrAddBin(s, n));
     if (!passesEq14(bin, height_m, continuityBound_m)) {
         stats.continuityRejected++;
         return false;
     }
     addMeasurement(bin, height_m, variance_m2, params);
-    if (point)  // a height without a place (insertHeight) says nothing of the slope
-        addPlanePoint(bin.plane, float(point->point_m.x() - cellCenter_m(ix)),
-                      float(point->point_m.y() - cellCenter_m(iy)), float(height_m),
-                      float(1.0 / variance_m2));
+    if (!std::isnan(x_m))  // a height without a place (insertHeight) says nothing of the slope
+        addPlanePoint(bin.plane, float(x_m - cellCenter_m(ix)), float(y_m - cellCenter_m(iy)),
+                      float(height_m), float(1.0 / variance_m2));
     stats.accepted++;
     m_index.noteUpdate(s, ix, iy, height_m, 1);
     return true;
@@ -102,8 +101,7 @@ bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height
 
 namespace {
 
-/** Points classified per block before the sequential bin update. */
-constexpr size_t kPointBlock = 256;
+constexpr size_t kPointBlock = PointBlock::kCapacity;
 
 enum PointStatus : uint8_t {
     kAccept,
@@ -112,16 +110,119 @@ enum PointStatus : uint8_t {
     kOutsideMap,
     kTooUncertain,
     kOutsideBinRange,
-    kStatusCount
+    kStatusCount,
+    kCheckSingular = kStatusCount  //!< not positive definite: isSingularCovariance decides
 };
 
 /** Per-point results of the classification pass over one block. */
 struct ClassifiedBlock {
-    uint8_t status[kPointBlock];
-    int16_t bin[kPointBlock];
-    int32_t ix[kPointBlock], iy[kPointBlock];
-    uint32_t slot[kPointBlock];
+    alignas(64) double weight[kPointBlock];  //!< 1 / fused variance [1/m^2]
+    alignas(64) int32_t ix[kPointBlock], iy[kPointBlock];
+    alignas(64) int32_t slot[kPointBlock];
+    alignas(64) int32_t bin[kPointBlock];
+    alignas(64) uint8_t status[kPointBlock];
 };
+
+/** What the classification needs of the grid, by value (no aliasing with the block). */
+struct ClassifyGeometry {
+    double invCellSize;  //!< [1/m]
+    CellWindow window;
+    int originSlotX, originSlotY;
+    double binHeight_m;
+    double maxVariance9_m2;  //!< Delta_max^2 of eq 13, compared with 9 var
+    /** kMinFusedVariance_m2, passed at run time: with the constant, GCC folds 1 / constant into
+     * one arm of the select and the loop no longer vectorises. */
+    double minFusedVariance_m2;
+};
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define MULTIBIN_CLASSIFY_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define MULTIBIN_CLASSIFY_CLONES
+#endif
+
+/** Pass 1 over a block, no bin access: validity, the gates that need only the point, cell, slot
+ * and bin index, and the point's weight. Branch-free so the compiler vectorises it; the same
+ * double arithmetic as BinStore::cellIndex, binIndexOf, isCovariance and
+ * BinUpdateParams::passesEq13, so every decision and weight is theirs bit for bit. A point whose
+ * covariance is not positive definite gets kCheckSingular (the caller asks
+ * isSingularCovariance, rare). */
+MULTIBIN_CLASSIFY_CLONES
+void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
+                   ClassifiedBlock& cb) {
+    constexpr double kLimit = std::numeric_limits<int>::max() / 4;  // as BinStore::cellIndex
+    constexpr double kBinLow = std::numeric_limits<int16_t>::min();
+    constexpr double kBinHigh = double(std::numeric_limits<int16_t>::max()) + 1.0;
+    const float* __restrict px = pts.v[0];
+    const float* __restrict py = pts.v[1];
+    const float* __restrict pz = pts.v[2];
+    const float* __restrict cxx = pts.v[3];
+    const float* __restrict cxy = pts.v[4];
+    const float* __restrict cxz = pts.v[5];
+    const float* __restrict cyy = pts.v[6];
+    const float* __restrict cyz = pts.v[7];
+    const float* __restrict czz = pts.v[8];
+    // Comparisons become 0/1 ints combined with & and arithmetic, and every choice a select, so
+    // the loops have no control flow and vectorise. Two loops: GCC 12 does not vectorise a
+    // clamped double's conversion to int in the same loop as the clamp.
+    alignas(64) double cellX[kPointBlock], cellY[kPointBlock], binQ[kPointBlock];
+    alignas(64) int32_t flags[kPointBlock];  // gates passed: 1 finite, 2 positive definite,
+                                             // 4 eq 13, 8 the bin index fits
+    for (size_t i = 0; i < m; i++) {
+        const double x = px[i], y = py[i], z = pz[i];
+        const double xx = cxx[i], xy = cxy[i], xz = cxz[i], yy = cyy[i], yz = cyz[i], zz = czz[i];
+        // All nine values finite iff their sum in double is (nine floats cannot overflow a
+        // double; a NaN or infinity makes the sum NaN or infinite).
+        const double sum = x + y + z + xx + xy + xz + yy + yz + zz;
+        const int finite = int(sum - sum == 0.0);
+        // Positive definite by Sylvester's criterion, as isCovariance.
+        const double m2 = xx * yy - xy * xy;
+        const double m3 =
+            xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+        const int positiveDefinite = int(xx > 0) & int(m2 > 0) & int(m3 > 0);
+        const int eq13 = 1 - int(9.0 * zz > g.maxVariance9_m2);
+        const double q = z / g.binHeight_m;
+        const int binFits = int(q >= kBinLow) & int(q < kBinHigh);
+        double fx = x * g.invCellSize, fy = y * g.invCellSize;  // as BinStore::cellIndex
+        fx = fx < kLimit ? fx : kLimit;                         // also NaN
+        fx = fx < -kLimit ? -kLimit : fx;
+        fy = fy < kLimit ? fy : kLimit;
+        fy = fy < -kLimit ? -kLimit : fy;
+        cellX[i] = fx;
+        cellY[i] = fy;
+        binQ[i] = binFits ? q : 0.0;
+        flags[i] = finite | positiveDefinite << 1 | eq13 << 2 | binFits << 3;
+        cb.weight[i] = 1.0 / (zz < g.minFusedVariance_m2 ? g.minFusedVariance_m2 : zz);
+    }
+    const auto floorToInt = [](double v) {  // as BinStore::floorToInt
+        const int t = static_cast<int>(v);
+        return t - int(v < double(t));
+    };
+    const int nx = g.window.nx, ny = g.window.ny;
+    for (size_t i = 0; i < m; i++) {
+        const int ix = floorToInt(cellX[i]), iy = floorToInt(cellY[i]);
+        const int dx = ix - g.window.ix0, dy = iy - g.window.iy0;
+        const int inWindow = int(dx >= 0) & int(dx < nx) & int(dy >= 0) & int(dy < ny);
+        int sx = dx + g.originSlotX, sy = dy + g.originSlotY;
+        sx -= nx * int(sx >= nx);
+        sy -= ny * int(sy >= ny);
+        const int f = flags[i];
+        const int finite = f & 1, positiveDefinite = f >> 1 & 1, eq13 = f >> 2 & 1,
+                  binFits = f >> 3 & 1;
+        // The first gate failed decides, in the order of the scalar checks.
+        const int rest =
+            (1 - inWindow) * kOutsideMap +
+            inWindow * ((1 - eq13) * kTooUncertain + eq13 * (1 - binFits) * kOutsideBinRange);
+        const int status =
+            (1 - finite) * kNotFinite +
+            finite * ((1 - positiveDefinite) * kCheckSingular + positiveDefinite * rest);
+        cb.status[i] = static_cast<uint8_t>(status);
+        cb.ix[i] = ix;
+        cb.iy[i] = iy;
+        cb.bin[i] = floorToInt(binQ[i]);
+        cb.slot[i] = (sx + sy * nx) * inWindow;
+    }
+}
 
 }  // namespace
 
@@ -133,26 +234,27 @@ InsertStats BinGrid::insertPoints(const PointsWithCov& mapPoints, const BinUpdat
 InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
                                   const BinUpdateParams& params, double continuityBound_m) {
     return insertBlocks(
-        count, [mapPoints](size_t begin, size_t) { return mapPoints + begin; }, params,
-        continuityBound_m);
+        count,
+        [mapPoints](size_t begin, size_t m, PointBlock& block) {
+            block.gather(mapPoints + begin, m);
+        },
+        params, continuityBound_m);
 }
 
 InsertStats BinGrid::insertSensorPoints(const PosePropagator& propagator,
                                         const PointsWithCov& sensorPoints,
                                         const BinUpdateParams& params, double continuityBound_m) {
-    // One classification block of map-frame points at a time (9 kB, stays in the L1 cache).
-    std::array<PointWithCov, kPointBlock> mapPoints;
+    // One block of map-frame points at a time (9 kB, stays in the L1 cache).
     return insertBlocks(
         sensorPoints.size(),
-        [&](size_t begin, size_t m) {
-            propagator.apply(sensorPoints.data() + begin, mapPoints.data(), m);
-            return static_cast<const PointWithCov*>(mapPoints.data());
+        [&](size_t begin, size_t m, PointBlock& block) {
+            propagator.applyBlock(sensorPoints.data() + begin, m, block);
         },
         params, continuityBound_m);
 }
 
 template <typename BlockSource>
-InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
+InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
                                   const BinUpdateParams& params, double continuityBound_m) {
     InsertStats stats;
     // Eq 14 compares each laser point with the bin height left by the previous point, so with a
@@ -162,8 +264,14 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
     // division chained through every point.
     const bool perPoint = continuityBound_m < std::numeric_limits<double>::infinity();
     const CellWindow w = window();
+    const ClassifyGeometry geometry{
+        inverseCellSize(),   w,
+        originSlotX(),       originSlotY(),
+        params.binHeight_m,  params.maxElevationUncertainty_m * params.maxElevationUncertainty_m,
+        kMinFusedVariance_m2};
 
-    // The open run: consecutive accepted points in one bin.
+    // The open run: consecutive accepted points in one bin. Its plane moments are a copy, written
+    // back when the run closes, so the per-point update stays in registers.
     struct Run {
         BinId bin = kNoBin;
         size_t slot = 0;
@@ -171,7 +279,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
         int ix = 0, iy = 0;
         uint32_t points = 0;
         HeightInformation sum;
-        PlaneMoments* plane = nullptr;    // the bin's: no bin is added while a run is open
+        PlaneMoments plane;
         double cellX_m = 0, cellY_m = 0;  // the cell's centre [m]
         double maxHeight_m = 0;
         bool frozen = false;  // the bin has zero variance: its height cannot move
@@ -183,81 +291,80 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& blockAt,
             bin.height_m = static_cast<float>(run.sum.height_m());
             bin.variance_m2 = static_cast<float>(run.sum.variance_m2());
         }
-        for (uint32_t k = 0; k < run.points; k++) bin.certainty += params.certaintyIncrement;
+        bin.plane = run.plane;
+        addCertainty(bin.certainty, params.certaintyIncrement, run.points);
         util::addSaturating(bin.pointCount, run.points);
         m_index.noteUpdate(run.slot, run.ix, run.iy, run.maxHeight_m, run.points);
         run.bin = kNoBin;
     };
 
+    PointBlock pts;
     ClassifiedBlock cb;
     size_t rejected[kStatusCount] = {};
     for (size_t begin = 0; begin < count; begin += kPointBlock) {
         const size_t m = std::min(kPointBlock, count - begin);
-        const PointWithCov* pts = blockAt(begin, m);
-        // Pass 1, no bin access: validity, gates that need only the point, cell and bin index.
-        for (size_t i = 0; i < m; i++) {
-            const PointWithCov& p = pts[i];
-            const SymmetricCov3& c = p.cov_m2;
-            // All nine values finite iff their sum in double is (nine floats cannot overflow a
-            // double; a NaN or infinity makes the sum NaN or infinite): one test, no branches.
-            const double sum = double(p.point_m.x()) + double(p.point_m.y()) +
-                               double(p.point_m.z()) + double(c.xx) + double(c.xy) + double(c.xz) +
-                               double(c.yy) + double(c.yz) + double(c.zz);
-            if (!(sum - sum == 0.0)) {
-                cb.status[i] = kNotFinite;
-                continue;
-            }
-            const int ix = cellIndex(p.point_m.x()), iy = cellIndex(p.point_m.y());
-            int16_t n = 0;
-            uint8_t status = kAccept;
-            if (!isCovariance(c))  // zero or singular: an exact pose, fused as it is
-                status = kBadCovariance;
-            else if (!w.contains(ix, iy))
-                status = kOutsideMap;
-            else if (!params.passesEq13(double(c.zz)))
-                status = kTooUncertain;
-            else if (!binIndexOf(p.point_m.z(), params.binHeight_m, n))
-                status = kOutsideBinRange;
-            cb.status[i] = status;
-            cb.bin[i] = n;
-            cb.ix[i] = ix;
-            cb.iy[i] = iy;
-            cb.slot[i] = status == kAccept ? static_cast<uint32_t>(slot(ix, iy)) : 0;
-        }
+        fillBlock(begin, m, pts);
+        classifyBlock(geometry, pts, m, cb);
         // Pass 2, in point order: the bin updates.
         for (size_t i = 0; i < m; i++) {
             if (cb.status[i] != kAccept) {  // rare: counted per reason after the loop
-                rejected[cb.status[i]]++;
-                continue;
+                if (cb.status[i] == kCheckSingular) {
+                    const SymmetricCov3 c{pts.v[3][i], pts.v[4][i], pts.v[5][i],
+                                          pts.v[6][i], pts.v[7][i], pts.v[8][i]};
+                    if (!isSingularCovariance(c)) {
+                        rejected[kBadCovariance]++;
+                        continue;
+                    }
+                    // An exact pose, fused as it is: the gates after the covariance's.
+                    if (!w.contains(cb.ix[i], cb.iy[i])) {
+                        rejected[kOutsideMap]++;
+                        continue;
+                    }
+                    if (!params.passesEq13(double(c.zz))) {
+                        rejected[kTooUncertain]++;
+                        continue;
+                    }
+                    int16_t n;
+                    if (!binIndexOf(pts.v[2][i], params.binHeight_m, n)) {
+                        rejected[kOutsideBinRange]++;
+                        continue;
+                    }
+                } else {
+                    rejected[cb.status[i]]++;
+                    continue;
+                }
             }
-            const double h = pts[i].point_m.z();
-            const double var = std::max<double>(pts[i].cov_m2.zz, kMinFusedVariance_m2);
-            const size_t s = cb.slot[i];
+            const float x = pts.v[0][i], y = pts.v[1][i];
+            const double h = pts.v[2][i];
+            const double weight = cb.weight[i];
+            const size_t s = size_t(cb.slot[i]);
+            const int16_t n = static_cast<int16_t>(cb.bin[i]);
             if (perPoint) {
-                fuseMeasurement(s, cb.ix[i], cb.iy[i], cb.bin[i], h, var, params, continuityBound_m,
-                                stats, &pts[i]);
+                fuseMeasurement(s, cb.ix[i], cb.iy[i], n, h,
+                                std::max<double>(pts.v[8][i], kMinFusedVariance_m2), params,
+                                continuityBound_m, stats, x, y);
                 continue;
             }
-            if (run.bin == kNoBin || run.slot != s || run.n != cb.bin[i]) {
+            if (run.bin == kNoBin || run.slot != s || run.n != n) {
                 closeRun();
-                run.bin = findOrAddBin(s, cb.bin[i]);
+                run.bin = findOrAddBin(s, n);
                 run.slot = s;
-                run.n = cb.bin[i];
+                run.n = n;
                 run.ix = cb.ix[i];
                 run.iy = cb.iy[i];
                 run.points = 0;
                 run.maxHeight_m = h;
-                Bin& bin = BinStore::bin(run.bin);
-                run.plane = &bin.plane;
+                const Bin& bin = BinStore::bin(run.bin);
+                run.plane = bin.plane;
                 run.cellX_m = cellCenter_m(run.ix);
                 run.cellY_m = cellCenter_m(run.iy);
                 run.frozen = bin.pointCount > 0 && !(bin.variance_m2 > 0);
                 run.sum = HeightInformation{};
                 if (bin.pointCount > 0 && !run.frozen) run.sum.add(bin.height_m, bin.variance_m2);
             }
-            run.sum.add(h, var);
-            addPlanePoint(*run.plane, float(pts[i].point_m.x() - run.cellX_m),
-                          float(pts[i].point_m.y() - run.cellY_m), float(h), float(1.0 / var));
+            run.sum.addWeighted(h, weight);
+            addPlanePoint(run.plane, float(x - run.cellX_m), float(y - run.cellY_m), float(h),
+                          float(weight));
             run.maxHeight_m = std::max(run.maxHeight_m, h);
             run.points++;
             stats.accepted++;

@@ -26,6 +26,17 @@ namespace multibin {
  * covariance and the sensor pose into those polynomial coefficients (in double); per point what
  * is left is about a hundred single-precision multiply-adds, evaluated over blocks of points in
  * structure-of-arrays form so the compiler vectorises them. */
+/** Points in structure-of-arrays form, a block at a time: the layout the propagation computes in
+ * and the insertion core classifies from, so neither converts to PointWithCov and back. */
+struct PointBlock {
+    static constexpr size_t kCapacity = 256;
+    /** x, y, z [m], then the covariance entries xx, xy, xz, yy, yz, zz [m^2]. */
+    alignas(64) float v[9][kCapacity];
+
+    /** Copies `in[0 .. n)`, n <= kCapacity. */
+    void gather(const PointWithCov* in, size_t n);
+};
+
 class PosePropagator {
 public:
     PosePropagator(const mrpt::poses::CPose3DPDFGaussian& robotPoseInMap,
@@ -40,6 +51,10 @@ public:
     /** A batch from `in[0 .. n)` into `out[0 .. n)`; the ranges may be the same (in place) but
      * must not otherwise overlap. */
     void apply(const PointWithCov* in, PointWithCov* out, size_t n) const;
+
+    /** A block: `in[0 .. n)` (n <= PointBlock::kCapacity) into `out`, the same values as
+     * apply(). */
+    void applyBlock(const PointWithCov* in, size_t n, PointBlock& out) const;
 
     /** d p_map / d (x, y, z, yaw, pitch, roll) of the robot pose, at a point given in the robot
      * frame [m]. */

@@ -135,16 +135,16 @@ public:
     }
 
 private:
-    /** The insertion core over `count` map-frame points, fetched a classification block at a time
-     * by `blockAt(begin, n)` (a pointer to points begin .. begin + n - 1). */
+    /** The insertion core over `count` map-frame points, a block at a time:
+     * `fillBlock(begin, n, block)` writes points begin .. begin + n - 1 into `block`. */
     template <typename BlockSource>
-    InsertStats insertBlocks(size_t count, BlockSource&& blockAt, const BinUpdateParams& params,
+    InsertStats insertBlocks(size_t count, BlockSource&& fillBlock, const BinUpdateParams& params,
                              double continuityBound_m);
     /** Gates 13 and bin range passed: eq 14 and the per-point Kalman update (eq 15). */
     bool fuseMeasurement(size_t slot, int ix, int iy, int16_t n, double height_m,
                          double variance_m2, const BinUpdateParams& params,
-                         double continuityBound_m, InsertStats& stats,
-                         const PointWithCov* point);  //!< its place feeds the plane moments
+                         double continuityBound_m, InsertStats& stats, float x_m,
+                         float y_m);  //!< its place feeds the plane moments; NaN: no place
 
     VisibilityIndex m_index;
 };

@@ -61,6 +61,12 @@ public:
         return t - (v < double(t) ? 1 : 0);
     }
     double cellCenter_m(int index) const { return (index + 0.5) * m_cellSize_m; }
+    /** 1 / cell size, the factor cellIndex applies [1/m]. */
+    double inverseCellSize() const { return m_invCellSize; }
+    /** The slot coordinates of the window's first cell (ix0 mod nx, iy0 mod ny): slot() in
+     * closed form for code that computes slots in bulk. */
+    int originSlotX() const { return m_originSlotX; }
+    int originSlotY() const { return m_originSlotY; }
     /** i mod n in [0, n) (0 for an empty axis): the slot coordinate of index i on an axis of n. */
     static int floorMod(int i, int n) { return n > 0 ? ((i % n) + n) % n : 0; }
     /** @} */

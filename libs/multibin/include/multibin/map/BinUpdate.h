@@ -37,10 +37,11 @@ struct HeightInformation {
     double information = 0;     //!< sum of 1/var [1/m^2]
     double weightedHeight = 0;  //!< sum of h/var [1/m]
 
-    void add(double height_m, double variance_m2) {
-        const double w = 1.0 / variance_m2;
-        information += w;
-        weightedHeight += height_m * w;
+    void add(double height_m, double variance_m2) { addWeighted(height_m, 1.0 / variance_m2); }
+    /** The same with the weight w = 1/var [1/m^2] already computed. */
+    void addWeighted(double height_m, double weight) {
+        information += weight;
+        weightedHeight += height_m * weight;
     }
     double variance_m2() const { return 1.0 / information; }
     double height_m() const { return weightedHeight * variance_m2(); }
@@ -58,6 +59,23 @@ inline void addMeasurement(BinEstimate& bin, double height_m, double variance_m2
         fuse(bin.height_m, bin.variance_m2, height_m, variance_m2);
     }
     util::addSaturating(bin.pointCount, 1u);
+}
+
+/** `certainty += increment`, `times` times over, in float: what a bin's certainty counter becomes
+ * after `times` measurements. Whole numbers below 2^24 add exactly in float, so for them (the
+ * default increment 1 on any counter that was not decremented by a fraction) one addition gives
+ * the sequence's result bit for bit; otherwise the sequence is run. */
+inline void addCertainty(float& certainty, float increment, uint32_t times) {
+    constexpr double kExact = 16777216.0;  // 2^24: every integer up to it is a float
+    const auto whole = [](float v) {
+        return std::abs(v) < float(kExact) && float(static_cast<int32_t>(v)) == v;
+    };
+    const double total = double(certainty) + double(increment) * double(times);
+    if (whole(certainty) && whole(increment) && std::abs(total) <= kExact) {
+        certainty = static_cast<float>(total);
+        return;
+    }
+    for (uint32_t k = 0; k < times; k++) certainty += increment;
 }
 
 /** Adds a point at (dx_m, dy_m) from its cell's centre, height z_m, weight w = 1/var_z to the

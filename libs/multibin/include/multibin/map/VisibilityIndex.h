@@ -162,7 +162,13 @@ inline void VisibilityIndex::noteUpdate(size_t s, int ix, int iy, double height_
     } else {
         cs.cycle = m_cycle;
         cs.updatedIndex = static_cast<uint32_t>(m_updated.size());
-        m_updated.push_back({ix, iy, float(height_m), points});
+        // Written field by field into the vector: a pushed temporary was assembled on the stack
+        // with 4-byte stores and read back as one 16-byte load, a store-forwarding stall.
+        UpdatedCell& u = m_updated.emplace_back();
+        u.ix = ix;
+        u.iy = iy;
+        u.maxHeight_m = float(height_m);
+        u.points = points;
     }
 }
 
