@@ -169,6 +169,128 @@ TEST(BinGrid, ZeroAndSingularCovariancesAreExactNotErrors) {
     }
 }
 
+TEST(BinGrid, BlockClassificationDecidesAsTheScalarGates) {
+    // The insertion core classifies points a block at a time, branch-free and vectorised; every
+    // decision must be the scalar gates' (cellIndex, isCovariance, passesEq13, binIndexOf) and
+    // every fused height the same. Reference: the same points one by one through the scalar
+    // functions and insertHeight. Mixed in: NaN and infinite values, huge coordinates, points on
+    // cell and bin edges, indefinite, zero and rank-deficient covariances, eq 13 failures,
+    // heights outside the int16 bin range; more than one block (256 points).
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    PointsWithCov points;
+    for (int i = 0; i < 3000; i++) {
+        PointWithCov p =
+            pointAt(0.5 * u(rng), 0.5 * u(rng), 0.2 * u(rng), 0.001 + 0.01 * (u(rng) + 1));
+        switch (i % 23) {
+            case 1:
+                p.point_m.x() = NAN;
+                break;
+            case 2:
+                p.cov_m2.zz = std::numeric_limits<float>::infinity();
+                break;
+            case 3:
+                p.point_m.y() = 3e9f;
+                break;
+            case 4:
+                p.point_m.x() = -3e9f;
+                break;
+            case 5:
+                p.point_m.x() = 0.1f * float(i % 7);
+                break;  // on a cell edge
+            case 6:
+                p.point_m.z() = 0.05f * float(i % 5 - 2);
+                break;  // on a bin edge
+            case 7:
+                p.cov_m2.xy = 1.0f;
+                break;  // indefinite
+            case 8:
+                p.cov_m2 = {};
+                break;  // exact
+            case 9:
+                p.cov_m2 = rangeOnlyCovariance(Eigen::Vector3f(0.6f, 0.0f, -0.8f), 0.01f);
+                break;
+            case 10:
+                p.cov_m2.zz = 0.2f;
+                break;  // fails eq 13
+            case 11:
+                p.point_m.z() = 5000.f;
+                break;  // beyond the int16 bin index
+            case 12:
+                p.point_m.y() = 0.95f;
+                break;  // outside the 1 m window
+            default:
+                break;
+        }
+        points.push_back(p);
+    }
+    const BinUpdateParams params;
+    const double bound = 1e9;  // finite: both sides fuse point by point
+    BinGrid block = gridAroundOrigin(), scalar = gridAroundOrigin();
+    const InsertStats sb = block.insertPoints(points, params, bound);
+    InsertStats ss;
+    for (const PointWithCov& p : points) {
+        const SymmetricCov3& c = p.cov_m2;
+        const double sum = double(p.point_m.x()) + p.point_m.y() + p.point_m.z() + c.xx + c.xy +
+                           c.xz + c.yy + c.yz + c.zz;
+        if (!std::isfinite(sum)) {
+            ss.notFinite++;
+            continue;
+        }
+        if (!isCovariance(c)) {
+            ss.badCovariance++;
+            continue;
+        }
+        const int ix = scalar.cellIndex(p.point_m.x()), iy = scalar.cellIndex(p.point_m.y());
+        if (!scalar.window().contains(ix, iy)) {
+            ss.outsideMap++;
+            continue;
+        }
+        scalar.insertHeight(ix, iy, p.point_m.z(), std::max<double>(c.zz, kMinFusedVariance_m2),
+                            params, bound, ss);
+    }
+    EXPECT_EQ(sb.accepted, ss.accepted);
+    EXPECT_EQ(sb.notFinite, ss.notFinite);
+    EXPECT_EQ(sb.badCovariance, ss.badCovariance);
+    EXPECT_EQ(sb.outsideMap, ss.outsideMap);
+    EXPECT_EQ(sb.tooUncertain, ss.tooUncertain);
+    EXPECT_EQ(sb.outsideBinRange, ss.outsideBinRange);
+    EXPECT_GT(sb.accepted, 1000u);
+    EXPECT_GT(
+        sb.notFinite * sb.badCovariance * sb.outsideMap * sb.tooUncertain * sb.outsideBinRange, 0u)
+        << "every reason occurs";
+    ASSERT_EQ(block.binCount(), scalar.binCount());
+    size_t compared = 0;
+    const CellWindow& w = block.window();
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
+            block.forEachBin(ix, iy, [&](const Bin& b) {
+                scalar.forEachBin(ix, iy, [&](const Bin& r) {
+                    if (r.index != b.index) return;
+                    compared++;
+                    EXPECT_EQ(b.height_m, r.height_m) << ix << " " << iy << " bin " << b.index;
+                    EXPECT_EQ(b.variance_m2, r.variance_m2);
+                    EXPECT_EQ(b.certainty, r.certainty);
+                    EXPECT_EQ(b.pointCount, r.pointCount);
+                });
+            });
+    EXPECT_EQ(compared, block.binCount());
+}
+
+TEST(BinUpdate, CertaintyAddedAtOnceEqualsTheSequenceBitForBit) {
+    // addCertainty adds whole numbers in one step (exact below 2^24) and runs the sequence
+    // otherwise: both must give the float the sequence gives.
+    for (const float start : {0.f, 3.f, -4.f, 2.5f, 16777200.f, 1e-3f})
+        for (const float increment : {1.f, 2.f, 0.5f, 0.1f, 3.f})
+            for (const uint32_t times : {0u, 1u, 2u, 7u, 100u}) {
+                float sequence = start;
+                for (uint32_t k = 0; k < times; k++) sequence += increment;
+                float atOnce = start;
+                addCertainty(atOnce, increment, times);
+                EXPECT_EQ(atOnce, sequence) << start << " + " << times << " x " << increment;
+            }
+}
+
 TEST(BinGrid, GrowingKeepsEveryBin) {
     BinGrid g(0.1);
     g.reset(0.1, CellWindow{0, 0, 4, 4});
