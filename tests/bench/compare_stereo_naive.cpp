@@ -10,7 +10,9 @@
  * For experiments, environment variables override the map's options: HALO, NC (0/1 filters), SUB
  * (stereo_subsample), SIG (stereo_matching_sigma_px), HJ (stereo_halo_jump_px), TEX, TEXR
  * (stereo_texture_min_std_grey, stereo_texture_radius_px), MEU (max_elevation_uncertainty_m);
- * DEM=1 scores the DEM with filled cells; DUMP=FILE writes the cells (stereo_naive.h).
+ * FULL (stereo_sgbm_full_width); DEM=1 scores the DEM with filled cells; DUMP=FILE writes the
+ * cells; NAIVE_FULL=1 gives the naive pipeline the library's full-width matching too
+ * (stereo_naive.h).
  * `--disparity-errors PREFIX` (a scenario WITH disparity images: the true disparity plus
  * N(0, 0.25 px)) prints SGBM's disparity against it, split by the texture filter's criterion. */
 #include <cstdio>
@@ -105,6 +107,7 @@ int main(int argc, char** argv) {
                 if (auto e = std::getenv("HJ")) so.haloJump_px = std::atof(e);
                 if (auto e = std::getenv("TEX")) so.textureMinStd_grey = std::atof(e);
                 if (auto e = std::getenv("TEXR")) so.textureRadius_px = std::atoi(e);
+                if (auto e = std::getenv("FULL")) so.sgbmFullWidth = std::atoi(e);
                 if (auto e = std::getenv("MEU")) o.max_elevation_uncertainty_m = std::atof(e);
             },
             area);
