@@ -9,9 +9,9 @@
  * Prints one table row per scenario (doc/sensor-models.md, "Stereo against the naive pipeline").
  * For experiments, environment variables override the map's options: HALO, NC (0/1 filters), SUB
  * (stereo_subsample), SIG (stereo_matching_sigma_px), HJ (stereo_halo_jump_px), TEX, TEXR
- * (stereo_texture_min_std_grey, stereo_texture_radius_px), MEU (max_elevation_uncertainty_m);
- * FULL (stereo_sgbm_full_width); DEM=1 scores the DEM with filled cells; DUMP=FILE writes the
- * cells; NAIVE_FULL=1 gives the naive pipeline the library's full-width matching too
+ * (stereo_texture_min_std_grey, stereo_texture_radius_px), MEU (max_elevation_uncertainty_m), MAXR
+ * (max_range_m); FULL (stereo_sgbm_full_width); DEM=1 scores the DEM with filled cells; DUMP=FILE
+ * writes the cells; NAIVE_FULL=1 gives the naive pipeline the library's full-width matching too
  * (stereo_naive.h).
  * `--disparity-errors PREFIX` (a scenario WITH disparity images: the true disparity plus
  * N(0, 0.25 px)) prints SGBM's disparity against it, split by the texture filter's criterion
@@ -121,6 +121,7 @@ int main(int argc, char** argv) {
                 if (auto e = std::getenv("NCA")) so.nearClusterMaxArea_px = std::atoi(e);
                 if (auto e = std::getenv("HR")) so.haloRadius_px = std::atoi(e);
                 if (auto e = std::getenv("MEU")) o.max_elevation_uncertainty_m = std::atof(e);
+                if (auto e = std::getenv("MAXR")) o.max_range_m = std::atof(e);
             },
             area);
         std::printf("%-28s %7zu %9.2f %9.2f %6.1f%% %10.3f %10.3f %9.3f %9.3f %8.1f%%\n", argv[i],
