@@ -9,10 +9,14 @@
  * Prints one table row per scenario (doc/sensor-models.md, "Stereo against the naive pipeline").
  * For experiments, environment variables override the map's options: HALO, NC (0/1 filters), SUB
  * (stereo_subsample), SIG (stereo_matching_sigma_px), HJ (stereo_halo_jump_px), TEX, TEXR
- * (stereo_texture_min_std_grey, stereo_texture_radius_px), MEU (max_elevation_uncertainty_m);
- * DEM=1 scores the DEM with filled cells; DUMP=FILE writes the cells (stereo_naive.h).
+ * (stereo_texture_min_std_grey, stereo_texture_radius_px), MEU (max_elevation_uncertainty_m), MAXR
+ * (max_range_m); FULL (stereo_sgbm_full_width); DEM=1 scores the DEM with filled cells; DUMP=FILE
+ * writes the cells; NAIVE_FULL=1 gives the naive pipeline the library's full-width matching too
+ * (stereo_naive.h).
  * `--disparity-errors PREFIX` (a scenario WITH disparity images: the true disparity plus
- * N(0, 0.25 px)) prints SGBM's disparity against it, split by the texture filter's criterion. */
+ * N(0, 0.25 px)) prints SGBM's disparity against it, split by the texture filter's criterion
+ * (textured pixels of the leftmost numDisparities columns, matched thanks to
+ * stereo_sgbm_full_width, apart). */
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -21,7 +25,8 @@
 
 namespace {
 /** SGBM (library defaults) against the simulator's disparity image, textured and textureless
- * pixels apart (local grey std over 5 x 5 at or above / below stereo_texture_min_std_grey). */
+ * pixels apart (local grey std over 5 x 5 at or above / below stereo_texture_min_std_grey), the
+ * textured ones of the leftmost numDisparities columns apart too. */
 int disparityErrors(const std::string& prefix) {
     mrpt::maps::CSimpleMap sm;
     mrpt::io::CFileGZInputStream f(prefix + ".simplemap");
@@ -31,7 +36,7 @@ int disparityErrors(const std::string& prefix) {
         size_t n = 0, gross = 0;
         double sumSq = 0, sum = 0;
         size_t frac[10] = {};
-    } acc[2];  // 0 textured, 1 textureless
+    } acc[3];  // textured, textureless, textured in the leftmost numDisparities columns
     for (size_t i = 0; i < sm.size(); i++)
         for (const auto& obs : *std::get<1>(sm.get(i))) {
             auto st = std::dynamic_pointer_cast<mrpt::obs::CObservationStereoImages>(obs);
@@ -44,7 +49,8 @@ int disparityErrors(const std::string& prefix) {
             for (int v = 0; v < sgbm.height; v++)
                 for (int u = 0; u < sgbm.width; u++) {
                     if (!sgbm.valid(u, v) || !sim.valid(u, v)) continue;
-                    Acc& a = acc[flat.valid(u, v) ? 0 : 1];
+                    const bool band = u < opts.numDisparitiesFor(sgbm.width);
+                    Acc& a = acc[!flat.valid(u, v) ? 1 : band ? 2 : 0];
                     const double e = sgbm.at(u, v) - sim.at(u, v);
                     a.n++;
                     if (std::abs(e) > 2) {
@@ -57,13 +63,14 @@ int disparityErrors(const std::string& prefix) {
                     a.frac[std::min(9, int(10 * (d - std::floor(d))))]++;
                 }
         }
-    for (int k = 0; k < 2; k++) {
+    const char* names[3] = {"textured", "textureless", "left band"};
+    for (int k = 0; k < 3; k++) {
         const Acc& a = acc[k];
         const double m = double(a.n - a.gross);
         std::printf(
             "%-11s px %8zu  > 2 px %5.2f %%  within 2 px: mean %+.3f px  RMS %.3f px  "
             "sub-pixel fraction deciles:",
-            k ? "textureless" : "textured", a.n, 100.0 * double(a.gross) / double(a.n), a.sum / m,
+            names[k], a.n, 100.0 * double(a.gross) / double(a.n), a.sum / m,
             std::sqrt(a.sumSq / m));
         for (size_t c : a.frac) std::printf(" %.3f", double(c) / m);
         std::printf("\n");
@@ -105,7 +112,16 @@ int main(int argc, char** argv) {
                 if (auto e = std::getenv("HJ")) so.haloJump_px = std::atof(e);
                 if (auto e = std::getenv("TEX")) so.textureMinStd_grey = std::atof(e);
                 if (auto e = std::getenv("TEXR")) so.textureRadius_px = std::atoi(e);
+                if (auto e = std::getenv("FULL")) so.sgbmFullWidth = std::atoi(e);
+                if (auto e = std::getenv("UNIQ")) so.sgbmUniquenessRatio = std::atoi(e);
+                if (auto e = std::getenv("D12")) so.sgbmDisp12MaxDiff = std::atoi(e);
+                if (auto e = std::getenv("BLOCK")) so.sgbmBlockSize = std::atoi(e);
+                if (auto e = std::getenv("SPW")) so.sgbmSpeckleWindowSize = std::atoi(e);
+                if (auto e = std::getenv("MODE")) so.sgbmMode = e;
+                if (auto e = std::getenv("NCA")) so.nearClusterMaxArea_px = std::atoi(e);
+                if (auto e = std::getenv("HR")) so.haloRadius_px = std::atoi(e);
                 if (auto e = std::getenv("MEU")) o.max_elevation_uncertainty_m = std::atof(e);
+                if (auto e = std::getenv("MAXR")) o.max_range_m = std::atof(e);
             },
             area);
         std::printf("%-28s %7zu %9.2f %9.2f %6.1f%% %10.3f %10.3f %9.3f %9.3f %8.1f%%\n", argv[i],

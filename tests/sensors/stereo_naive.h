@@ -65,8 +65,10 @@ Score compare(const std::string& prefix, EditOptions edit, const Area& area = {}
     const auto gt = multibin::EsriAsciiGrid::load(prefix + "_gt.asc");
     const double cell_m = gt.cellsize_m;
 
-    // (a) naive: SGBM with the library's default parameters, triangulate, plain mean.
-    const multibin::sensors::StereoModelOptions defaults;
+    // (a) naive: OpenCV's SGBM call with the library's default parameters (so without the
+    // library's left-border padding), triangulate, plain mean.
+    multibin::sensors::StereoModelOptions defaults;
+    defaults.sgbmFullWidth = std::getenv("NAIVE_FULL") != nullptr;  // an experiment
     mrpt::maps::CHeightGridMap2D naive(
         mrpt::maps::CHeightGridMap2D::mrSimpleAverage, gt.xllcenter_m - cell_m / 2,
         gt.xMax_m() + cell_m / 2, gt.yllcenter_m - cell_m / 2, gt.yMax_m() + cell_m / 2, cell_m);

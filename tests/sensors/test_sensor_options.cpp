@@ -28,6 +28,7 @@ TEST(SensorOptions, ReadsContractKeys) {
         "stereo_extrinsics_sigma = 0.001 0.002 0.003 0.004 0.005 0.006\n"
         "stereo_matching_sigma_px = 0.3\n"
         "stereo_sgbm_num_disparities = 64\n"
+        "stereo_sgbm_full_width = false\n"
         "depth_axial_sigma_quadratic_per_m = 0.003\n");
     EXPECT_DOUBLE_EQ(o.laser.agcByLabel.at("LASER"), 512);
     EXPECT_DOUBLE_EQ(o.laser.agcByLabel.at("LASER2"), 300);
@@ -37,6 +38,8 @@ TEST(SensorOptions, ReadsContractKeys) {
     EXPECT_DOUBLE_EQ(o.stereo.matchingSigma_px, 0.3);
     EXPECT_EQ(o.stereo.sgbmNumDisparities, 64);
     EXPECT_EQ(o.stereo.numDisparitiesFor(1282), 64);
+    EXPECT_FALSE(o.stereo.sgbmFullWidth);
+    EXPECT_TRUE(SensorModelOptions().stereo.sgbmFullWidth);  // the default
     // Automatic: width / 4 in multiples of 16, within [16, 256].
     const SensorModelOptions autoOpts = load("stereo_sgbm_num_disparities = 0\n");
     EXPECT_EQ(autoOpts.stereo.numDisparitiesFor(1282), 256);  // 320 -> 256

@@ -407,6 +407,44 @@ TEST(StereoModel, SgbmOnATexturedPairRecoversTheDisparity) {
                  std::invalid_argument);
 }
 
+TEST(StereoModel, SgbmFullWidthMatchesTheLeftmostColumns) {
+    // The textured plane at disparity 12 again, 32 disparities searched: OpenCV leaves columns
+    // 0-31 without disparity; with stereo_sgbm_full_width, columns 12-31 (right pixel u - 12 >= 0
+    // inside the right image) get the true disparity, and no pixel gets a match whose right pixel
+    // falls left of the right image.
+    const int W = 320, H = 240, trueD = 12;
+    cv::Mat big(H, W + trueD, CV_8UC1);
+    cv::RNG rng(3);
+    rng.fill(big, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(big, big, cv::Size(3, 3), 0.8);
+    const mrpt::img::CImage left(cv::Mat(big(cv::Rect(0, 0, W, H))), mrpt::img::DEEP_COPY);
+    const mrpt::img::CImage right(cv::Mat(big(cv::Rect(trueD, 0, W, H))), mrpt::img::DEEP_COPY);
+    StereoModelOptions o;
+    o.sgbmNumDisparities = 32;
+    o.sgbmFullWidth = false;
+    const DisparityImage narrow = computeDisparitySGBM(left, right, o);
+    o.sgbmFullWidth = true;
+    const DisparityImage full = computeDisparitySGBM(left, right, o);
+    size_t narrowBand = 0, band = 0, bandGood = 0, outside = 0, differ = 0;
+    for (int v = 0; v < H; v++)
+        for (int u = 0; u < W; u++) {
+            if (u < 32) narrowBand += narrow.valid(u, v);
+            if (full.valid(u, v) && u - full.at(u, v) < 0) outside++;
+            if (u >= trueD + 2 && u < 32 && full.valid(u, v)) {  // 2 px: half the block
+                band++;
+                bandGood += std::abs(full.at(u, v) - trueD) <= 0.5f;
+            }
+            // Beyond the band the padding changes nothing but SGBM's paths from the left edge.
+            if (u >= 64 && narrow.valid(u, v) && full.valid(u, v))
+                differ += std::abs(narrow.at(u, v) - full.at(u, v)) > 0.5f;
+        }
+    EXPECT_EQ(narrowBand, 0u);
+    EXPECT_GT(band, size_t(0.9 * 18 * H));
+    EXPECT_GT(bandGood, size_t(0.98 * double(band)));
+    EXPECT_EQ(outside, 0u);
+    EXPECT_LT(differ, size_t(0.001 * 256 * H));
+}
+
 TEST(StereoModel, UnrectifiedPairIsRefused) {
     const StereoGeometry g = stocGeometry();
     DisparityImage disp(g.width, g.height);

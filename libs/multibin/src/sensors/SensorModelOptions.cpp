@@ -188,6 +188,7 @@ void visitKeys(Options& o, Visit&& visit) {
     visit({"stereo_min_depth_m", "stereo_min_depth"}, stereo.minDepth_m, atLeast(0, "m"));
     visit("stereo_sgbm_min_disparity", stereo.sgbmMinDisparity);
     visit("stereo_sgbm_num_disparities", stereo.sgbmNumDisparities, atLeast(0));
+    visit("stereo_sgbm_full_width", stereo.sgbmFullWidth);
     visit("stereo_sgbm_block_size", stereo.sgbmBlockSize, oddBetween(1, 255));
     visit("stereo_sgbm_p1", stereo.sgbmP1, atLeast(0));
     visit("stereo_sgbm_p2", stereo.sgbmP2, atLeast(0));

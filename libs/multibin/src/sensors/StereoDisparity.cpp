@@ -74,13 +74,27 @@ DisparityImage computeDisparitySGBM(const mrpt::img::CImage& left, const mrpt::i
                                        o.sgbmUniquenessRatio, o.sgbmSpeckleWindowSize,
                                        o.sgbmSpeckleRange, mode);
     cv::Mat disp16;
-    sgbm->compute(lg, rg, disp16);  // CV_16S, disparity * 16, < minDisparity * 16 = invalid
+    // OpenCV gives no disparity to the leftmost minDisparity + numDisparities columns (a quarter
+    // of the image by default), where part of the search range lies left of the right image.
+    const int pad =
+        o.sgbmFullWidth ? std::max(0, o.sgbmMinDisparity + sgbm->getNumDisparities()) : 0;
+    if (pad > 0) {
+        cv::Mat lp, rp, dp;
+        cv::copyMakeBorder(lg, lp, 0, 0, pad, 0, cv::BORDER_REPLICATE);
+        cv::copyMakeBorder(rg, rp, 0, 0, pad, 0, cv::BORDER_REPLICATE);
+        sgbm->compute(lp, rp, dp);
+        disp16 = dp(cv::Rect(pad, 0, lg.cols, lg.rows));
+    } else {
+        sgbm->compute(lg, rg, disp16);  // CV_16S, disparity * 16, < minDisparity * 16 = invalid
+    }
     DisparityImage out(disp16.cols, disp16.rows);
     const int invalidBelow = o.sgbmMinDisparity * 16;
     for (int v = 0; v < disp16.rows; v++) {
         const int16_t* row = disp16.ptr<int16_t>(v);
         for (int u = 0; u < disp16.cols; u++)
-            if (row[u] >= invalidBelow && row[u] > 0) out.at(u, v) = float(row[u]) / 16.f;
+            // With padding, a match in the padding (right pixel u - d < 0) is no match.
+            if (row[u] >= invalidBelow && row[u] > 0 && (pad == 0 || row[u] <= 16 * u))
+                out.at(u, v) = float(row[u]) / 16.f;
     }
     return out;
 }

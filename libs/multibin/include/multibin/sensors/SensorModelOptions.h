@@ -92,8 +92,14 @@ struct StereoModelOptions {
     /** The number of disparities searched for an image `width_px` wide. */
     int numDisparitiesFor(int width_px) const;
     /** Multiple of 16; 0 = from the image width: width / 4 rounded down to a multiple of 16,
-     * between 16 and 256 (the leftmost numDisparities columns get no disparity). */
+     * between 16 and 256 (OpenCV leaves the leftmost minDisparity + numDisparities columns
+     * without a disparity unless sgbmFullWidth). */
     int sgbmNumDisparities = 0;
+    /** Match the leftmost columns too: the pair is padded on the left (edge columns repeated)
+     * by minDisparity + numDisparities before SGBM and cropped after; a match whose right pixel
+     * falls outside the right image is dropped (key `stereo_sgbm_full_width`;
+     * doc/sensor-models.md, "Stereo against the naive pipeline"). */
+    bool sgbmFullWidth = true;
     int sgbmBlockSize = 5;  //!< odd
     int sgbmP1 = 0, sgbmP2 = 0;
     int sgbmDisp12MaxDiff = 1;
