@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/geometry/PosePropagation.h"
 
+#include "multibin/util/VectorClones.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -14,11 +16,6 @@ Eigen::Matrix3d toEigen(const mrpt::math::CMatrixDouble33& m) {
     return e;
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define MULTIBIN_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MULTIBIN_VECTOR_CLONES
-#endif
 
 /** Index pairs (r, c) of the stored upper triangle, in SymmetricCov3's order. */
 constexpr int kEntryRow[6] = {0, 0, 0, 1, 1, 2};
@@ -35,9 +32,8 @@ void scatter(const PointBlock& b, size_t n, PointWithCov* out) {
 }
 
 /** The per-point work over one block. Loops run over points innermost with loop-invariant
- * coefficients, so each is a plain vectorisable stream. Built twice (AVX2 and the baseline
- * x86-64 SSE2, chosen at load time); neither uses fused multiply-add and every lane does the same
- * operations in the same order, so results are bit-identical whichever runs. */
+ * coefficients, so each is a plain vectorisable stream, built for AVX-512, AVX2 and the baseline
+ * (MULTIBIN_VECTOR_CLONES: bit-identical whichever runs). */
 MULTIBIN_VECTOR_CLONES
 void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const PointBlock& in,
                     PointBlock& out) {

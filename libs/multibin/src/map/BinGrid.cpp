@@ -8,6 +8,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/util/Counters.h"
+#include "multibin/util/VectorClones.h"
 
 namespace multibin {
 
@@ -135,19 +136,13 @@ struct ClassifyGeometry {
     double minFusedVariance_m2;
 };
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define MULTIBIN_CLASSIFY_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MULTIBIN_CLASSIFY_CLONES
-#endif
-
 /** Pass 1 over a block, no bin access: validity, the gates that need only the point, cell, slot
  * and bin index, and the point's weight. Branch-free so the compiler vectorises it; the same
  * double arithmetic as BinStore::cellIndex, binIndexOf, isCovariance and
  * BinUpdateParams::passesEq13, so every decision and weight is theirs bit for bit. A point whose
  * covariance is not positive definite gets kCheckSingular (the caller asks
  * isSingularCovariance, rare). */
-MULTIBIN_CLASSIFY_CLONES
+MULTIBIN_VECTOR_CLONES
 void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
                    ClassifiedBlock& cb) {
     constexpr double kLimit = std::numeric_limits<int>::max() / 4;  // as BinStore::cellIndex

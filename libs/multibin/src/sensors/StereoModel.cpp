@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "RayPoint.h"
+#include "multibin/util/VectorClones.h"
 
 namespace multibin::sensors {
 
@@ -288,12 +289,6 @@ struct PointConstants {
     }
 };
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define MULTIBIN_STEREO_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MULTIBIN_STEREO_CLONES
-#endif
-
 /** What became of a pixel: kept, or which test skipped it (in the order of the tests). */
 enum PixelStatus : int32_t { kKept = 0, kNoDisparity = 1, kTooNear = 2, kOutOfRange = 3 };
 
@@ -317,7 +312,7 @@ struct RowBuffers {
 /** Points, covariances and status of the n pixels u = 0, step, 2 step... of one row: straight-
  * line code over arrays, which the compiler vectorises (4 doubles a step with AVX2; the right
  * pixel's table entries are gathered). `drow` and the table pointers point at the row. */
-MULTIBIN_STEREO_CLONES
+MULTIBIN_VECTOR_CLONES
 void rowPoints(const PointConstants& constants, const RowInputs& in, double dv, size_t n,
                const float* __restrict drow, const float* __restrict luu,
                const float* __restrict luv, const float* __restrict lvv,
