@@ -119,7 +119,7 @@ enum PointStatus : uint8_t {
 struct ClassifiedBlock {
     alignas(64) double weight[kPointBlock];  //!< 1 / fused variance [1/m^2]
     alignas(64) int32_t ix[kPointBlock], iy[kPointBlock];
-    alignas(64) int32_t slot[kPointBlock];
+    alignas(64) uint32_t slot[kPointBlock];  // as BinStore::slot, below 2^32 cells
     alignas(64) int32_t bin[kPointBlock];
     alignas(64) uint8_t status[kPointBlock];
 };
@@ -215,7 +215,7 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
         cb.ix[i] = ix;
         cb.iy[i] = iy;
         cb.bin[i] = floorToInt(binQ[i]);
-        cb.slot[i] = (sx + sy * nx) * inWindow;
+        cb.slot[i] = (uint32_t(sx) + uint32_t(sy) * uint32_t(nx)) * uint32_t(inWindow);
     }
 }
 
