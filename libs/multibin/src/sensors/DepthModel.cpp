@@ -4,10 +4,13 @@
 #include <mrpt/maps/CPointsMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "RayPoint.h"
 
@@ -46,6 +49,34 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
         const_cast<mrpt::obs::CObservation3DRangeScan&>(scan).unprojectInto(local, pp);
         appendPointsMap(local, opts, minRange_m, maxRange_m, out, stats);
     }
+}
+
+size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
+                                const DepthModelOptions& opts,
+                                const std::function<int64_t(float x_m, float y_m)>& cellOf,
+                                const std::function<bool(const PointWithCov&)>& failsOwnGate) {
+    const size_t before = mapPoints.size();
+    mapPoints.erase(std::remove_if(mapPoints.begin(), mapPoints.end(), failsOwnGate),
+                    mapPoints.end());
+    // Counting pass, then the covariance pass: two scratch arrays, no allocation per point.
+    std::vector<int64_t> cell(mapPoints.size());
+    std::unordered_map<int64_t, uint32_t> count;
+    count.reserve(mapPoints.size() / 8 + 16);
+    for (size_t i = 0; i < mapPoints.size(); i++) {
+        cell[i] = cellOf(mapPoints[i].point_m.x(), mapPoints[i].point_m.y());
+        count[cell[i]]++;
+    }
+    for (size_t i = 0; i < mapPoints.size(); i++) {
+        PointWithCov& p = mapPoints[i];
+        const Eigen::Vector3d ray = p.point_m.cast<double>() - sensor_m;
+        const double r = ray.norm();
+        if (!(r > 0) || !std::isfinite(r)) continue;  // the map counts it as it is
+        const Eigen::Vector3d v = ray / r;
+        const double s = opts.frameSigma_m(r);
+        const double add = double(count[cell[i]]) * s * s;  // [m^2] along the ray
+        p.cov_m2 = SymmetricCov3::fromMatrix(p.cov_m2.toMatrix() + add * v * v.transpose());
+    }
+    return before - mapPoints.size();
 }
 
 }  // namespace multibin::sensors
