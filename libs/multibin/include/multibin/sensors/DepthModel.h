@@ -24,8 +24,10 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
 /** The error the points of one depth frame share (DepthModelOptions::frameSigma_m()), in the map
  * frame: n points of a frame in one cell that share an error of sd s carry the information of
  * variance sigma^2 / n + s^2, not sigma^2 / n. Each point gets n s(r)^2 v v^T added to its
- * covariance, n the number of `mapPoints` in its cell (`cellOf`, a key per cell), v its unit ray
- * from `sensor_m` and r its range: for equal sigmas the cell's fused variance is exactly
+ * covariance, n the number of `mapPoints` in its cell (`cellOf`, a key per cell; per cell, not
+ * per bin: the error is the cell's, and the cell surface fuses adjacent bins of one surface as
+ * independent, which gives back sigma^2 / n + s^2 only if each bin carries the cell's n), v its
+ * unit ray from `sensor_m` and r its range: for equal sigmas the cell's fused variance is exactly
  * sigma^2 / n + s^2 and its weighted mean is unchanged; across frames the shared errors are
  * independent, so more frames still shrink it. The eq 13 gate is a point's own: the points
  * `failsOwnGate` selects are removed first and their number returned (the caller fuses the rest
