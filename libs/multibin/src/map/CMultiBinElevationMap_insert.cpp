@@ -204,7 +204,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
             ownGateRejected = multibin::sensors::addFrameSharedCovariance(
                 mapPoints, sensor_m, insertionOptions.sensors.depth,
                 [&grid](float x, float y) {
-                    return int64_t(grid.cellIndex(x)) * (int64_t(1) << 32) + grid.cellIndex(y);
+                    return Eigen::Vector2i(grid.cellIndex(x), grid.cellIndex(y));
                 },
                 [&](const PointWithCov& p) {
                     // What the grid would count as too uncertain: finite, inside the window.

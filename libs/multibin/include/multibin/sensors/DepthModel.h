@@ -24,7 +24,7 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
 /** The error the points of one depth frame share (DepthModelOptions::frameSigma_m()), in the map
  * frame: n points of a frame in one cell that share an error of sd s carry the information of
  * variance sigma^2 / n + s^2, not sigma^2 / n. Each point gets n s(r)^2 v v^T added to its
- * covariance, n the number of `mapPoints` in its cell (`cellOf`, a key per cell; per cell, not
+ * covariance, n the number of `mapPoints` in its cell (`cellOf`: its indices; per cell, not
  * per bin: the error is the cell's, and the cell surface fuses adjacent bins of one surface as
  * independent, which gives back sigma^2 / n + s^2 only if each bin carries the cell's n), v its
  * unit ray from `sensor_m` and r its range: for equal sigmas the cell's fused variance is exactly
@@ -34,7 +34,7 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
  * without the gate). */
 size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
                                 const DepthModelOptions& opts,
-                                const std::function<int64_t(float x_m, float y_m)>& cellOf,
+                                const std::function<Eigen::Vector2i(float x_m, float y_m)>& cellOf,
                                 const std::function<bool(const PointWithCov&)>& failsOwnGate);
 
 }  // namespace multibin::sensors
