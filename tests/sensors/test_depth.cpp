@@ -156,6 +156,49 @@ TEST(DepthModel, RealMrptDepthFrameInsertsWithoutNaN) {
     EXPECT_GT(bins, 100u);
 }
 
+// The frame-shared error (doc/sensor-models.md, "Frame-shared error"): 16 points of one frame in
+// one 2 cm cell, 1 m straight below the camera. Independent points fuse to sigma^2 / 16; with the
+// shared error s they fuse to sigma^2 / 16 + s^2 (hand-computed), at the same height. A point too
+// uncertain on its own (8 m away) is rejected by eq 13 either way, counted once.
+TEST(DepthModel, FrameSharedErrorFusesToSigmaSquaredOverNPlusShared) {
+    mrpt::obs::CObservation3DRangeScan scan;
+    scan.sensorLabel = "DEPTH";
+    scan.hasPoints3D = true;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            scan.points3D_x.push_back(1.0f);  // +x forward: straight down once pitched
+            scan.points3D_y.push_back(0.003f * float(i) - 0.0045f);
+            scan.points3D_z.push_back(0.003f * float(j) - 0.0045f);
+        }
+    scan.points3D_x.push_back(8.0f);
+    scan.points3D_y.push_back(0.0f);
+    scan.points3D_z.push_back(0.0f);
+    mrpt::poses::CPose3DPDFGaussian pose;  // exact
+    pose.mean = mrpt::poses::CPose3D(0.01, 0.01, 1.0, 0, M_PI / 2, 0);
+
+    double h[2], sigma[2];
+    const DepthModelOptions shared;
+    for (const bool on : {false, true}) {
+        mrpt::maps::CMultiBinElevationMap map;
+        map.insertionOptions.fill.enabled = false;
+        map.insertionOptions.height_sigma_floor_m = 1e-5;
+        if (!on) {
+            map.insertionOptions.sensors.depth.quantisationStep_per_m = 0;
+            map.insertionOptions.sensors.depth.frameSigmaRelative = 0;
+        }
+        ASSERT_TRUE(map.insertObservation(scan, pose));
+        EXPECT_EQ(map.insertStats().accepted, 16u);
+        EXPECT_EQ(map.insertStats().tooUncertain, 1u);
+        ASSERT_TRUE(map.cellHeight(0.01, 0.01, h[on], sigma[on]));
+    }
+    const double sa = shared.axialSigma_m(1.0), s = shared.frameSigma_m(1.0);
+    EXPECT_NEAR(s, std::sqrt(0.003 * 0.003 / 12 + 0.005 * 0.005), 1e-12);
+    EXPECT_NEAR(sigma[0], sa / 4, 0.02 * sa / 4);
+    EXPECT_NEAR(sigma[1], std::sqrt(sa * sa / 16 + s * s), 0.02 * s);
+    EXPECT_NEAR(h[0], 0.0, 1e-4);
+    EXPECT_NEAR(h[1], h[0], 1e-6);
+}
+
 TEST(MonteCarloCheck, DetectsACovarianceTwentyPercentOff) {
     // The consistency check itself: samples of N(0, I) pass against I and fail against 1.2 I
     // (NEES too small) and 0.8 I (NEES too large).

@@ -15,6 +15,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/VisibilityConstraint.h"
+#include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 using namespace mrpt::maps;
@@ -187,17 +188,44 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
-    if (isDualGrid()) {
-        recenterRelative(robotPose.mean.x(), robotPose.mean.y());
-    } else if (growthNeeded(sensorPoints, propagator)) {
-        // Growth is sized by all map-frame points: propagate them first (the rare case).
+    if (isDualGrid()) recenterRelative(robotPose.mean.x(), robotPose.mean.y());
+    const bool grow = !isDualGrid() && growthNeeded(sensorPoints, propagator);
+    if (grow || sensed.depthFrameError) {
+        // Growth is sized by all map-frame points, and a depth frame's shared error is counted
+        // per map cell: propagate them first.
         PointsWithCov mapPoints;
         propagator.apply(sensorPoints, mapPoints);
-        growToCover(mapPoints, sensor_m);
+        if (grow) growToCover(mapPoints, sensor_m);
+        multibin::BinGrid& grid = gridFor(obs);
+        size_t ownGateRejected = 0;
+        if (sensed.depthFrameError) {
+            const multibin::BinUpdateParams params = binUpdateParams();
+            const multibin::CellWindow& w = grid.window();
+            ownGateRejected = multibin::sensors::addFrameSharedCovariance(
+                mapPoints, sensor_m, insertionOptions.sensors.depth,
+                [&grid](float x, float y) {
+                    return Eigen::Vector2i(grid.cellIndex(x), grid.cellIndex(y));
+                },
+                [&](const PointWithCov& p) {
+                    // What the grid would count as too uncertain: finite, inside the window.
+                    return p.point_m.allFinite() && std::isfinite(p.cov_m2.zz) &&
+                           w.contains(grid.cellIndex(p.point_m.x()),
+                                      grid.cellIndex(p.point_m.y())) &&
+                           !params.passesEq13(p.cov_m2.zz);
+                });
+        }
         return insertIntoGrid(
-                   gridFor(obs),
+                   grid,
                    [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
-                       return g.insertPoints(mapPoints, params, continuityBound_m);
+                       if (!sensed.depthFrameError)
+                           return g.insertPoints(mapPoints, params, continuityBound_m);
+                       // Eq 13 was applied to each point's own variance above.
+                       multibin::BinUpdateParams shared = params;
+                       shared.maxElevationUncertainty_m = std::numeric_limits<double>::infinity();
+                       multibin::InsertStats s =
+                           g.insertPoints(mapPoints, shared, continuityBound_m);
+                       s.tooUncertain += ownGateRejected;
+                       return s;
                    },
                    sensor_m)
                    .accepted > 0;

@@ -49,6 +49,7 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
     out.points.clear();
     out.continuityBound_m = std::numeric_limits<double>::infinity();
     out.stats = {};
+    out.depthFrameError = false;
     if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
         out.sensorPose = scan->sensorPose;
         if (chooseModel(obs, opts, K::laser, {K::laser, K::lidar}) == K::lidar) {
@@ -86,8 +87,11 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
         out.sensorPose = scan.sensorPose;
         return true;
     };
-    if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs))
+    if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
+        // One frame of one camera. A point cloud may merge frames or sensors: no term.
+        out.depthFrameError = opts.depth.sharesFrameError();
         return onlyModel(*depth, K::depth, depthScanToPoints, opts.depth, out.stats.depth);
+    }
     if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {
         out.sensorPose = cloud->sensorPose;
         switch (chooseModel(obs, opts, K::depth, {K::depth, K::lidar, K::stereo})) {

@@ -251,6 +251,8 @@ void visitKeys(Options& o, Visit&& visit) {
     visit({"depth_axial_offset_m", "depth_axial_offset"}, depth.axialOffset_m, atLeast(0, "m"));
     visit({"depth_lateral_sigma_rad", "depth_lateral_sigma"}, depth.lateralSigma_rad,
           positive("rad"));
+    visit("depth_quantisation_step_per_m", depth.quantisationStep_per_m, atLeast(0, "1/m"));
+    visit("depth_frame_sigma_relative", depth.frameSigmaRelative, atLeast(0));
 }
 }  // namespace
 

@@ -3,6 +3,10 @@
 
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
 #include "multibin/sensors/SensorStats.h"
@@ -16,5 +20,21 @@ namespace multibin::sensors {
 void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
                        const DepthModelOptions& opts, double minRange_m, double maxRange_m,
                        PointsWithCov& out, DepthStats& stats);
+
+/** The error the points of one depth frame share (DepthModelOptions::frameSigma_m()), in the map
+ * frame: n points of a frame in one cell that share an error of sd s carry the information of
+ * variance sigma^2 / n + s^2, not sigma^2 / n. Each point gets n s(r)^2 v v^T added to its
+ * covariance, n the number of `mapPoints` in its cell (`cellOf`: its indices; per cell, not
+ * per bin: the error is the cell's, and the cell surface fuses adjacent bins of one surface as
+ * independent, which gives back sigma^2 / n + s^2 only if each bin carries the cell's n), v its
+ * unit ray from `sensor_m` and r its range: for equal sigmas the cell's fused variance is exactly
+ * sigma^2 / n + s^2 and its weighted mean is unchanged; across frames the shared errors are
+ * independent, so more frames still shrink it. The eq 13 gate is a point's own: the points
+ * `failsOwnGate` selects are removed first and their number returned (the caller fuses the rest
+ * without the gate). */
+size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
+                                const DepthModelOptions& opts,
+                                const std::function<Eigen::Vector2i(float x_m, float y_m)>& cellOf,
+                                const std::function<bool(const PointWithCov&)>& failsOwnGate);
 
 }  // namespace multibin::sensors

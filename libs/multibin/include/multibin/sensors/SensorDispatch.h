@@ -47,6 +47,10 @@ struct SensorPoints {
     mrpt::poses::CPose3D sensorPose;  //!< sensor on the robot
     /** Eq 14's Delta_zmax [m] for a laser scan with a previous scan; +infinity otherwise. */
     double continuityBound_m = std::numeric_limits<double>::infinity();
+    /** A depth camera frame (CObservation3DRangeScan) whose points share an error
+     * (DepthModelOptions::sharesFrameError()): the map adds it per cell
+     * (addFrameSharedCovariance()). Point clouds, which may merge frames, get none. */
+    bool depthFrameError = false;
     /** What the model did with this observation's readings (only its own kind is non-zero). */
     SensorModelStats stats;
 };

@@ -140,6 +140,21 @@ struct DepthModelOptions {
     double axialSigmaQuadratic_per_m = 0.0019;  //!< key `depth_axial_sigma_quadratic_per_m` [m/m^2]
     double axialOffset_m = 0.4;                 //!< key `depth_axial_offset_m` [m]
     double lateralSigma_rad = 0.0014;  //!< key `depth_lateral_sigma_rad` [rad] (0.8 px at 580 px)
+    /** The error the points of one frame share, which averaging them does not shrink
+     * (doc/sensor-models.md): the depth quantisation of a structured-light camera, one step of
+     * quantisationStep_per_m r^2 (disparity step / (focal length x baseline): 1/8 px / (580 px x
+     * 7.5 cm) for a Kinect; key `depth_quantisation_step_per_m` [1/m]), a uniform error of sd
+     * step / sqrt(12) over the patch a step covers; plus a calibration error of sd
+     * frameSigmaRelative r (key `depth_frame_sigma_relative` [-]). Both 0: points independent. */
+    double quantisationStep_per_m = 0.003;
+    double frameSigmaRelative = 0.005;
+
+    /** Standard deviation of the error shared by a frame's points at range r [m] along the ray. */
+    double frameSigma_m(double r_m) const {
+        const double step = quantisationStep_per_m * r_m * r_m, rel = frameSigmaRelative * r_m;
+        return std::sqrt(step * step / 12.0 + rel * rel);
+    }
+    bool sharesFrameError() const { return quantisationStep_per_m > 0 || frameSigmaRelative > 0; }
 
     double axialSigma_m(double z_m) const {
         const double dz = z_m - axialOffset_m;
