@@ -194,8 +194,9 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     m_laserOnly.flushLocalToGlobal();
 
     std::vector<MethodEstimate> methods;
-    MethodEstimate rawLaser{"raw_laser", m_rawLaser.heights_m(), {}, "raw_laser", m_raw_s, 0};
-    MethodEstimate rawAll{"raw_all", m_rawAll.heights_m(), {}, "raw_all", m_raw_s, 0};
+    MethodEstimate rawLaser{"raw_laser", m_rawLaser.heights_m(), {}, "raw_laser", m_raw_s, 0, true,
+                            {}};
+    MethodEstimate rawAll{"raw_all", m_rawAll.heights_m(), {}, "raw_all", m_raw_s, 0, true, {}};
     methods.push_back(rawLaser);
     methods.push_back(rawAll);
 
