@@ -129,25 +129,20 @@ struct ClassifyGeometry {
     double invCellSize;  //!< [1/m]
     CellWindow window;
     int originSlotX, originSlotY;
-    double binHeight_m;
-    double maxVariance9_m2;  //!< Delta_max^2 of eq 13, compared with 9 var
+    BinUpdateParams params;
     /** kMinFusedVariance_m2, passed at run time: with the constant, GCC folds 1 / constant into
      * one arm of the select and the loop no longer vectorises. */
     double minFusedVariance_m2;
 };
 
 /** Pass 1 over a block, no bin access: validity, the gates that need only the point, cell, slot
- * and bin index, and the point's weight. Branch-free so the compiler vectorises it; the same
- * double arithmetic as BinStore::cellIndex, binIndexOf, isCovariance and
- * BinUpdateParams::passesEq13, so every decision and weight is theirs bit for bit. A point whose
- * covariance is not positive definite gets kCheckSingular (the caller asks
- * isSingularCovariance, rare). */
+ * and bin index, and the point's weight, with the scalar path's own functions (cellIndex's
+ * clamp and floor, binIndexFits, isPositiveDefinite, passesEq13), so every decision and weight is
+ * theirs bit for bit. Branch-free so the compiler vectorises it. A point whose covariance is not
+ * positive definite gets kCheckSingular (the caller asks isSingularCovariance, rare). */
 MULTIBIN_VECTOR_CLONES
 void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
                    ClassifiedBlock& cb) {
-    constexpr double kLimit = std::numeric_limits<int>::max() / 4;  // as BinStore::cellIndex
-    constexpr double kBinLow = std::numeric_limits<int16_t>::min();
-    constexpr double kBinHigh = double(std::numeric_limits<int16_t>::max()) + 1.0;
     const float* __restrict px = pts.v[0];
     const float* __restrict py = pts.v[1];
     const float* __restrict pz = pts.v[2];
@@ -170,32 +165,19 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
         // double; a NaN or infinity makes the sum NaN or infinite).
         const double sum = x + y + z + xx + xy + xz + yy + yz + zz;
         const int finite = int(sum - sum == 0.0);
-        // Positive definite by Sylvester's criterion, as isCovariance.
-        const double m2 = xx * yy - xy * xy;
-        const double m3 =
-            xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
-        const int positiveDefinite = int(xx > 0) & int(m2 > 0) & int(m3 > 0);
-        const int eq13 = 1 - int(9.0 * zz > g.maxVariance9_m2);
-        const double q = z / g.binHeight_m;
-        const int binFits = int(q >= kBinLow) & int(q < kBinHigh);
-        double fx = x * g.invCellSize, fy = y * g.invCellSize;  // as BinStore::cellIndex
-        fx = fx < kLimit ? fx : kLimit;                         // also NaN
-        fx = fx < -kLimit ? -kLimit : fx;
-        fy = fy < kLimit ? fy : kLimit;
-        fy = fy < -kLimit ? -kLimit : fy;
-        cellX[i] = fx;
-        cellY[i] = fy;
+        const int positiveDefinite = int(isPositiveDefinite(xx, xy, xz, yy, yz, zz));
+        const int eq13 = int(g.params.passesEq13(zz));
+        const double q = z / g.params.binHeight_m;
+        const int binFits = int(BinStore::binIndexFits(q));
+        cellX[i] = BinStore::clampedCellCoordinate(x * g.invCellSize);
+        cellY[i] = BinStore::clampedCellCoordinate(y * g.invCellSize);
         binQ[i] = binFits ? q : 0.0;
         flags[i] = finite | positiveDefinite << 1 | eq13 << 2 | binFits << 3;
         cb.weight[i] = 1.0 / (zz < g.minFusedVariance_m2 ? g.minFusedVariance_m2 : zz);
     }
-    const auto floorToInt = [](double v) {  // as BinStore::floorToInt
-        const int t = static_cast<int>(v);
-        return t - int(v < double(t));
-    };
     const int nx = g.window.nx, ny = g.window.ny;
     for (size_t i = 0; i < m; i++) {
-        const int ix = floorToInt(cellX[i]), iy = floorToInt(cellY[i]);
+        const int ix = BinStore::floorToInt(cellX[i]), iy = BinStore::floorToInt(cellY[i]);
         const int dx = ix - g.window.ix0, dy = iy - g.window.iy0;
         const int inWindow = int(dx >= 0) & int(dx < nx) & int(dy >= 0) & int(dy < ny);
         int sx = dx + g.originSlotX, sy = dy + g.originSlotY;
@@ -214,7 +196,7 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
         cb.status[i] = static_cast<uint8_t>(status);
         cb.ix[i] = ix;
         cb.iy[i] = iy;
-        cb.bin[i] = floorToInt(binQ[i]);
+        cb.bin[i] = BinStore::floorToInt(binQ[i]);
         cb.slot[i] = (uint32_t(sx) + uint32_t(sy) * uint32_t(nx)) * uint32_t(inWindow);
     }
 }
@@ -259,11 +241,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
     // division chained through every point.
     const bool perPoint = continuityBound_m < std::numeric_limits<double>::infinity();
     const CellWindow w = window();
-    const ClassifyGeometry geometry{
-        inverseCellSize(),   w,
-        originSlotX(),       originSlotY(),
-        params.binHeight_m,  params.maxElevationUncertainty_m * params.maxElevationUncertainty_m,
-        kMinFusedVariance_m2};
+    const ClassifyGeometry geometry{inverseCellSize(), w,      originSlotX(),
+                                    originSlotY(),     params, kMinFusedVariance_m2};
 
     // The open run: consecutive accepted points in one bin. Its plane moments are a copy, written
     // back when the run closes, so the per-point update stays in registers.

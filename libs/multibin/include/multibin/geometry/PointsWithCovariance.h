@@ -33,13 +33,18 @@ bool isSingularCovariance(const SymmetricCov3& c);
 /** Whether `c` is a covariance: finite and positive semi-definite. Zero and rank-deficient
  * covariances pass (an exact pose, a range-only sensor: the point is exactly known along some
  * directions); indefinite ones (a negative variance, |correlation| > 1) and NaN do not. */
-inline bool isCovariance(const SymmetricCov3& c) {
-    // Positive-definite by Sylvester's criterion (leading minors), in double: the common case.
-    const double xx = c.xx, xy = c.xy, xz = c.xz, yy = c.yy, yz = c.yz, zz = c.zz;
+/** Positive definite by Sylvester's criterion (leading minors), in double; no branch, so loops
+ * over points vectorise. */
+inline bool isPositiveDefinite(double xx, double xy, double xz, double yy, double yz, double zz) {
     const double m2 = xx * yy - xy * xy;
     const double m3 =
         xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
-    if (__builtin_expect(xx > 0 && m2 > 0 && m3 > 0, 1)) return true;
+    return (xx > 0) & (m2 > 0) & (m3 > 0);
+}
+
+inline bool isCovariance(const SymmetricCov3& c) {
+    if (__builtin_expect(isPositiveDefinite(c.xx, c.xy, c.xz, c.yy, c.yz, c.zz), 1))
+        return true;  // the common case
     return isSingularCovariance(c);
 }
 

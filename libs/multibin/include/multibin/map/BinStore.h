@@ -38,27 +38,33 @@ public:
     /** Index of the cell containing a coordinate [m]; clamped far outside any window, so
      * absurd coordinates never overflow (NaN gives the upper limit). */
     int cellIndex(double coord_m) const {
+        return floorToInt(clampedCellCoordinate(coord_m * m_invCellSize));
+    }
+    /** A coordinate in cells [-], clamped to +-2^29 (NaN to the upper limit): far outside any
+     * window, and its floor fits an int. Selects only, so loops over points vectorise. */
+    static double clampedCellCoordinate(double f) {
         constexpr double kLimit = std::numeric_limits<int>::max() / 4;
-        double f = coord_m * m_invCellSize;
-        if (!(f < kLimit)) f = kLimit;  // also NaN
-        if (f < -kLimit) f = -kLimit;
-        return floorToInt(f);
+        f = f < kLimit ? f : kLimit;  // also NaN
+        return f < -kLimit ? -kLimit : f;
     }
     /** Vertical bin index of a height [m]: floor(height / binHeight); false if it does not fit
      * the int16 bin index (or is NaN). */
     static bool binIndexOf(double height_m, double binHeight_m, int16_t& n) {
         const double q = height_m / binHeight_m;
-        if (!(q >= std::numeric_limits<int16_t>::min() &&
-              q < double(std::numeric_limits<int16_t>::max()) + 1.0))
-            return false;
+        if (!binIndexFits(q)) return false;
         n = static_cast<int16_t>(floorToInt(q));
         return true;
     }
+    /** Whether floor(q) of a height in bins fits the int16 bin index (false for NaN). */
+    static bool binIndexFits(double q) {
+        return (q >= std::numeric_limits<int16_t>::min()) &
+               (q < double(std::numeric_limits<int16_t>::max()) + 1.0);
+    }
     /** floor(v) for finite |v| < 2^31, without a libm call (baseline x86-64 has no SSE4.1
-     * rounding instruction). */
+     * rounding instruction) and without a branch. */
     static int floorToInt(double v) {
         const int t = static_cast<int>(v);  // truncates towards zero
-        return t - (v < double(t) ? 1 : 0);
+        return t - int(v < double(t));
     }
     double cellCenter_m(int index) const { return (index + 0.5) * m_cellSize_m; }
     /** 1 / cell size, the factor cellIndex applies [1/m]. */
