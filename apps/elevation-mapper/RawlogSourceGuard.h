@@ -20,9 +20,10 @@ public:
     static constexpr uint64_t kPerByte = 16;
     /** MRPT allocates on its error path where a std::bad_alloc is std::terminate (an
      * exception's message and stack trace inside the throw expression, what()): requests of up
-     * to kSmallBytes may go kSlackBytes beyond the limit, and the first refusal raises the limit
-     * to kSlackBytes beyond what was taken, once. The peak stays under the limit + 3 x
-     * kSlackBytes. */
+     * to kSmallBytes may go kSlackBytes beyond the limit, the first refusal raises the limit
+     * to kSlackBytes beyond what was taken, once, and requests of up to kSmallBytes made while
+     * an exception is being handled (MRPT's handlers rethrow with a stack trace) have kSlackBytes
+     * of their own. The peak stays under the limit + 4 x kSlackBytes. */
     static constexpr uint64_t kSmallBytes = uint64_t(64) << 10;
     static constexpr uint64_t kSlackBytes = uint64_t(64) << 20;
     static uint64_t limitFor(uint64_t bytesLeft);
