@@ -122,6 +122,9 @@ struct ClassifiedBlock {
     alignas(64) uint32_t slot[kPointBlock];  // as BinStore::slot, below 2^32 cells
     alignas(64) int32_t bin[kPointBlock];
     alignas(64) uint8_t status[kPointBlock];
+    /** The status the gates after the covariance's give (window, eq 13, bin range): the
+     * status of a kCheckSingular point whose covariance isSingularCovariance accepts. */
+    alignas(64) uint8_t statusAfterCovariance[kPointBlock];
 };
 
 /** What the classification needs of the grid, by value (no aliasing with the block). */
@@ -194,6 +197,7 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
             (1 - finite) * kNotFinite +
             finite * ((1 - positiveDefinite) * kCheckSingular + positiveDefinite * rest);
         cb.status[i] = static_cast<uint8_t>(status);
+        cb.statusAfterCovariance[i] = static_cast<uint8_t>(rest);
         cb.ix[i] = ix;
         cb.iy[i] = iy;
         cb.bin[i] = BinStore::floorToInt(binQ[i]);
@@ -282,29 +286,15 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         // Pass 2, in point order: the bin updates.
         for (size_t i = 0; i < m; i++) {
             if (cb.status[i] != kAccept) {  // rare: counted per reason after the loop
-                if (cb.status[i] == kCheckSingular) {
+                uint8_t status = cb.status[i];
+                if (status == kCheckSingular) {  // zero or singular: an exact pose, fused as it is
                     const SymmetricCov3 c{pts.v[3][i], pts.v[4][i], pts.v[5][i],
                                           pts.v[6][i], pts.v[7][i], pts.v[8][i]};
-                    if (!isSingularCovariance(c)) {
-                        rejected[kBadCovariance]++;
-                        continue;
-                    }
-                    // An exact pose, fused as it is: the gates after the covariance's.
-                    if (!w.contains(cb.ix[i], cb.iy[i])) {
-                        rejected[kOutsideMap]++;
-                        continue;
-                    }
-                    if (!params.passesEq13(double(c.zz))) {
-                        rejected[kTooUncertain]++;
-                        continue;
-                    }
-                    int16_t n;
-                    if (!binIndexOf(pts.v[2][i], params.binHeight_m, n)) {
-                        rejected[kOutsideBinRange]++;
-                        continue;
-                    }
-                } else {
-                    rejected[cb.status[i]]++;
+                    status = isSingularCovariance(c) ? cb.statusAfterCovariance[i]
+                                                     : uint8_t(kBadCovariance);
+                }
+                if (status != kAccept) {
+                    rejected[status]++;
                     continue;
                 }
             }
