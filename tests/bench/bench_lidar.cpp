@@ -109,6 +109,22 @@ void BM_MapInsertVlp16Revolution(benchmark::State& state) {
 }
 BENCHMARK(BM_MapInsertVlp16Revolution)->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond);
 
+/** The same with visibility, arg: the insertion core's threads (insertion_threads), wall time:
+ * 1 (on one core) against 2 (the two-stage pipeline; run on two free cores). */
+void BM_MapInsertVlp16RevolutionThreads(benchmark::State& state) {
+    const auto cloud = vlp16Revolution();
+    const auto pose = robotPose();
+    auto map = lidarMap();
+    map->insertionOptions.insertion_threads = int(state.range(0));
+    map->insertObservation(cloud, pose);  // grows the map: not timed
+    for (auto _ : state) benchmark::DoNotOptimize(map->insertObservation(cloud, pose));
+}
+BENCHMARK(BM_MapInsertVlp16RevolutionThreads)
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
 /** MRPT's recorded VLP-16 scan, or null if mrpt-common is missing. */
 mrpt::obs::CObservation::Ptr mrptVlp16Scan() {
     mrpt::obs::CRawlog rawlog;

@@ -240,6 +240,18 @@ BENCHMARK(BM_StereoFrameEndToEnd)
     ->Args({1, 2})
     ->Unit(benchmark::kMillisecond);
 
+// The same frame, every pixel, with visibility; arg: the insertion core's threads
+// (insertion_threads), wall time: 1 (one core) against 2 (the two-stage pipeline).
+static void BM_StereoFrameThreads(benchmark::State& state) {
+    mrpt::maps::CMultiBinElevationMap map;
+    map.insertionOptions.sensors.stereo.subsample = 1;
+    map.insertionOptions.insertion_threads = int(state.range(0));
+    const auto obs = stereoFrameOverFloor();
+    const auto pdf = robotPosePdf();
+    runMap(state, map, [&] { map.insertObservation(obs, pdf); });
+}
+BENCHMARK(BM_StereoFrameThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
 // A 640 x 480 frame of points already in the map frame (propagated once beforehand) through the
 // map's own insertion: bin update and visibility (arg 1) or bin update only (arg 0).
 static void BM_MapFrameFromMapPoints(benchmark::State& state) {

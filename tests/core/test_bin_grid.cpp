@@ -394,9 +394,43 @@ TEST(BinGrid, BlockHeightBoundCoversEveryBin) {
     EXPECT_EQ(fresh.blockMaxHeight_m(5, 1), -std::numeric_limits<float>::infinity());
 }
 
+namespace {
+/** Every bin of `b` byte for byte equal to `a`'s, and the same updated cells. */
+void expectSameBins(const BinGrid& a, const BinGrid& b) {
+    ASSERT_EQ(a.binCount(), b.binCount());
+    size_t same = 0;
+    const CellWindow& w = a.window();
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            std::vector<Bin> x, y;
+            a.forEachBin(ix, iy, [&](const Bin& bin) { x.push_back(bin); });
+            b.forEachBin(ix, iy, [&](const Bin& bin) { y.push_back(bin); });
+            ASSERT_EQ(x.size(), y.size());
+            for (size_t i = 0; i < x.size(); i++) {
+                ASSERT_EQ(std::memcmp(&x[i], &y[i], sizeof(Bin)), 0) << ix << "," << iy;
+                same++;
+            }
+        }
+    EXPECT_EQ(same, a.binCount());
+    ASSERT_EQ(a.updatedCells().size(), b.updatedCells().size());
+    for (size_t i = 0; i < a.updatedCells().size(); i++) {
+        EXPECT_EQ(a.updatedCells()[i].points, b.updatedCells()[i].points);
+        EXPECT_EQ(a.updatedCells()[i].maxHeight_m, b.updatedCells()[i].maxHeight_m);
+    }
+}
+
+void expectSameStats(const InsertStats& a, const InsertStats& b) {
+    EXPECT_EQ(a.accepted, b.accepted);
+    EXPECT_EQ(a.continuityRejected, b.continuityRejected);
+    EXPECT_EQ(a.outsideMap, b.outsideMap);
+    EXPECT_EQ(a.tooUncertain, b.tooUncertain);
+}
+}  // namespace
+
 TEST(BinGrid, FusedSensorInsertionIsBitIdenticalToTwoSteps) {
     // PosePropagator::apply then insertPoints, against insertSensorPoints, with and without the
-    // eq 14 bound, on batches whose runs of points in one bin cross the 256-point blocks.
+    // eq 14 bound, on batches whose runs of points in one bin cross the 256-point blocks; and
+    // both on two threads (insertion_threads = 2: 79 blocks, the two-stage pipeline).
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     mrpt::poses::CPose3DPDFGaussian robot;
@@ -419,38 +453,24 @@ TEST(BinGrid, FusedSensorInsertionIsBitIdenticalToTwoSteps) {
                 sensorPoints.push_back(p);
             }
         }
-        BinGrid twoSteps(0.02), fused(0.02);
-        twoSteps.reset(0.02, CellWindow{-100, -100, 250, 200});
-        fused.reset(0.02, CellWindow{-100, -100, 250, 200});
+        const CellWindow window{-100, -100, 250, 200};
+        BinGrid twoSteps(0.02), fused(0.02), twoStepsPipelined(0.02), fusedPipelined(0.02);
+        for (BinGrid* g : {&twoSteps, &fused, &twoStepsPipelined, &fusedPipelined})
+            g->reset(0.02, window);
+        twoStepsPipelined.setInsertionThreads(2);
+        fusedPipelined.setInsertionThreads(2);
         BinUpdateParams p;
         PointsWithCov mapPoints;
         propagator.apply(sensorPoints, mapPoints);
         const InsertStats a = twoSteps.insertPoints(mapPoints, p, bound);
         const InsertStats b = fused.insertSensorPoints(propagator, sensorPoints, p, bound);
+        const InsertStats c = twoStepsPipelined.insertPoints(mapPoints, p, bound);
+        const InsertStats d = fusedPipelined.insertSensorPoints(propagator, sensorPoints, p, bound);
         EXPECT_GT(a.accepted, 15000u);
-        EXPECT_EQ(a.accepted, b.accepted);
-        EXPECT_EQ(a.continuityRejected, b.continuityRejected);
-        EXPECT_EQ(a.outsideMap, b.outsideMap);
-        ASSERT_EQ(twoSteps.binCount(), fused.binCount());
-        size_t same = 0;
-        const CellWindow& w = twoSteps.window();
-        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
-                std::vector<Bin> x, y;
-                twoSteps.forEachBin(ix, iy, [&](const Bin& bin) { x.push_back(bin); });
-                fused.forEachBin(ix, iy, [&](const Bin& bin) { y.push_back(bin); });
-                ASSERT_EQ(x.size(), y.size());
-                for (size_t i = 0; i < x.size(); i++) {
-                    ASSERT_EQ(std::memcmp(&x[i], &y[i], sizeof(Bin)), 0) << ix << "," << iy;
-                    same++;
-                }
-            }
-        EXPECT_EQ(same, twoSteps.binCount());
-        ASSERT_EQ(twoSteps.updatedCells().size(), fused.updatedCells().size());
-        for (size_t i = 0; i < twoSteps.updatedCells().size(); i++) {
-            EXPECT_EQ(twoSteps.updatedCells()[i].points, fused.updatedCells()[i].points);
-            EXPECT_EQ(twoSteps.updatedCells()[i].maxHeight_m, fused.updatedCells()[i].maxHeight_m);
-        }
+        for (const InsertStats* s : {&b, &c, &d}) expectSameStats(a, *s);
+        expectSameBins(twoSteps, fused);
+        expectSameBins(twoSteps, twoStepsPipelined);
+        expectSameBins(twoSteps, fusedPipelined);
     }
 }
 

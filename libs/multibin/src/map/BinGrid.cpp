@@ -3,12 +3,22 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
+#include <exception>
+#include <memory>
 #include <stdexcept>
+#include <thread>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/util/Counters.h"
 #include "multibin/util/VectorClones.h"
+
+#include "HelperThread.h"
 
 namespace multibin {
 
@@ -205,6 +215,35 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
     }
 }
 
+/** A block as the first stage leaves it for the bin updates: its points and their classes. */
+struct ClassifiedStage {
+    PointBlock points;
+    ClassifiedBlock classes;
+    size_t count = 0;
+};
+
+/** Blocks in flight between the two stages of the pipeline: 8 x 14 kB, inside the L2 cache. */
+constexpr size_t kPipelineRing = 8;
+/** The pipeline pays from about this many blocks on (handing a task to the helper thread costs
+ * about as much as a few blocks' work): a 30 000-return lidar revolution, a stereo or depth frame,
+ * not a 683-beam laser scan. */
+constexpr size_t kPipelineMinBlocks = 16;
+
+/** Waits for `ready()`: spins briefly (the other stage is usually a block away), then yields the
+ * core (on a loaded machine the other stage may have lost its core). */
+template <class Ready>
+void waitUntil(Ready&& ready) {
+    for (int spins = 0; !ready(); spins++) {
+        if (spins < 1024) {
+#if defined(__x86_64__) || defined(__i386__)
+            _mm_pause();
+#endif
+        } else {
+            std::this_thread::yield();
+        }
+    }
+}
+
 }  // namespace
 
 InsertStats BinGrid::insertPoints(const PointsWithCov& mapPoints, const BinUpdateParams& params,
@@ -232,6 +271,53 @@ InsertStats BinGrid::insertSensorPoints(const PosePropagator& propagator,
             propagator.applyBlock(sensorPoints.data() + begin, m, block);
         },
         params, continuityBound_m);
+}
+
+template <typename Classify, typename Update>
+bool BinGrid::insertPipelined(size_t blocks, Classify& classify, Update& updateBins) {
+    // Two stages on two cores: the helper thread propagates and classifies blocks ahead while
+    // this thread updates the bins in point order, so the bins are those of one thread, bit for
+    // bit. Only this thread touches the grid.
+    std::unique_ptr<ClassifiedStage[]> ring(new ClassifiedStage[kPipelineRing]);
+    std::atomic<size_t> produced{0}, consumed{0};
+    std::atomic<bool> stopProducing{false}, producerFailed{false};
+    std::exception_ptr producerError;
+    auto produce = [&]() {
+        try {
+            for (size_t j = 0; j < blocks; j++) {
+                waitUntil([&] {
+                    return j < consumed.load(std::memory_order_acquire) + kPipelineRing ||
+                           stopProducing.load(std::memory_order_relaxed);
+                });
+                if (stopProducing.load(std::memory_order_relaxed)) return;
+                classify(j, ring[j % kPipelineRing]);
+                produced.store(j + 1, std::memory_order_release);
+            }
+        } catch (...) {
+            producerError = std::current_exception();
+            producerFailed.store(true, std::memory_order_release);
+        }
+    };
+    HelperThread& helper = HelperThread::shared();
+    if (!helper.tryStart(produce)) return false;  // busy with another map: one core
+    try {
+        for (size_t j = 0; j < blocks; j++) {
+            waitUntil([&] {
+                return produced.load(std::memory_order_acquire) > j ||
+                       producerFailed.load(std::memory_order_acquire);
+            });
+            if (produced.load(std::memory_order_acquire) <= j) break;  // the producer threw
+            updateBins(ring[j % kPipelineRing]);
+            consumed.store(j + 1, std::memory_order_release);
+        }
+    } catch (...) {
+        stopProducing.store(true, std::memory_order_relaxed);
+        helper.wait();
+        throw;
+    }
+    helper.wait();
+    if (producerError) std::rethrow_exception(producerError);
+    return true;
 }
 
 template <typename BlockSource>
@@ -276,15 +362,14 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         run.bin = kNoBin;
     };
 
-    PointBlock pts;
-    ClassifiedBlock cb;
     size_t rejected[kStatusCount] = {};
-    for (size_t begin = 0; begin < count; begin += kPointBlock) {
-        const size_t m = std::min(kPointBlock, count - begin);
-        fillBlock(begin, m, pts);
-        classifyBlock(geometry, pts, m, cb);
-        // Pass 2, in point order: the bin updates.
-        for (size_t i = 0; i < m; i++) {
+    // Pass 2, in point order: the bin updates of one classified block.
+    // Inlined into both loops below: called through a function, the run and the counters live
+    // in memory and the bin update is 6 % slower.
+    auto updateBins = [&](const ClassifiedStage& stage) __attribute__((always_inline)) {
+        const PointBlock& pts = stage.points;
+        const ClassifiedBlock& cb = stage.classes;
+        for (size_t i = 0; i < stage.count; i++) {
             if (cb.status[i] != kAccept) {  // rare: counted per reason after the loop
                 uint8_t status = cb.status[i];
                 if (status == kCheckSingular) {  // zero or singular: an exact pose, fused as it is
@@ -332,6 +417,22 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
             run.maxHeight_m = std::max(run.maxHeight_m, h);
             run.points++;
             stats.accepted++;
+        }
+    };
+    // Pass 1 of block j: the points (propagated, for sensor points) and their classes.
+    const size_t blocks = (count + kPointBlock - 1) / kPointBlock;
+    auto classify = [&](size_t j, ClassifiedStage& stage) {
+        const size_t begin = j * kPointBlock;
+        stage.count = std::min(kPointBlock, count - begin);
+        fillBlock(begin, stage.count, stage.points);
+        classifyBlock(geometry, stage.points, stage.count, stage.classes);
+    };
+    if (!(m_insertionThreads >= 2 && blocks >= kPipelineMinBlocks &&
+          insertPipelined(blocks, classify, updateBins))) {
+        ClassifiedStage stage;
+        for (size_t j = 0; j < blocks; j++) {
+            classify(j, stage);
+            updateBins(stage);
         }
     }
     closeRun();

@@ -173,6 +173,7 @@ void visitInsertionKeys(Options& o, Visit&& visit) {
     visit("dem_return_filled", o.dem_return_filled);
     visit("relief_sigma", o.relief_sigma);
     visit("height_query", o.height_query, kHeightQueries);
+    visit("insertion_threads", o.insertion_threads, between(1, 2));
 }
 
 /** The origin the options fix before any data arrive: the explicit one, or originNear() of a

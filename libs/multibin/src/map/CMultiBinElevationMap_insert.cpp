@@ -307,6 +307,7 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
     const multibin::BinUpdateParams params = binUpdateParams();
     grid.beginCycle();
+    grid.setInsertionThreads(insertionOptions.insertion_threads);
     m_impl->fillStale = true;
     const multibin::InsertStats s = fuse(grid, params);
     m_impl->stats += s;

@@ -87,6 +87,12 @@ public:
         const BinUpdateParams& params,
         double continuityBound_m = std::numeric_limits<double>::infinity());
 
+    /** Threads of the insertion core (1 or 2): with 2, an observation of many points (at least
+     * 16 blocks of 256) is propagated and classified on a helper thread while this thread
+     * updates the bins in point order: the same bins bit for bit, on two cores. 1 by default. */
+    void setInsertionThreads(int threads) { m_insertionThreads = threads; }
+    int insertionThreads() const { return m_insertionThreads; }
+
     /** Fuses one height measurement into cell (ix, iy), which must be inside the window.
      * Returns false if a gate refused it (counted in `stats`). */
     bool insertHeight(int ix, int iy, double height_m, double variance_m2,
@@ -140,6 +146,11 @@ private:
     template <typename BlockSource>
     InsertStats insertBlocks(size_t count, BlockSource&& fillBlock, const BinUpdateParams& params,
                              double continuityBound_m);
+    /** insertBlocks' two passes on two threads: `classify(j, stage)` fills and classifies
+     * block j on the helper thread, `updateBins(stage)` runs here in block order. False, with
+     * nothing done, if the helper thread is busy. */
+    template <typename Classify, typename Update>
+    bool insertPipelined(size_t blocks, Classify& classify, Update& updateBins);
     /** Gates 13 and bin range passed: eq 14 and the per-point Kalman update (eq 15). */
     bool fuseMeasurement(size_t slot, int ix, int iy, int16_t n, double height_m,
                          double variance_m2, const BinUpdateParams& params,
@@ -147,6 +158,7 @@ private:
                          float y_m);  //!< its place feeds the plane moments; NaN: no place
 
     VisibilityIndex m_index;
+    int m_insertionThreads = 1;
 };
 
 }  // namespace multibin
