@@ -73,6 +73,35 @@ TEST(PosePropagation, JacobianMatchesFiniteDifferencesAndMrpt) {
         for (int c = 0; c < 6; c++) EXPECT_NEAR(J(r, c), Jmrpt(r, c), 1e-9);
 }
 
+TEST(PosePropagation, PoseHeightVarianceIsTheJacobiansQuadraticForm) {
+    // The double-precision polynomial the continuity bound (eq 14) evaluates against
+    // (J_R C_R J_R^T)_zz from the Jacobian, with a full correlated covariance, at random points.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    for (int trial = 0; trial < 20; trial++) {
+        CPose3DPDFGaussian robot;
+        robot.mean = CPose3D(unit(rng), unit(rng), 0.3 * unit(rng), 3 * unit(rng), 0.5 * unit(rng),
+                             0.5 * unit(rng));
+        Eigen::Matrix<double, 6, 6> A;
+        for (int r = 0; r < 6; r++)
+            for (int c = 0; c < 6; c++) A(r, c) = 0.01 * unit(rng);
+        const Eigen::Matrix<double, 6, 6> C = A * A.transpose();  // positive semi-definite
+        for (int r = 0; r < 6; r++)
+            for (int c = 0; c < 6; c++) robot.cov(r, c) = C(r, c);
+        const CPose3D sensor(0.1, 0.05, 0.26, 0.2, mrpt::DEG2RAD(40.0), 0.1);
+        const multibin::PosePropagator prop(robot, sensor);
+        for (int k = 0; k < 50; k++) {
+            const Eigen::Vector3d ps(3 * unit(rng), 3 * unit(rng), 3 * unit(rng));
+            Eigen::Vector3d pr;
+            sensor.composePoint(ps.x(), ps.y(), ps.z(), pr.x(), pr.y(), pr.z());
+            const Eigen::Matrix<double, 1, 6> j = prop.jacobianWrtRobotPose(pr).row(2);
+            const double expected = (j * C * j.transpose())(0, 0);
+            EXPECT_NEAR(prop.poseHeightVariance_m2(ps.x(), ps.y(), ps.z()), expected,
+                        1e-12 + 1e-9 * expected);
+        }
+    }
+}
+
 TEST(PosePropagation, CovarianceMatchesMonteCarlo) {
     const CPose3DPDFGaussian robot = poseWithCov(CPose3D(0.5, 0.2, 0.1, 0.3, 0.05, -0.04),
                                                  {0.02, 0.015, 0.01, 0.02, 0.01, 0.015});

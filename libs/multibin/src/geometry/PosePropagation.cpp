@@ -16,7 +16,6 @@ Eigen::Matrix3d toEigen(const mrpt::math::CMatrixDouble33& m) {
     return e;
 }
 
-
 /** Index pairs (r, c) of the stored upper triangle, in SymmetricCov3's order. */
 constexpr int kEntryRow[6] = {0, 0, 0, 1, 1, 2};
 constexpr int kEntryCol[6] = {0, 1, 2, 1, 2, 2};
@@ -141,6 +140,8 @@ PosePropagator::PosePropagator(const mrpt::poses::CPose3DPDFGaussian& robotPoseI
             for (int j = 0; j < 4; j++) coef[kMono[std::min(i, j)][std::max(i, j)]] += P(i, j);
         }
         for (int m = 0; m < 10; m++) m_k.robot[e][m] = static_cast<float>(coef[m]);
+        if (r == 2 && c == 2)
+            for (int m = 0; m < 10; m++) m_poseHeightVariance[m] = coef[m];
     }
     // Entry (r, c) of A C_S A^T = sum_ij A(r, i) C_S(i, j) A(c, j), A the sensor-to-map rotation.
     const Eigen::Matrix3d& A = rotSensorToMap;

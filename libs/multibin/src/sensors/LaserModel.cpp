@@ -124,13 +124,9 @@ double continuityBound_m(const PointsWithCov& sensorPoints, const mrpt::poses::C
                          const mrpt::poses::CPose3DPDFGaussian& currentRobotPose,
                          const LaserModelOptions& opts) {
     if (sensorPoints.empty()) return std::numeric_limits<double>::infinity();
+    // The pose terms are the z-z entries of J_R C J_R^T, which the propagators hold as
+    // polynomials in the sensor-frame point: no Jacobian and no 6x6 product per point.
     const PosePropagator prev(previousRobotPose, sensorPose), cur(currentRobotPose, sensorPose);
-    Eigen::Matrix<double, 6, 6> Cprev, Ccur;
-    for (int r = 0; r < 6; r++)
-        for (int c = 0; c < 6; c++) {
-            Cprev(r, c) = previousRobotPose.cov(r, c);
-            Ccur(r, c) = currentRobotPose.cov(r, c);
-        }
     const auto& Rs = sensorPose.getRotationMatrix();
     const auto& Rr = currentRobotPose.mean.getRotationMatrix();
     // Height component of a sensor-frame direction in the map: row 2 of Rr * Rs.
@@ -145,12 +141,8 @@ double continuityBound_m(const PointsWithCov& sensorPoints, const mrpt::poses::C
         const double range = ps.norm();
         if (!(range > 0)) continue;
         const double sZr = opts.rangeSigma(range) * std::abs(zRow.dot(ps / range));
-        Eigen::Vector3d pr;
-        sensorPose.composePoint(ps.x(), ps.y(), ps.z(), pr.x(), pr.y(), pr.z());
-        const Eigen::Matrix<double, 1, 6> ja = prev.jacobianWrtRobotPose(pr).row(2);
-        const Eigen::Matrix<double, 1, 6> jb = cur.jacobianWrtRobotPose(pr).row(2);
-        const double sa2 = (ja * Cprev * ja.transpose())(0, 0);
-        const double sb2 = (jb * Ccur * jb.transpose())(0, 0);
+        const double sa2 = prev.poseHeightVariance_m2(ps.x(), ps.y(), ps.z());
+        const double sb2 = cur.poseHeightVariance_m2(ps.x(), ps.y(), ps.z());
         const double sZp2 = std::max(0.0, sa2 + sb2 - 2 * rho * std::sqrt(sa2 * sb2));
         worst2 = std::max(worst2, 2 * sZr * sZr + sZp2);
     }

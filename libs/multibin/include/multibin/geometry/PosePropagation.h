@@ -60,6 +60,17 @@ public:
      * frame [m]. */
     Eigen::Matrix<double, 3, 6> jacobianWrtRobotPose(const Eigen::Vector3d& pointInRobot_m) const;
 
+    /** The z-z entry of J_R C_R J_R^T at a sensor-frame point [m^2]: the robot pose's share of
+     * the point's height variance, in double from the same polynomial apply() evaluates in single
+     * precision (ten multiply-adds, no Jacobian). Clamped at 0 (rounding). */
+    double poseHeightVariance_m2(double x_m, double y_m, double z_m) const {
+        const double* c = m_poseHeightVariance;
+        const double v = c[0] + c[1] * x_m + c[2] * y_m + c[3] * z_m + c[4] * x_m * x_m +
+                         c[5] * x_m * y_m + c[6] * x_m * z_m + c[7] * y_m * y_m + c[8] * y_m * z_m +
+                         c[9] * z_m * z_m;
+        return v > 0 ? v : 0.0;
+    }
+
     /** Sensor origin in the map frame [m]. */
     const Eigen::Vector3d& sensorOriginInMap_m() const { return m_sensorOrigin_m; }
 
@@ -89,6 +100,8 @@ private:
     Eigen::Matrix3d m_rotSensorToMap;  //!< sensor-to-map rotation
     Eigen::Matrix3d m_dRot[3];         //!< dRot/dyaw, dRot/dpitch, dRot/droll of the robot pose
     Coefficients m_k;
+    /** m_k.robot's z-z row in double [m^2 / m^k]. */
+    double m_poseHeightVariance[10];
 };
 
 }  // namespace multibin
