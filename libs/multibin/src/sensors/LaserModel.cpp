@@ -7,6 +7,7 @@
 #include <string>
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/util/VectorClones.h"
 
 namespace multibin::sensors {
 
@@ -119,6 +120,36 @@ void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
     }
 }
 
+namespace {
+/** What continuityBound_m's per-point term needs, by value. */
+struct ContinuityTerms {
+    double zRow[3];  //!< row 2 of the sensor-to-map rotation
+    RangeSigmaCurve rangeSigma;
+    double previous[10], current[10];  //!< the poses' height-variance polynomials
+    double rho;                        //!< correlation of the two poses' errors
+};
+
+/** 2 sigma_zr^2 + sigma_zp^2 of each of `n` points (continuityBound_m's) into `out`; 0 for a
+ * point at range 0 (or NaN). Branch-free, so it vectorises (the maximum is taken after: GCC 12
+ * does not vectorise a floating-point max reduction without -ffast-math). */
+MULTIBIN_VECTOR_CLONES
+void differenceVariances(const ContinuityTerms& t, const double* xs, const double* ys,
+                         const double* zs, size_t n, double* out) {
+    for (size_t i = 0; i < n; i++) {
+        const double x = xs[i], y = ys[i], z = zs[i];
+        const double range = std::sqrt(x * x + y * y + z * z);
+        const double along = t.zRow[0] * (x / range) + t.zRow[1] * (y / range) +
+                             t.zRow[2] * (z / range);  // e_z . d in the map
+        const double sZr = t.rangeSigma(range) * std::abs(along);
+        const double sa2 = PosePropagator::heightVariancePolynomial(t.previous, x, y, z);
+        const double sb2 = PosePropagator::heightVariancePolynomial(t.current, x, y, z);
+        const double d2 = sa2 + sb2 - 2 * t.rho * std::sqrt(sa2 * sb2);
+        const double v = 2 * sZr * sZr + (d2 > 0 ? d2 : 0.0);
+        out[i] = range > 0 ? v : 0.0;
+    }
+}
+}  // namespace
+
 double continuityBound_m(const PointsWithCov& sensorPoints, const mrpt::poses::CPose3D& sensorPose,
                          const mrpt::poses::CPose3DPDFGaussian& previousRobotPose,
                          const mrpt::poses::CPose3DPDFGaussian& currentRobotPose,
@@ -126,25 +157,31 @@ double continuityBound_m(const PointsWithCov& sensorPoints, const mrpt::poses::C
     if (sensorPoints.empty()) return std::numeric_limits<double>::infinity();
     // The pose terms are the z-z entries of J_R C J_R^T, which the propagators hold as
     // polynomials in the sensor-frame point: no Jacobian and no 6x6 product per point.
+    ContinuityTerms t;
     const PosePropagator prev(previousRobotPose, sensorPose), cur(currentRobotPose, sensorPose);
+    std::copy_n(prev.poseHeightVarianceCoefficients(), 10, t.previous);
+    std::copy_n(cur.poseHeightVarianceCoefficients(), 10, t.current);
     const auto& Rs = sensorPose.getRotationMatrix();
     const auto& Rr = currentRobotPose.mean.getRotationMatrix();
     // Height component of a sensor-frame direction in the map: row 2 of Rr * Rs.
-    Eigen::Vector3d zRow;
     for (int c = 0; c < 3; c++)
-        zRow[c] = Rr(2, 0) * Rs(0, c) + Rr(2, 1) * Rs(1, c) + Rr(2, 2) * Rs(2, c);
-    const double rho = opts.continuityPoseCorrelation;
+        t.zRow[c] = Rr(2, 0) * Rs(0, c) + Rr(2, 1) * Rs(1, c) + Rr(2, 2) * Rs(2, c);
+    t.rangeSigma = opts.rangeSigma;
+    t.rho = opts.continuityPoseCorrelation;
 
     double worst2 = 0;
-    for (const PointWithCov& p : sensorPoints) {
-        const Eigen::Vector3d ps = p.point_m.cast<double>();
-        const double range = ps.norm();
-        if (!(range > 0)) continue;
-        const double sZr = opts.rangeSigma(range) * std::abs(zRow.dot(ps / range));
-        const double sa2 = prev.poseHeightVariance_m2(ps.x(), ps.y(), ps.z());
-        const double sb2 = cur.poseHeightVariance_m2(ps.x(), ps.y(), ps.z());
-        const double sZp2 = std::max(0.0, sa2 + sb2 - 2 * rho * std::sqrt(sa2 * sb2));
-        worst2 = std::max(worst2, 2 * sZr * sZr + sZp2);
+    constexpr size_t kBlock = 256;
+    alignas(64) double x[kBlock], y[kBlock], z[kBlock], v[kBlock];
+    for (size_t begin = 0; begin < sensorPoints.size(); begin += kBlock) {
+        const size_t n = std::min(kBlock, sensorPoints.size() - begin);
+        for (size_t i = 0; i < n; i++) {
+            const Eigen::Vector3f& p = sensorPoints[begin + i].point_m;
+            x[i] = p.x();
+            y[i] = p.y();
+            z[i] = p.z();
+        }
+        differenceVariances(t, x, y, z, n, v);
+        for (size_t i = 0; i < n; i++) worst2 = std::max(worst2, v[i]);
     }
     return opts.continuitySigmas * std::sqrt(worst2) + opts.continuityAllowance_m;
 }

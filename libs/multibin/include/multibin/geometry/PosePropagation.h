@@ -64,10 +64,15 @@ public:
      * the point's height variance, in double from the same polynomial apply() evaluates in single
      * precision (ten multiply-adds, no Jacobian). Clamped at 0 (rounding). */
     double poseHeightVariance_m2(double x_m, double y_m, double z_m) const {
-        const double* c = m_poseHeightVariance;
-        const double v = c[0] + c[1] * x_m + c[2] * y_m + c[3] * z_m + c[4] * x_m * x_m +
-                         c[5] * x_m * y_m + c[6] * x_m * z_m + c[7] * y_m * y_m + c[8] * y_m * z_m +
-                         c[9] * z_m * z_m;
+        return heightVariancePolynomial(m_poseHeightVariance, x_m, y_m, z_m);
+    }
+    /** Its coefficients, of the monomials 1, x, y, z, xx, xy, xz, yy, yz, zz, for loops over
+     * points that evaluate heightVariancePolynomial themselves. */
+    const double* poseHeightVarianceCoefficients() const { return m_poseHeightVariance; }
+    /** The polynomial of poseHeightVariance_m2 with coefficients `c`, clamped at 0; no branch. */
+    static double heightVariancePolynomial(const double* c, double x, double y, double z) {
+        const double v = c[0] + c[1] * x + c[2] * y + c[3] * z + c[4] * x * x + c[5] * x * y +
+                         c[6] * x * z + c[7] * y * y + c[8] * y * z + c[9] * z * z;
         return v > 0 ? v : 0.0;
     }
 
