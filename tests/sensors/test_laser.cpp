@@ -152,6 +152,44 @@ TEST(LaserModel, ScanMixedPixelCountedInStats) {
     EXPECT_EQ(pts.size(), 41u);
 }
 
+TEST(LaserModel, BeamDirectionsFollowEachScansGeometry) {
+    // The beam directions are cached between scans; scans of other beam counts, apertures and
+    // scanning directions, interleaved, must each get their own: every point is exactly
+    // r_i (cos a_i, sin a_i, 0) with a_i = getScanAngle(i).
+    LaserModelOptions opts;
+    opts.mixedPixelFilter = false;
+    struct Geometry {
+        size_t beams;
+        float aperture_rad;
+        bool rightToLeft;
+    };
+    const Geometry geometries[] = {{683, 4.18879f, true},
+                                   {683, 4.18879f, false},  // only the direction changes
+                                   {181, float(M_PI), false},
+                                   {683, 3.0f, false},
+                                   {683, 4.18879f, false}};
+    for (const Geometry& g : geometries) {
+        mrpt::obs::CObservation2DRangeScan scan;
+        scan.aperture = g.aperture_rad;
+        scan.rightToLeft = g.rightToLeft;
+        scan.maxRange = 5.0f;
+        scan.resizeScan(g.beams);
+        for (size_t i = 0; i < g.beams; i++) {
+            scan.setScanRange(i, 0.5f + 0.001f * float(i));
+            scan.setScanRangeValidity(i, true);
+        }
+        PointsWithCov pts;
+        LaserStats stats;
+        laserScanToPoints(scan, opts, 0.02, 20, pts, stats);
+        ASSERT_EQ(pts.size(), g.beams);
+        for (size_t i = 0; i < g.beams; i++) {
+            const float a = scan.getScanAngle(i), r = scan.getScanRange(i);
+            ASSERT_EQ(pts[i].point_m.x(), std::cos(a) * r) << g.beams << " beams, beam " << i;
+            ASSERT_EQ(pts[i].point_m.y(), std::sin(a) * r) << g.beams << " beams, beam " << i;
+        }
+    }
+}
+
 TEST(LaserModel, ContinuityBoundHandComputed) {
     // Laser pointing straight down 0.5 m above the ground, exact poses: only the range term and
     // the allowance remain: 3 * sqrt(2) * sigma_r(0.5) + 0.01.

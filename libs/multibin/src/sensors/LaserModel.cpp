@@ -57,6 +57,35 @@ std::vector<bool> findMixedPixels(const std::vector<float>& ranges_m,
     return mixed;
 }
 
+namespace {
+/** The unit beam directions (cos a_i, sin a_i, 0) of a scan, a_i = getScanAngle(i): the same for
+ * every scan of one laser, so they are cached per thread and rebuilt when the beam count, the
+ * aperture or the scanning direction change (the sine and cosine were 5 % of a scan). */
+const std::vector<Eigen::Vector3f>& beamDirections(const mrpt::obs::CObservation2DRangeScan& scan) {
+    struct Cache {
+        size_t beams = 0;
+        float aperture = 0;
+        bool rightToLeft = true, built = false;
+        std::vector<Eigen::Vector3f> directions;
+    };
+    thread_local Cache cache;
+    const size_t n = scan.getScanSize();
+    if (!cache.built || cache.beams != n || !(cache.aperture == scan.aperture) ||
+        cache.rightToLeft != scan.rightToLeft) {
+        cache.directions.resize(n);
+        for (size_t i = 0; i < n; i++) {
+            const float a = scan.getScanAngle(i);
+            cache.directions[i] = Eigen::Vector3f(std::cos(a), std::sin(a), 0.f);
+        }
+        cache.beams = n;
+        cache.aperture = scan.aperture;
+        cache.rightToLeft = scan.rightToLeft;
+        cache.built = true;
+    }
+    return cache.directions;
+}
+}  // namespace
+
 void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
                        const LaserModelOptions& opts, double minRange_m, double maxRange_m,
                        PointsWithCov& out, LaserStats& stats) {
@@ -76,8 +105,10 @@ void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
 
     // Ranges for the mixed-pixel clustering: +inf = no return, NaN = unusable reading.
     std::vector<float> ranges(n);
+    // getScanRange() returns a reference into the scan's contiguous range vector.
+    const float* scanRanges = n > 0 ? &scan.getScanRange(0) : nullptr;
     for (size_t i = 0; i < n; i++) {
-        const float r = scan.getScanRange(i);
+        const float r = scanRanges[i];
         if (!std::isfinite(r))
             ranges[i] = std::numeric_limits<float>::quiet_NaN();
         else if (!scan.getScanRangeValidity(i) || r >= scan.maxRange || r <= 0)
@@ -88,6 +119,7 @@ void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
     const std::vector<bool> mixed =
         opts.mixedPixelFilter ? findMixedPixels(ranges, opts) : std::vector<bool>(n, false);
 
+    const std::vector<Eigen::Vector3f>& directions = beamDirections(scan);
     const auto agc = opts.agcByLabel.find(scan.sensorLabel);
     const bool checkIntensity = scan.hasIntensity() && agc != opts.agcByLabel.end();
     for (size_t i = 0; i < n; i++) {
@@ -113,8 +145,7 @@ void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
             stats.mixedPixel++;
             continue;
         }
-        const float a = scan.getScanAngle(i);
-        const Eigen::Vector3f dir(std::cos(a), std::sin(a), 0.f);
+        const Eigen::Vector3f& dir = directions[i];
         out.push_back({dir * r, rangeOnlyCovariance(dir, float(opts.rangeSigma(r)))});
         stats.kept++;
     }
