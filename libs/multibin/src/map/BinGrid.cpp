@@ -229,18 +229,21 @@ constexpr size_t kPipelineRing = 8;
  * not a 683-beam laser scan. */
 constexpr size_t kPipelineMinBlocks = 16;
 
-/** Waits for `ready()`: spins briefly (the other stage is usually a block away), then yields the
- * core (on a loaded machine the other stage may have lost its core). */
+inline void pauseCore() {
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_pause();  // a spin-wait hint: frees the core's resources for its other hyperthread
+#endif
+}
+
+/** Waits for `ready()` (the helper thread, for a free slot of the ring): spins briefly (the other
+ * stage is usually a block away), then yields the core. */
 template <class Ready>
 void waitUntil(Ready&& ready) {
     for (int spins = 0; !ready(); spins++) {
-        if (spins < 1024) {
-#if defined(__x86_64__) || defined(__i386__)
-            _mm_pause();
-#endif
-        } else {
+        if (spins < 1024)
+            pauseCore();
+        else
             std::this_thread::yield();
-        }
     }
 }
 
@@ -277,46 +280,68 @@ template <typename Classify, typename Update>
 bool BinGrid::insertPipelined(size_t blocks, Classify& classify, Update& updateBins) {
     // Two stages on two cores: the helper thread propagates and classifies blocks ahead while
     // this thread updates the bins in point order, so the bins are those of one thread, bit for
-    // bit. Only this thread touches the grid.
+    // bit; only this thread touches the grid. This thread does not wait for the helper: a block
+    // the helper has not delivered when its turn comes (the helper not awake yet, or its core
+    // taken by another process) is classified here, and the helper moves past it.
     std::unique_ptr<ClassifiedStage[]> ring(new ClassifiedStage[kPipelineRing]);
-    std::atomic<size_t> produced{0}, consumed{0};
-    std::atomic<bool> stopProducing{false}, producerFailed{false};
-    std::exception_ptr producerError;
+    std::atomic<size_t> slotHolds[kPipelineRing];  // 1 + the block a slot holds; 0: none yet
+    for (std::atomic<size_t>& h : slotHolds) h.store(0, std::memory_order_relaxed);
+    std::atomic<size_t> nextForHelper{0}, consumed{0};
+    std::atomic<bool> done{false};
     auto produce = [&]() {
         try {
-            for (size_t j = 0; j < blocks; j++) {
+            for (;;) {
+                const size_t j = nextForHelper.fetch_add(1, std::memory_order_relaxed);
+                if (j >= blocks) return;
+                // Slot j % ring is free once block j - ring has been consumed.
                 waitUntil([&] {
                     return j < consumed.load(std::memory_order_acquire) + kPipelineRing ||
-                           stopProducing.load(std::memory_order_relaxed);
+                           done.load(std::memory_order_relaxed);
                 });
-                if (stopProducing.load(std::memory_order_relaxed)) return;
+                if (done.load(std::memory_order_relaxed)) return;
+                if (j < consumed.load(std::memory_order_acquire)) continue;  // done here
                 classify(j, ring[j % kPipelineRing]);
-                produced.store(j + 1, std::memory_order_release);
+                slotHolds[j % kPipelineRing].store(j + 1, std::memory_order_release);
             }
         } catch (...) {
-            producerError = std::current_exception();
-            producerFailed.store(true, std::memory_order_release);
+            // Nothing is lost: this thread classifies every block the helper does not deliver.
         }
     };
     HelperThread& helper = HelperThread::shared();
     if (!helper.tryStart(produce)) return false;  // busy with another map: one core
+    auto stopHelper = [&] {
+        done.store(true, std::memory_order_relaxed);
+        helper.wait();  // at most the block it is classifying
+    };
+    ClassifiedStage own;  // a block classified on this thread
     try {
         for (size_t j = 0; j < blocks; j++) {
-            waitUntil([&] {
-                return produced.load(std::memory_order_acquire) > j ||
-                       producerFailed.load(std::memory_order_acquire);
-            });
-            if (produced.load(std::memory_order_acquire) <= j) break;  // the producer threw
-            updateBins(ring[j % kPipelineRing]);
+            const std::atomic<size_t>& holds = slotHolds[j % kPipelineRing];
+            bool ready = holds.load(std::memory_order_acquire) == j + 1;
+            // Wait briefly for a block the helper has claimed (about one block's work).
+            for (int spin = 0;
+                 !ready && spin < 64 && nextForHelper.load(std::memory_order_relaxed) > j; spin++) {
+                pauseCore();
+                ready = holds.load(std::memory_order_acquire) == j + 1;
+            }
+            if (ready) {
+                updateBins(ring[j % kPipelineRing]);
+            } else {
+                // Keep the helper off block j if it has not claimed it yet.
+                size_t next = nextForHelper.load(std::memory_order_relaxed);
+                while (next <= j && !nextForHelper.compare_exchange_weak(
+                                        next, j + 1, std::memory_order_relaxed)) {
+                }
+                classify(j, own);
+                updateBins(own);
+            }
             consumed.store(j + 1, std::memory_order_release);
         }
     } catch (...) {
-        stopProducing.store(true, std::memory_order_relaxed);
-        helper.wait();
+        stopHelper();
         throw;
     }
-    helper.wait();
-    if (producerError) std::rethrow_exception(producerError);
+    stopHelper();
     return true;
 }
 
