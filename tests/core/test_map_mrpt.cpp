@@ -408,6 +408,45 @@ TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
     EXPECT_EQ(map.insertStats().outOfRange, 1u);  // 50 m away: beyond max_range
 }
 
+TEST(CMultiBinElevationMap, GrowsForOnePointJustOutsideAmongManyInside) {
+    // The growth check screens points (vectorised) and tests only those near the window's edge
+    // exactly: one point a millimetre beyond the edge, in any of 600 positions of a block of
+    // points well inside, must still grow the window, and a point beyond max_size_m / 2 must not.
+    CMultiBinElevationMap::TCreationOptions c;
+    c.max_size_m = 60.0;
+    CMultiBinElevationMap map(c);
+    auto cloud = [](const std::vector<Eigen::Vector3f>& points) {
+        auto obs = mrpt::obs::CObservationPointCloud::Create();
+        auto pts = mrpt::maps::CSimplePointsMap::Create();
+        for (const auto& p : points) pts->insertPoint(p.x(), p.y(), p.z());
+        obs->pointcloud = pts;
+        obs->sensorPose = CPose3D(0, 0, 1.0, 0, 0, 0);
+        return obs;
+    };
+    std::vector<Eigen::Vector3f> first;
+    for (int i = 0; i < 40; i++)
+        for (int j = 0; j < 40; j++)
+            first.emplace_back(-0.5f + 0.025f * i, -0.5f + 0.025f * j, -1.f);
+    ASSERT_TRUE(map.insertObservation(*cloud(first), CPose3D()));
+    for (int k = 0; k < 12; k++) {
+        const double xMax = map.getXMax();
+        std::vector<Eigen::Vector3f> points(600, Eigen::Vector3f(0.f, 0.f, -1.f));
+        for (size_t i = 0; i < points.size(); i++) points[i].y() = -0.4f + 0.001f * float(i);
+        const size_t at = size_t(k) * 50 + 7;
+        const double robotX_m = xMax - 1.0;  // the edge 1 m ahead, well within max_size_m / 2
+        points[at].x() = float(xMax + 0.001 - robotX_m);  // just beyond the east edge
+        const size_t outsideBefore = map.insertStats().outsideMap;
+        ASSERT_TRUE(map.insertObservation(*cloud(points), CPose3D(robotX_m, 0, 0, 0, 0, 0)));
+        EXPECT_GT(map.getXMax(), xMax) << "insertion " << k;
+        EXPECT_EQ(map.insertStats().outsideMap, outsideBefore) << "insertion " << k;
+    }
+    const double xMax = map.getXMax();
+    std::vector<Eigen::Vector3f> far(300, Eigen::Vector3f(0.f, 0.f, -1.f));
+    far[150].x() = 30.5f;  // beyond max_size_m / 2 from the sensor
+    ASSERT_TRUE(map.insertObservation(*cloud(far), CPose3D(xMax - 1.0, 0, 0, 0, 0, 0)));
+    EXPECT_EQ(map.getXMax(), xMax);
+}
+
 TEST(StrictConfigSection, ReadChoiceTakesOnlyTheListedWords) {
     mrpt::config::CConfigFileMemory ini;
     ini.write("s", "mode", "hot");

@@ -17,6 +17,7 @@
 #include "multibin/map/VisibilityConstraint.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/SensorDispatch.h"
+#include "multibin/util/VectorClones.h"
 
 using namespace mrpt::maps;
 using multibin::PointsWithCov;
@@ -31,6 +32,37 @@ bool canGrowTheMap(const PointWithCov& p, const Eigen::Vector3d& sensor_m, doubl
     return std::abs(p.point_m.x() - sensor_m.x()) <= half_m &&
            std::abs(p.point_m.y() - sensor_m.y()) <= half_m && !std::isnan(p.cov_m2.zz) &&
            params.passesEq13(p.cov_m2.zz);
+}
+
+/** What growthNeeded's screen needs, by value: the window and the sensor-to-map transform. */
+struct GrowthScreen {
+    double rot[2][3];               //!< the first two rows of the sensor-to-map rotation
+    double sensorX_m, sensorY_m;    //!< the sensor origin in the map
+    double x0_m, x1_m, y0_m, y1_m;  //!< the window's edges
+    double half_m;                  //!< max_size_m / 2
+    double originNorm_m;            //!< |x| + |y| + |z| of the sensor origin
+};
+
+/** growthNeeded's screen over n sensor-frame points: 1 where a point may grow the window and must
+ * be tested exactly, 0 where it clearly cannot (clearly inside the window, or clearly farther
+ * than half_m from the sensor); NaN coordinates give 1. The positions in double as
+ * PosePropagator::horizontalInMap_m computes them. Branch-free, so it vectorises. */
+MULTIBIN_VECTOR_CLONES
+void screenForGrowth(const GrowthScreen& g, const float* xs, const float* ys, const float* zs,
+                     size_t n, uint8_t* mayGrow) {
+    for (size_t i = 0; i < n; i++) {
+        const double px = xs[i], py = ys[i], pz = zs[i];
+        const double qx = g.rot[0][0] * px + g.rot[0][1] * py + g.rot[0][2] * pz + g.sensorX_m;
+        const double qy = g.rot[1][0] * px + g.rot[1][1] * py + g.rot[1][2] * pz + g.sensorY_m;
+        // Far more than the single-precision propagation can differ from these [m].
+        const double slack =
+            1e-4 + 1e-5 * (std::abs(px) + std::abs(py) + std::abs(pz) + g.originNorm_m);
+        const int inside = int(qx - slack >= g.x0_m) & int(qx + slack <= g.x1_m) &
+                           int(qy - slack >= g.y0_m) & int(qy + slack <= g.y1_m);
+        const int far = int(std::abs(qx - g.sensorX_m) > g.half_m + slack) |
+                        int(std::abs(qy - g.sensorY_m) > g.half_m + slack);
+        mayGrow[i] = uint8_t((1 - inside) & (1 - far));
+    }
 }
 
 /** Options may be set in code after construction: every insertion entry point checks them
@@ -255,7 +287,18 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     const double x0 = w.ix0 * cell, x1 = (w.ix0 + w.nx) * cell;
     const double y0 = w.iy0 * cell, y1 = (w.iy0 + w.ny) * cell;
     const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
-    const double tNorm = s.cwiseAbs().sum();
+    GrowthScreen screen;
+    const Eigen::Matrix3d& A = propagator.rotationSensorToMap();
+    for (int r = 0; r < 2; r++)
+        for (int k = 0; k < 3; k++) screen.rot[r][k] = A(r, k);
+    screen.sensorX_m = s.x();
+    screen.sensorY_m = s.y();
+    screen.x0_m = x0;
+    screen.x1_m = x1;
+    screen.y0_m = y0;
+    screen.y1_m = y1;
+    screen.half_m = half;
+    screen.originNorm_m = s.cwiseAbs().sum();
     const multibin::BinUpdateParams params = binUpdateParams();
     constexpr size_t kBatch = 256;
     PointWithCov exact[kBatch];
@@ -272,18 +315,23 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
         pending = 0;
         return grows;
     };
-    // Scalar code: about 20 instructions a point, most points leave at the first test.
-    for (const PointWithCov& p : sensorPoints) {
-        const Eigen::Vector2d q = propagator.horizontalInMap_m(p.point_m);
-        const double qx = q.x(), qy = q.y();
-        const double slack = 1e-4 + 1e-5 * (std::abs(p.point_m.x()) + std::abs(p.point_m.y()) +
-                                            std::abs(p.point_m.z()) + tNorm);  // [m]
-        if (qx - slack >= x0 && qx + slack <= x1 && qy - slack >= y0 && qy + slack <= y1)
-            continue;  // clearly inside the window
-        if (std::abs(qx - s.x()) > half + slack || std::abs(qy - s.y()) > half + slack)
-            continue;  // clearly too far from the sensor; NaN coordinates are tested exactly
-        exact[pending++] = p;
-        if (pending == kBatch && anyGrows()) return true;
+    // A block at a time: the screen (vectorised), then the few points it leaves, exactly.
+    alignas(64) float bx[kBatch], by[kBatch], bz[kBatch];
+    alignas(64) uint8_t mayGrow[kBatch];
+    for (size_t begin = 0; begin < sensorPoints.size(); begin += kBatch) {
+        const size_t n = std::min(kBatch, sensorPoints.size() - begin);
+        for (size_t i = 0; i < n; i++) {
+            const Eigen::Vector3f& p = sensorPoints[begin + i].point_m;
+            bx[i] = p.x();
+            by[i] = p.y();
+            bz[i] = p.z();
+        }
+        screenForGrowth(screen, bx, by, bz, n, mayGrow);
+        for (size_t i = 0; i < n; i++) {
+            if (!mayGrow[i]) continue;
+            exact[pending++] = sensorPoints[begin + i];
+            if (pending == kBatch && anyGrows()) return true;
+        }
     }
     return pending > 0 && anyGrows();
 }

@@ -79,6 +79,9 @@ public:
     /** Sensor origin in the map frame [m]. */
     const Eigen::Vector3d& sensorOriginInMap_m() const { return m_sensorOrigin_m; }
 
+    /** Sensor-to-map rotation. */
+    const Eigen::Matrix3d& rotationSensorToMap() const { return m_rotSensorToMap; }
+
     /** Map-frame x and y of a sensor-frame point [m], in double from the same pose (apply()
      * evaluates in single precision): for tests that must bound apply()'s result cheaply. */
     Eigen::Vector2d horizontalInMap_m(const Eigen::Vector3f& p_m) const {
