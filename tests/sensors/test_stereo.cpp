@@ -6,6 +6,7 @@
 #include <mrpt/obs/CObservationStereoImages.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -443,6 +444,37 @@ TEST(StereoModel, SgbmFullWidthMatchesTheLeftmostColumns) {
     EXPECT_GT(bandGood, size_t(0.98 * double(band)));
     EXPECT_EQ(outside, 0u);
     EXPECT_LT(differ, size_t(0.001 * 256 * H));
+}
+
+TEST(StereoModel, RowsOnTwoCoresGiveTheSamePointsInTheSameOrder) {
+    // threads = 2: the helper thread does the lower half of the rows into its own array,
+    // appended after the upper half. Every point, covariance and count must equal one thread's,
+    // for steps 1 to 3 (odd row counts too); an image already in `out` stays in front.
+    const StereoGeometry g = stocGeometry();
+    const StereoCovarianceTable table(g, uncertainOptions());
+    DisparityImage disp(g.width, g.height);
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<float> d(0.f, 120.f);
+    for (int v = 0; v < g.height; v++)
+        for (int u = 0; u < g.width; u++) disp.at(u, v) = (u * 7 + v * 3) % 5 == 0 ? 0.f : d(rng);
+    for (int step = 1; step <= 3; step++) {
+        PointsWithCov one, two;
+        one.push_back({Eigen::Vector3f(1, 2, 3), {}});
+        two = one;
+        const StereoPixelCounts a = table.appendPoints(disp, step, 0.2, 0.5, 10.0, one, 1);
+        const StereoPixelCounts b = table.appendPoints(disp, step, 0.2, 0.5, 10.0, two, 2);
+        EXPECT_GT(a.kept, 1000u);
+        EXPECT_GT(a.noDisparity, 1000u);
+        EXPECT_GT(a.outOfRange + a.tooNear, 100u);
+        EXPECT_EQ(a.pixels, b.pixels);
+        EXPECT_EQ(a.kept, b.kept);
+        EXPECT_EQ(a.noDisparity, b.noDisparity);
+        EXPECT_EQ(a.tooNear, b.tooNear);
+        EXPECT_EQ(a.outOfRange, b.outOfRange);
+        ASSERT_EQ(one.size(), two.size());
+        EXPECT_EQ(std::memcmp(one.data(), two.data(), one.size() * sizeof(PointWithCov)), 0)
+            << "step " << step;
+    }
 }
 
 TEST(StereoModel, UnrectifiedPairIsRefused) {

@@ -18,7 +18,7 @@
 #include "multibin/util/Counters.h"
 #include "multibin/util/VectorClones.h"
 
-#include "HelperThread.h"
+#include "../util/HelperThread.h"
 
 namespace multibin {
 

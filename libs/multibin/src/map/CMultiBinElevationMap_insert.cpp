@@ -202,7 +202,8 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     try {
         if (!multibin::sensors::observationToSensorPoints(
                 obs, robotPose, insertionOptions.sensors, insertionOptions.min_range_m,
-                insertionOptions.max_range_m, m_impl->sensorState, sensed))
+                insertionOptions.max_range_m, m_impl->sensorState, sensed,
+                insertionOptions.insertion_threads))
             return false;  // not an observation this map models
     } catch (const std::invalid_argument&) {
         m_impl->sensorState.stats += sensed.stats;  // the refusal's counter (badAperture, ...)

@@ -44,7 +44,7 @@ SensorModelKind chooseModel(const mrpt::obs::CObservation& obs, const SensorMode
 bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
                                const mrpt::poses::CPose3DPDFGaussian& robotPose,
                                const SensorModelOptions& opts, double minRange_m, double maxRange_m,
-                               SensorModelState& state, SensorPoints& out) {
+                               SensorModelState& state, SensorPoints& out, int threads) {
     using K = SensorModelKind;
     out.points.clear();
     out.continuityBound_m = std::numeric_limits<double>::infinity();
@@ -75,7 +75,8 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
     if (const auto* stereo = dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs)) {
         chooseModel(obs, opts, K::stereo, {K::stereo});
         stereoToPoints(*stereo, opts.stereo, minRange_m, maxRange_m,
-                       state.stereoTables[stereo->sensorLabel], out.points, out.stats.stereo);
+                       state.stereoTables[stereo->sensorLabel], out.points, out.stats.stereo,
+                       threads);
         out.sensorPose = mrpt::poses::CPose3D(stereo->cameraPose);  // left camera on the robot
         return true;
     }

@@ -63,10 +63,11 @@ struct SensorPoints {
  * CObservationRotatingScan (lidar). Invalid, NaN and out-of-range readings are counted in
  * out.stats; the caller adds them up. Returns false for observations that no model handles;
  * throws std::invalid_argument naming the key `sensor_models` for a model its observation class
- * cannot take. `robotPose` is the robot pose PDF of the observation. */
+ * cannot take. `robotPose` is the robot pose PDF of the observation. `threads` = 2 lets a stereo
+ * pair's rows use the helper thread (StereoCovarianceTable::appendPoints). */
 bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
                                const mrpt::poses::CPose3DPDFGaussian& robotPose,
                                const SensorModelOptions& opts, double minRange_m, double maxRange_m,
-                               SensorModelState& state, SensorPoints& out);
+                               SensorModelState& state, SensorPoints& out, int threads = 1);
 
 }  // namespace multibin::sensors

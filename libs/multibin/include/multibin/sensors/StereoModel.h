@@ -96,10 +96,13 @@ public:
      * `step_px`-th pixel in u and v of `disparity` (the table's image size), appended to `out` in
      * raster order. Pixels without a valid disparity, nearer than `minDepth_m` or with a range
      * outside [minRange_m, maxRange_m] are skipped and counted, in that order of tests. No heap
-     * allocation per pixel; per row, what depends only on the row is computed once. Throws
+     * allocation per pixel; per row, what depends only on the row is computed once. With
+     * `threads` = 2 the process's helper thread computes the lower half of the rows (the same
+     * points, in the same order; one thread if the helper is busy). Throws
      * std::invalid_argument if the image size differs from the table's or step_px < 1. */
     StereoPixelCounts appendPoints(const DisparityImage& disparity, int step_px, double minDepth_m,
-                                   double minRange_m, double maxRange_m, PointsWithCov& out) const;
+                                   double minRange_m, double maxRange_m, PointsWithCov& out,
+                                   int threads = 1) const;
 
 private:
     StereoGeometry m_geometry;
@@ -116,11 +119,12 @@ private:
  * StereoSGBM; halo and near-cluster filters; every `subsample`-th pixel; eqs 4-10 for the
  * covariance, through `table`: the per-pixel table of this camera that the caller keeps between
  * pairs, (re)built here when the calibration or the sigmas change. What was done with the pixels
- * is added to `stats`. Throws std::invalid_argument naming the observation if it has neither a
- * disparity image nor a right image, or if the image size differs from its calibration. */
+ * is added to `stats`; `threads` as for appendPoints(). Throws std::invalid_argument naming the
+ * observation if it has neither a disparity image nor a right image, or if the image size
+ * differs from its calibration. */
 void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const StereoModelOptions& opts,
                     double minRange_m, double maxRange_m,
                     std::shared_ptr<const StereoCovarianceTable>& table, PointsWithCov& out,
-                    StereoStats& stats);
+                    StereoStats& stats, int threads = 1);
 
 }  // namespace multibin::sensors

@@ -1,4 +1,4 @@
-/* Part of the multibin elevation-mapping library. Private to src/map. */
+/* Part of the multibin elevation-mapping library. Private to src/. */
 #pragma once
 
 #include <condition_variable>
@@ -9,7 +9,8 @@
 namespace multibin {
 
 /** One thread shared by the whole process that runs one task at a time beside its caller: the
- * second core of the insertion pipeline (BinGrid::insertBlocks). A caller that finds it busy
+ * second core of the insertion pipeline (BinGrid::insertBlocks) and of the stereo rows
+ * (StereoCovarianceTable::appendPoints). A caller that finds it busy
  * (another map inserting from another thread) does all the work itself, so callers never wait on
  * each other. Started on first use, joined at exit. */
 class HelperThread {
