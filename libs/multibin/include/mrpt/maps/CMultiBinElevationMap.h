@@ -171,10 +171,11 @@ public:
          * value of the cell containing the point (cellHeight(), the answer before the sub-cell
          * surface). Rasters and gap filling always use the cell values. */
         enum class HeightQuery { Plane, Nearest } height_query = HeightQuery::Plane;
-        /** Threads of the insertion core (key `insertion_threads`, 1 or 2): with 2, a large
+        /** Threads of the insertion (key `insertion_threads`, 1 or 2): with 2, a large
          * observation (a lidar revolution, a stereo or depth frame: 4 096 points or more) is
          * propagated and classified on a helper thread while the calling thread updates the
-         * bins; the map is the same bit for bit. 1: everything on the calling thread. */
+         * bins, and the helper computes half of a stereo pair's rows; the map is the same bit
+         * for bit. 1: everything on the calling thread. */
         int insertion_threads = 1;
 
         void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
