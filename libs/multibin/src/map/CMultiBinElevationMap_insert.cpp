@@ -321,12 +321,7 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     alignas(64) uint8_t mayGrow[kBatch];
     for (size_t begin = 0; begin < sensorPoints.size(); begin += kBatch) {
         const size_t n = std::min(kBatch, sensorPoints.size() - begin);
-        for (size_t i = 0; i < n; i++) {
-            const Eigen::Vector3f& p = sensorPoints[begin + i].point_m;
-            bx[i] = p.x();
-            by[i] = p.y();
-            bz[i] = p.z();
-        }
+        gatherPositions(sensorPoints.data() + begin, n, bx, by, bz);
         screenForGrowth(screen, bx, by, bz, n, mayGrow);
         for (size_t i = 0; i < n; i++) {
             if (!mayGrow[i]) continue;

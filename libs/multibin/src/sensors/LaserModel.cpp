@@ -205,12 +205,7 @@ double continuityBound_m(const PointsWithCov& sensorPoints, const mrpt::poses::C
     alignas(64) double x[kBlock], y[kBlock], z[kBlock], v[kBlock];
     for (size_t begin = 0; begin < sensorPoints.size(); begin += kBlock) {
         const size_t n = std::min(kBlock, sensorPoints.size() - begin);
-        for (size_t i = 0; i < n; i++) {
-            const Eigen::Vector3f& p = sensorPoints[begin + i].point_m;
-            x[i] = p.x();
-            y[i] = p.y();
-            z[i] = p.z();
-        }
+        gatherPositions(sensorPoints.data() + begin, n, x, y, z);
         differenceVariances(t, x, y, z, n, v);
         for (size_t i = 0; i < n; i++) worst2 = std::max(worst2, v[i]);
     }

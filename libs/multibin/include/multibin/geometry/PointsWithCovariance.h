@@ -57,6 +57,17 @@ struct PointWithCov {
 /** A batch of points, all in one frame (a sensor frame, or the map frame). */
 using PointsWithCov = std::vector<PointWithCov>;
 
+/** The positions of `in[0 .. n)` into three arrays (structure of arrays, for loops over a block of
+ * points that the compiler vectorises); T float or double [m]. */
+template <typename T>
+void gatherPositions(const PointWithCov* in, size_t n, T* x, T* y, T* z) {
+    for (size_t i = 0; i < n; i++) {
+        x[i] = in[i].point_m.x();
+        y[i] = in[i].point_m.y();
+        z[i] = in[i].point_m.z();
+    }
+}
+
 /** Covariance [m^2] of a point measured along the unit ray `dir` with range standard deviation
  * `sigmaRange_m` and perfectly known bearing: sigma^2 * dir * dir^T (eq 3's J_S C_S J_S^T). */
 inline SymmetricCov3 rangeOnlyCovariance(const Eigen::Vector3f& dir, float sigmaRange_m) {
