@@ -161,6 +161,36 @@ void BM_MrptVlp16Scan(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_MrptVlp16Scan)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
+/** MRPT's recorded depth frame (mrpt-common's tests_rgbd.rawlog: 273 225 points of a wall and a
+ * bookshelf, 1.6-2.6 m) through the map, the camera looking down from 1.5 m as in the test
+ * MrptDatasets.RgbdFrameAsFloorHoldsThePlaneWithinThreeSigma, with a small pose covariance:
+ * depth model, the frame-shared error per cell, propagation, bin update, visibility. Arg: the
+ * insertion's threads (insertion_threads), wall time. */
+void BM_MrptRgbdFrame(benchmark::State& state) {
+    mrpt::obs::CRawlog rawlog;
+    if (!rawlog.loadFromRawLogFile("/usr/share/mrpt/datasets/tests_rgbd.rawlog")) {
+        state.SkipWithError("mrpt-common's tests_rgbd.rawlog is missing");
+        return;
+    }
+    mrpt::obs::CObservation::Ptr frame;
+    for (size_t i = 0; i < rawlog.size() && !frame; i++)
+        if (rawlog.getType(i) == mrpt::obs::CRawlog::etObservation)
+            frame = rawlog.getAsObservation(i);
+    if (!frame) {
+        state.SkipWithError("tests_rgbd.rawlog holds no observation");
+        return;
+    }
+    frame->load();
+    mrpt::maps::CMultiBinElevationMap map;
+    map.insertionOptions.insertion_threads = int(state.range(0));
+    mrpt::poses::CPose3DPDFGaussian pose = robotPose();
+    pose.mean = mrpt::poses::CPose3D(0, 0, 1.5, 0, M_PI / 2, 0);
+    map.insertObservation(*frame, pose);  // grows the map: not timed
+    for (auto _ : state) benchmark::DoNotOptimize(map.insertObservation(*frame, pose));
+    state.counters["fused"] = double(map.insertStats().accepted) / double(state.iterations() + 1);
+}
+BENCHMARK(BM_MrptRgbdFrame)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 }  // namespace
 
 BENCHMARK_MAIN();

@@ -236,15 +236,16 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
             const multibin::CellWindow& w = grid.window();
             ownGateRejected = multibin::sensors::addFrameSharedCovariance(
                 mapPoints, sensor_m, insertionOptions.sensors.depth,
-                [&grid](float x, float y) {
-                    return Eigen::Vector2i(grid.cellIndex(x), grid.cellIndex(y));
-                },
-                [&](const PointWithCov& p) {
-                    // What the grid would count as too uncertain: finite, inside the window.
-                    return p.point_m.allFinite() && std::isfinite(p.cov_m2.zz) &&
-                           w.contains(grid.cellIndex(p.point_m.x()),
-                                      grid.cellIndex(p.point_m.y())) &&
-                           !params.passesEq13(p.cov_m2.zz);
+                [&](const PointsWithCov& pts, std::vector<Eigen::Vector2i>& cells,
+                    std::vector<uint8_t>& failsOwnGate) {
+                    for (size_t i = 0; i < pts.size(); i++) {
+                        const PointWithCov& p = pts[i];
+                        cells[i] = {grid.cellIndex(p.point_m.x()), grid.cellIndex(p.point_m.y())};
+                        // What the grid would count as too uncertain: finite, inside the window.
+                        failsOwnGate[i] = p.point_m.allFinite() && std::isfinite(p.cov_m2.zz) &&
+                                          w.contains(cells[i].x(), cells[i].y()) &&
+                                          !params.passesEq13(p.cov_m2.zz);
+                    }
                 });
         }
         return insertIntoGrid(

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "RayPoint.h"
+#include "multibin/util/VectorClones.h"
 
 namespace multibin::sensors {
 
@@ -52,21 +53,51 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
     }
 }
 
+namespace {
+/** n s(r)^2 v v^T of each of `count` rays (x, y, z from the sensor [m], `pointsInCell` points in
+ * their cell): the six entries into `out`, and whether the ray has a direction (0 < r finite).
+ * Branch-free, so it vectorises. */
+MULTIBIN_VECTOR_CLONES
+void frameSharedTerms(const DepthModelOptions& opts, const double* xs, const double* ys,
+                      const double* zs, const uint32_t* pointsInCell, size_t count,
+                      double (*out)[256], uint8_t* hasDirection) {
+    for (size_t i = 0; i < count; i++) {
+        const double x = xs[i], y = ys[i], z = zs[i];
+        const double r = std::sqrt(x * x + y * y + z * z);
+        const double vx = x / r, vy = y / r, vz = z / r;
+        const double s = opts.frameSigma_m(r);
+        const double a = double(pointsInCell[i]) * s * s;  // [m^2] along the ray
+        out[0][i] = a * vx * vx;
+        out[1][i] = a * vx * vy;
+        out[2][i] = a * vx * vz;
+        out[3][i] = a * vy * vy;
+        out[4][i] = a * vy * vz;
+        out[5][i] = a * vz * vz;
+        hasDirection[i] = uint8_t(int(r > 0) & int(r - r == 0));
+    }
+}
+}  // namespace
+
 size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
-                                const DepthModelOptions& opts,
-                                const std::function<Eigen::Vector2i(float x_m, float y_m)>& cellOf,
-                                const std::function<bool(const PointWithCov&)>& failsOwnGate) {
+                                const DepthModelOptions& opts, const CellsAndGate& cellsAndGate) {
     const size_t before = mapPoints.size();
-    mapPoints.erase(std::remove_if(mapPoints.begin(), mapPoints.end(), failsOwnGate),
-                    mapPoints.end());
-    const size_t n = mapPoints.size();
+    std::vector<Eigen::Vector2i> cell(before);
+    std::vector<uint8_t> failsOwnGate(before);
+    cellsAndGate(mapPoints, cell, failsOwnGate);
+    // The points that fail their own gate leave, with their cells.
+    size_t n = 0;
+    for (size_t i = 0; i < before; i++) {
+        if (failsOwnGate[i]) continue;
+        mapPoints[n] = mapPoints[i];
+        cell[n++] = cell[i];
+    }
+    mapPoints.resize(n);
+    cell.resize(n);
     if (n == 0) return before;
     // Counting pass, then the covariance pass: scratch arrays, no allocation per point. The
     // counts live in a dense array over the frame's cells, or a hash map if that is too large.
-    std::vector<Eigen::Vector2i> cell(n);
     Eigen::Vector2i lo = Eigen::Vector2i::Constant(std::numeric_limits<int>::max()), hi = -lo;
     for (size_t i = 0; i < n; i++) {
-        cell[i] = cellOf(mapPoints[i].point_m.x(), mapPoints[i].point_m.y());
         lo = lo.cwiseMin(cell[i]);
         hi = hi.cwiseMax(cell[i]);
     }
@@ -87,21 +118,29 @@ size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d&
         for (size_t i = 0; i < n; i++) sparse[key(cell[i])]++;
         for (size_t i = 0; i < n; i++) perPoint[i] = sparse[key(cell[i])];
     }
-    for (size_t i = 0; i < n; i++) {
-        PointWithCov& p = mapPoints[i];
-        const Eigen::Vector3d ray = p.point_m.cast<double>() - sensor_m;
-        const double r = ray.norm();
-        if (!(r > 0) || !std::isfinite(r)) continue;  // the map counts it as it is
-        const Eigen::Vector3d v = ray / r;
-        const double s = opts.frameSigma_m(r);
-        const double a = double(perPoint[i]) * s * s;  // [m^2] along the ray
-        SymmetricCov3& c = p.cov_m2;
-        c.xx += float(a * v.x() * v.x());
-        c.xy += float(a * v.x() * v.y());
-        c.xz += float(a * v.x() * v.z());
-        c.yy += float(a * v.y() * v.y());
-        c.yz += float(a * v.y() * v.z());
-        c.zz += float(a * v.z() * v.z());
+    // The covariance pass, a block at a time: the terms in arrays (vectorised), then added.
+    constexpr size_t kBlock = 256;
+    alignas(64) double x[kBlock], y[kBlock], z[kBlock], term[6][kBlock];
+    alignas(64) uint8_t hasDirection[kBlock];
+    for (size_t begin = 0; begin < n; begin += kBlock) {
+        const size_t m = std::min(kBlock, n - begin);
+        gatherPositions(mapPoints.data() + begin, m, x, y, z);
+        for (size_t i = 0; i < m; i++) {
+            x[i] -= sensor_m.x();
+            y[i] -= sensor_m.y();
+            z[i] -= sensor_m.z();
+        }
+        frameSharedTerms(opts, x, y, z, perPoint.data() + begin, m, term, hasDirection);
+        for (size_t i = 0; i < m; i++) {
+            if (!hasDirection[i]) continue;  // the map counts it as it is
+            SymmetricCov3& c = mapPoints[begin + i].cov_m2;
+            c.xx += float(term[0][i]);
+            c.xy += float(term[1][i]);
+            c.xz += float(term[2][i]);
+            c.yy += float(term[3][i]);
+            c.yz += float(term[4][i]);
+            c.zz += float(term[5][i]);
+        }
     }
     return before - n;
 }

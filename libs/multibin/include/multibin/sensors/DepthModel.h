@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/sensors/SensorModelOptions.h"
@@ -21,20 +22,24 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
                        const DepthModelOptions& opts, double minRange_m, double maxRange_m,
                        PointsWithCov& out, DepthStats& stats);
 
+/** What addFrameSharedCovariance() needs of the map, for all points at once: each point's cell
+ * (the grid's indices) and whether the grid's eq 13 gate, applied to the point's own variance,
+ * would refuse it (finite, inside the window, too uncertain). */
+using CellsAndGate =
+    std::function<void(const PointsWithCov& mapPoints, std::vector<Eigen::Vector2i>& cells,
+                       std::vector<uint8_t>& failsOwnGate)>;
+
 /** The error the points of one depth frame share (DepthModelOptions::frameSigma_m()), in the map
  * frame: n points of a frame in one cell that share an error of sd s carry the information of
  * variance sigma^2 / n + s^2, not sigma^2 / n. Each point gets n s(r)^2 v v^T added to its
- * covariance, n the number of `mapPoints` in its cell (`cellOf`: its indices; per cell, not
- * per bin: the error is the cell's, and the cell surface fuses adjacent bins of one surface as
- * independent, which gives back sigma^2 / n + s^2 only if each bin carries the cell's n), v its
- * unit ray from `sensor_m` and r its range: for equal sigmas the cell's fused variance is exactly
- * sigma^2 / n + s^2 and its weighted mean is unchanged; across frames the shared errors are
- * independent, so more frames still shrink it. The eq 13 gate is a point's own: the points
- * `failsOwnGate` selects are removed first and their number returned (the caller fuses the rest
- * without the gate). */
+ * covariance, n the number of `mapPoints` in its cell (per cell, not per bin: the error is the
+ * cell's, and the cell surface fuses adjacent bins of one surface as independent, which gives
+ * back sigma^2 / n + s^2 only if each bin carries the cell's n), v its unit ray from `sensor_m`
+ * and r its range: for equal sigmas the cell's fused variance is exactly sigma^2 / n + s^2 and
+ * its weighted mean is unchanged; across frames the shared errors are independent, so more
+ * frames still shrink it. The eq 13 gate is a point's own: the points `cellsAndGate` marks are
+ * removed first and their number returned (the caller fuses the rest without the gate). */
 size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
-                                const DepthModelOptions& opts,
-                                const std::function<Eigen::Vector2i(float x_m, float y_m)>& cellOf,
-                                const std::function<bool(const PointWithCov&)>& failsOwnGate);
+                                const DepthModelOptions& opts, const CellsAndGate& cellsAndGate);
 
 }  // namespace multibin::sensors
