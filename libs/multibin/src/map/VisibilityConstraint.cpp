@@ -227,9 +227,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             uint32_t updatedIndex;
             bool clear;  // no square it passes over can conflict (so far)
         };
-        std::vector<Ray> unsorted;
-        std::vector<std::pair<double, uint32_t>> fan;  // pseudoAngle from the sensor, ray
-        unsorted.reserve(updated.size());
+        std::vector<std::pair<double, uint32_t>> fan;  // pseudoAngle from the sensor, cell
         fan.reserve(updated.size());
         rayState.assign(updated.size(), kWalk);
         double lowestRay_m = sensor_m.z();
@@ -246,12 +244,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                                          std::min(tz, sensor_m.z()) - kSlack_m)) {
                 rayState[i] = kClear;  // the rectangle towards the sensor, as the walk's test
             } else if (std::abs(tz) < kMaxHeight_m) {
-                const double slope = (sensor_m.z() - tz) / length;
-                const double ux = dx / length, uy = dy / length;
-                fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(unsorted.size()));
-                unsorted.push_back({tx, ty, ux, uy, std::abs(ux) + std::abs(uy), length, slope,
-                                    std::abs(slope) * 0.7072 * cell, tz, u.ix, u.iy, uint32_t(i),
-                                    true});
+                fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(i));
                 lowestRay_m = std::min(lowestRay_m, tz);
             }
         }
@@ -293,7 +286,25 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         std::vector<Ray> rays(nRays);
         for (size_t j = 0; j < nRays; j++) {
             keys[j] = fan[j].first;
-            rays[j] = unsorted[fan[j].second];
+            const BinGrid::UpdatedCell& u = updated[fan[j].second];
+            const double tz = u.maxHeight_m;
+            const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
+            const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
+            const double length = std::sqrt(dx * dx + dy * dy);
+            const double slope = (sensor_m.z() - tz) / length, ux = dx / length, uy = dy / length;
+            rays[j] = {tx,
+                       ty,
+                       ux,
+                       uy,
+                       std::abs(ux) + std::abs(uy),
+                       length,
+                       slope,
+                       std::abs(slope) * 0.7072 * cell,
+                       tz,
+                       u.ix,
+                       u.iy,
+                       fan[j].second,
+                       true};
             lengths[j] = rays[j].length;
             fastSlopes[j] = rays[j].slope >= 0 ? rays[j].slope : kNoFastTest;
         }
@@ -394,11 +405,21 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 if (!(units[k] > unitLow_m + minConflictMargin)) continue;
                 const int ix0 = bx * BinGrid::kBlockCells + i * kUnitCells;
                 const int iy0 = by * BinGrid::kBlockCells + j * kUnitCells;
-                for (int iy = iy0; iy < iy0 + kUnitCells; iy++)
-                    for (int ix = ix0; ix < ix0 + kUnitCells; ix++) {
-                        if (ix == r.ix && iy == r.iy) continue;
+                // Its cells likewise, from the unit's first cell.
+                const double cellCross0 =
+                    cross - (0.5 * kUnitCells - 0.5) * (stepX - stepY) / kUnitCells;
+                const double cellAlong0 =
+                    along - (0.5 * kUnitCells - 0.5) * (stepX + stepY) / kUnitCells;
+                const double cellStepX = stepX / kUnitCells, cellStepY = stepY / kUnitCells;
+                const double cellReach = (0.5 * cell + kSlack_m) * r.sumAbsU;
+                for (int cy = 0; cy < kUnitCells; cy++)
+                    for (int cx = 0; cx < kUnitCells; cx++) {
+                        const int ix = ix0 + cx, iy = iy0 + cy;
+                        const double cellCross = cellCross0 + cy * cellStepX - cx * cellStepY;
+                        if (std::abs(cellCross) > cellReach || (ix == r.ix && iy == r.iy)) continue;
+                        const double cellAlong = cellAlong0 + cx * cellStepX + cy * cellStepY;
                         const double cellLow_m =
-                            lowestOver(r, grid.cellCenter_m(ix), grid.cellCenter_m(iy), 0.5 * cell);
+                            lowestBetween(r, cellAlong - cellReach, cellAlong + cellReach);
                         if (boundMayConflict(grid.cellMaxHeight_m(ix, iy), cellLow_m) &&
                             !grid.updatedThisCycle(ix, iy))
                             return true;
@@ -472,9 +493,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 for (const auto& range : ranges)
                     for (size_t j = range[0]; j < range[1]; j++) {
                         // On the line, a sample at distance d from the target lies length - d
-                        // from the sensor.
+                        // from the sensor: none in the block if length < nearStep_m.
                         const double length = lengths[j];
-                        if (length < nearStep_m) continue;  // the block lies beyond the ray
+                        if (length < nearStep_m) continue;
                         if (length >= reachesBeyond_m && fastSlopes[j] <= maxSlope) continue;
                         Ray& r = rays[j];
                         if (!r.clear) continue;  // already to be walked
