@@ -248,35 +248,43 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 lowestRay_m = std::min(lowestRay_m, tz);
             }
         }
-        // The rays in key order, as the blocks below take them. A scan's come in beam order:
-        // keys nearly sorted, up or down, from some angle round to it; rotated and reversed to
-        // that order, insertion sort finishes in about linear time (std::sort otherwise).
-        if (fan.size() > 1) {
-            size_t descents = 0, wrap = 0;  // wrap: after the largest drop
-            double largestDrop = 0;
-            for (size_t j = 1; j < fan.size(); j++) {
-                const double drop = fan[j - 1].first - fan[j].first;
-                descents += drop > 0;
-                if (drop > largestDrop) largestDrop = drop, wrap = j;
-            }
-            if (2 * descents > fan.size()) {  // mostly clockwise
-                std::reverse(fan.begin(), fan.end());
-                largestDrop = 0;
-                wrap = 0;
-                for (size_t j = 1; j < fan.size(); j++)
-                    if (fan[j - 1].first - fan[j].first > largestDrop)
-                        largestDrop = fan[j - 1].first - fan[j].first, wrap = j;
-            }
-            if (largestDrop > 2) std::rotate(fan.begin(), fan.begin() + wrap, fan.end());
+        // The rays in key order, as the blocks below take them. A scan's come in beam order,
+        // keys nearly sorted (up or down) from some angle round to it: reversed and rotated to
+        // that order, insertion sort finishes in about linear time. Otherwise (a frame's rows)
+        // a counting sort on buckets of keys, as many as rays, first.
+        auto insertionSort = [&](size_t maxMoves) {  // false if it gave up
             size_t moves = 0;
-            for (size_t j = 1; j < fan.size() && moves <= 8 * fan.size(); j++) {
-                const auto entry = fan[j];
-                size_t k = j;
+            for (size_t a = 1; a < fan.size(); a++) {
+                const auto entry = fan[a];
+                size_t k = a;
                 for (; k > 0 && entry < fan[k - 1]; k--) fan[k] = fan[k - 1];
                 fan[k] = entry;
-                moves += j - k;
+                if ((moves += a - k) > maxMoves) return false;
             }
-            if (moves > 8 * fan.size()) std::sort(fan.begin(), fan.end());
+            return true;
+        };
+        if (const size_t n = fan.size(); n > 1) {
+            size_t descents = 0;
+            for (size_t j = 1; j < n; j++) descents += fan[j - 1].first > fan[j].first;
+            if (2 * descents > n) std::reverse(fan.begin(), fan.end());  // mostly clockwise
+            size_t wrap = 0;                                             // after the largest drop
+            double largestDrop = 0;
+            for (size_t j = 1; j < n; j++)
+                if (fan[j - 1].first - fan[j].first > largestDrop)
+                    largestDrop = fan[j - 1].first - fan[j].first, wrap = j;
+            if (largestDrop > 2) std::rotate(fan.begin(), fan.begin() + wrap, fan.end());
+            if (!insertionSort(2 * n)) {
+                std::vector<uint32_t> start(n + 1, 0);
+                auto bucketOf = [&](double key) {  // keys lie in [0, 4)
+                    return std::min(size_t(std::max(key, 0.0) * (0.25 * double(n))), n - 1);
+                };
+                for (const auto& entry : fan) start[bucketOf(entry.first) + 1]++;
+                for (size_t b = 1; b <= n; b++) start[b] += start[b - 1];
+                std::vector<std::pair<double, uint32_t>> bucketed(n);
+                for (const auto& entry : fan) bucketed[start[bucketOf(entry.first)]++] = entry;
+                fan.swap(bucketed);
+                if (!insertionSort(8 * n)) std::sort(fan.begin(), fan.end());
+            }
         }
         constexpr double kNoFastTest = std::numeric_limits<double>::infinity();
         // In key order; lengths and slopes apart for the blocks' loop over rays.
