@@ -309,6 +309,109 @@ TEST(Visibility, LocalHeightBoundEditsTheSameBinsAsTheGlobalWalk) {
     EXPECT_LT(visited, visitedReference);
 }
 
+TEST(Visibility, FanTestEditsTheSameBinsAsTheGlobalWalkOverRocks) {
+    // Laser-like fans over rough ground: a sensor 0.15-0.8 m up (sometimes below the ground or
+    // near a window edge), its rays ending on an arc of updated cells, rocks (discs up to 0.3 m)
+    // and stale spikes near the sensor and beside the targets, so that rays pass just above or
+    // just below blocks, units and cells. The library's fan test clears a ray only if no square
+    // it passes over can conflict: every bin must stay bit-identical to the reference walk.
+    std::mt19937 rng(20261124);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    size_t edits = 0, rays = 0;
+    for (int scene = 0; scene < 120; scene++) {
+        const double cell = unit(rng) < 0.7 ? 0.015 : 0.05;
+        const int n = 60 + int(unit(rng) * 80);
+        const int ix0 = int(unit(rng) * 200) - 100, iy0 = int(unit(rng) * 200) - 100;
+        BinGrid g(cell);
+        g.reset(cell, CellWindow{ix0, iy0, n, n});
+        BinUpdateParams p;
+        VisibilityParams v;
+        struct Rock {
+            double x, y, r, h;
+        };
+        std::vector<Rock> rocks;
+        const CellWindow w = g.window();
+        for (int k = int(unit(rng) * 12); k > 0; k--)
+            rocks.push_back({(w.ix0 + unit(rng) * w.nx) * cell, (w.iy0 + unit(rng) * w.ny) * cell,
+                             (2 + unit(rng) * 8) * cell, 0.02 + unit(rng) * 0.28});
+        const double tilt = (unit(rng) - 0.5) * 0.2;
+        auto ground = [&](double x, double y) {
+            double z = tilt * x + 0.004 * std::sin(x * 40) * std::cos(y * 30);
+            for (const Rock& r : rocks)
+                if (std::hypot(x - r.x, y - r.y) < r.r) z = std::max(z, r.h);
+            return z;
+        };
+        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+                if (unit(rng) < 0.1) continue;
+                const double x = g.cellCenter_m(ix), y = g.cellCenter_m(iy);
+                double z = ground(x, y);
+                if (unit(rng) < 0.01) z += 0.03 + unit(rng) * 0.3;  // stale spikes
+                PointsWithCov pts{pointAt(x, y, z, 0.002 + 0.004 * unit(rng))};
+                if (unit(rng) < 0.3) pts.push_back(pointAt(x, y, z + 0.001, 0.003));
+                g.beginCycle();
+                g.insertPoints(pts, p);
+            }
+        // The sensor and its fan: targets on an arc, seen at the ground or lower (objects gone).
+        const double sx = (w.ix0 + (0.1 + 0.8 * unit(rng)) * w.nx) * cell;
+        const double sy = (w.iy0 + (0.1 + 0.8 * unit(rng)) * w.ny) * cell;
+        const double kind = unit(rng);
+        const double sz = kind < 0.1 ? -0.2 : ground(sx, sy) + 0.15 + unit(rng) * 0.65;
+        const double heading = unit(rng) * 2 * M_PI, aperture = 0.5 + unit(rng) * 4.0;
+        const double range = (0.2 + unit(rng) * 0.6) * n * cell;
+        PointsWithCov update;
+        for (int b = 0; b < 200; b++) {
+            const double a = heading - 0.5 * aperture + aperture * b / 199.0;
+            const double r = range * (0.5 + 0.5 * unit(rng));
+            const double x = sx + r * std::cos(a), y = sy + r * std::sin(a);
+            const int ix = g.cellIndex(x), iy = g.cellIndex(y);
+            if (!w.contains(ix, iy)) continue;
+            const double z = ground(g.cellCenter_m(ix), g.cellCenter_m(iy)) -
+                             (unit(rng) < 0.2 ? 0.1 * unit(rng) : 0.0);
+            update.push_back(pointAt(g.cellCenter_m(ix), g.cellCenter_m(iy), z, 0.003));
+        }
+        // Near misses: on some rays, a stale bin in the cell where the ray leaves a block or a
+        // unit towards its target (where it is lowest over that square), within a centimetre
+        // of the conflict height there (the walk's ray height, cell rise and margin).
+        for (const PointWithCov& t : update) {
+            if (unit(rng) < 0.6) continue;
+            const double tx = t.point_m.x(), ty = t.point_m.y(), tz = t.point_m.z();
+            const double dx = sx - tx, dy = sy - ty, length = std::hypot(dx, dy);
+            if (length < 4 * cell) continue;
+            const double slope = (sz - tz) / length;
+            const double square_m = (unit(rng) < 0.5 ? 16 : 4) * cell;
+            // The first crossing of a square's edge going from the target towards the sensor.
+            double d = length;
+            for (const auto& [from, towards] : {std::pair{tx, dx}, std::pair{ty, dy}}) {
+                if (towards == 0) continue;
+                const double edge = towards > 0 ? std::ceil(from / square_m) * square_m
+                                                : std::floor(from / square_m) * square_m;
+                d = std::min(d, (edge - from) / towards * length);
+            }
+            d += 0.25 * cell * unit(rng);  // just inside the square
+            if (d >= length - cell) continue;
+            const double x = tx + dx / length * d, y = ty + dy / length * d;
+            const double conflictAt = tz + slope * d + std::abs(slope) * 0.7072 * cell + 0.026;
+            g.beginCycle();
+            g.insertPoints({pointAt(x, y, conflictAt + (unit(rng) - 0.4) * 0.02, 0.001)}, p);
+        }
+        g.beginCycle();
+        g.insertPoints(update, p);
+        const Eigen::Vector3d sensor(sx, sy, sz);
+        BinGrid reference = g;
+        const VisibilityStats s = applyVisibilityConstraint(g, sensor, v, p);
+        const VisibilityStats r = referenceVisibility(reference, sensor, v, p);
+        ASSERT_EQ(s.raysCast, r.raysCast) << "scene " << scene;
+        ASSERT_EQ(s.binsRemoved, r.binsRemoved) << "scene " << scene;
+        ASSERT_EQ(s.binsWeakened, r.binsWeakened) << "scene " << scene;
+        ASSERT_TRUE(binsOf(g) == binsOf(reference)) << "scene " << scene;
+        edits += r.binsRemoved + r.binsWeakened;
+        rays += r.raysCast;
+    }
+    std::cout << rays << " rays, " << edits << " bins edited\n";
+    EXPECT_GT(edits, 500u) << "the scenes must exercise the constraint";
+}
+
 TEST(Visibility, UpdatedCellBinAboveTheNewMeasurementsLosesCertainty) {
     BinGrid g(0.1);
     g.reset(0.1, CellWindow{-5, -5, 30, 10});

@@ -7,8 +7,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 namespace multibin {
 
@@ -20,6 +24,13 @@ void visitKeys(Params& o, Visit&& visit) {
     visit("visibility_constraint", o.enabled);
     visit({"visibility_margin_m", "visibility_margin"}, o.margin_m, atLeast(0, "m"));
     visit("visibility_certainty_decrement", o.certaintyDecrement, positive());
+}
+
+/** A pseudo-angle of the direction (dx, dy) in [0, 4): increasing with the angle from +x,
+ * counter-clockwise, one division instead of atan2 (not (0, 0)). */
+double pseudoAngle(double dx, double dy) {
+    if (dy >= 0) return dx >= 0 ? dy / (dx + dy) : 1 - dx / (dy - dx);
+    return dx <= 0 ? 2 - dy / (-dx - dy) : 3 + dx / (dx - dy);
 }
 }  // namespace
 
@@ -182,6 +193,332 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
     }
 
+    // The fan of rays at once (every ray starts at the sensor): a ray is proven clear, and not
+    // walked, when nothing it passes over can hold a bin above it by the smallest conflict
+    // margin. Each block high enough to matter is tested against the rays within its angle as
+    // seen from the sensor, at the ray's lowest height over the block's range of distances
+    // from the sensor (the block's geometry computed once for all rays); where a block is too
+    // high for a ray, its units of kUnitCells x kUnitCells cells, then their cells, at the
+    // ray's lowest height over the distances along the ray where it can cross them. So a ray
+    // passing high over rocks near the sensor while its end grazes flat ground needs no walk.
+    // Conservative: every sample of the walk lies, to the slack, in the squares tested, its ray
+    // height is no lower than the one tested (1e-9 m covers the rounding of heights below
+    // 1e4 m), and the bounds only go up.
+    // rayState[i] for updated cell i: kWalk, kClear (its ray edits nothing) or kNoRay (shorter
+    // than a cell); empty: the test did not run.
+    enum : uint8_t { kWalk, kClear, kNoRay };
+    std::vector<uint8_t> rayState;
+    constexpr double kMaxCoordinate_m = 1e5, kMaxHeight_m = 1e4, kHeightSlack_m = 1e-9;
+    const double regionExtent_m = std::max(
+        {std::abs(sensor_m.x()), std::abs(sensor_m.y()), std::abs(double(tableX0)) * block_m,
+         std::abs(double(tableY0)) * block_m, std::abs(double(tableX0) + tableNx) * block_m,
+         std::abs(double(tableY0) + tableNy) * block_m});
+    if (!regionBound.empty() && std::abs(sensor_m.z()) < kMaxHeight_m &&
+        regionExtent_m < kMaxCoordinate_m) {
+        // A bound as the tests below compare it: boundMayConflict(b, z) is limit(b) > z + margin.
+        auto limit_m = [&](float max_m) {
+            return max_m > -std::numeric_limits<float>::infinity()
+                       ? tolerantBound_m(max_m)
+                       : -std::numeric_limits<double>::infinity();
+        };
+        struct Ray {
+            double tx, ty, ux, uy, sumAbsU, length, slope, rise, tz;
+            int ix, iy;
+            uint32_t updatedIndex;
+            bool clear;  // no square it passes over can conflict (so far)
+        };
+        std::vector<std::pair<double, uint32_t>> fan;  // pseudoAngle from the sensor, cell
+        fan.reserve(updated.size());
+        rayState.assign(updated.size(), kWalk);
+        double lowestRay_m = sensor_m.z();
+        for (size_t i = 0; i < updated.size(); i++) {
+            const BinGrid::UpdatedCell& u = updated[i];
+            const double tz = u.maxHeight_m;
+            const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
+            const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
+            const double length = std::sqrt(dx * dx + dy * dy);  // as the walk's
+            if (length < cell) {
+                rayState[i] = kNoRay;
+            } else if (!towardsSensor.empty() &&
+                       !boundMayConflict(restBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
+                                         std::min(tz, sensor_m.z()) - kSlack_m)) {
+                rayState[i] = kClear;  // the rectangle towards the sensor, as the walk's test
+            } else if (std::abs(tz) < kMaxHeight_m) {
+                fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(i));
+                lowestRay_m = std::min(lowestRay_m, tz);
+            }
+        }
+        // The rays in key order, as the blocks below take them. A scan's come in beam order,
+        // keys nearly sorted (up or down) from some angle round to it: reversed and rotated to
+        // that order, insertion sort finishes in about linear time. Otherwise (a frame's rows)
+        // a counting sort on buckets of keys, as many as rays, first.
+        auto insertionSort = [&](size_t maxMoves) {  // false if it gave up
+            size_t moves = 0;
+            for (size_t a = 1; a < fan.size(); a++) {
+                const auto entry = fan[a];
+                size_t k = a;
+                for (; k > 0 && entry < fan[k - 1]; k--) fan[k] = fan[k - 1];
+                fan[k] = entry;
+                if ((moves += a - k) > maxMoves) return false;
+            }
+            return true;
+        };
+        if (const size_t n = fan.size(); n > 1) {
+            size_t descents = 0;
+            for (size_t j = 1; j < n; j++) descents += fan[j - 1].first > fan[j].first;
+            if (2 * descents > n) std::reverse(fan.begin(), fan.end());  // mostly clockwise
+            size_t wrap = 0;                                             // after the largest drop
+            double largestDrop = 0;
+            for (size_t j = 1; j < n; j++)
+                if (fan[j - 1].first - fan[j].first > largestDrop)
+                    largestDrop = fan[j - 1].first - fan[j].first, wrap = j;
+            if (largestDrop > 2) std::rotate(fan.begin(), fan.begin() + wrap, fan.end());
+            if (!insertionSort(2 * n)) {
+                std::vector<uint32_t> start(n + 1, 0);
+                auto bucketOf = [&](double key) {  // keys lie in [0, 4)
+                    return std::min(size_t(std::max(key, 0.0) * (0.25 * double(n))), n - 1);
+                };
+                for (const auto& entry : fan) start[bucketOf(entry.first) + 1]++;
+                for (size_t b = 1; b <= n; b++) start[b] += start[b - 1];
+                std::vector<std::pair<double, uint32_t>> bucketed(n);
+                for (const auto& entry : fan) bucketed[start[bucketOf(entry.first)]++] = entry;
+                fan.swap(bucketed);
+                if (!insertionSort(8 * n)) std::sort(fan.begin(), fan.end());
+            }
+        }
+        constexpr double kNoFastTest = std::numeric_limits<double>::infinity();
+        // In key order; lengths and slopes apart for the blocks' loop over rays.
+        const size_t nRays = fan.size();
+        // fastSlopes: the slope, or +infinity where the fast test below does not apply.
+        std::vector<double> keys(nRays), lengths(nRays), fastSlopes(nRays);
+        std::vector<Ray> rays(nRays);
+        for (size_t j = 0; j < nRays; j++) {
+            keys[j] = fan[j].first;
+            const BinGrid::UpdatedCell& u = updated[fan[j].second];
+            const double tz = u.maxHeight_m;
+            const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
+            const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
+            const double length = std::sqrt(dx * dx + dy * dy);
+            const double slope = (sensor_m.z() - tz) / length, ux = dx / length, uy = dy / length;
+            rays[j] = {tx,
+                       ty,
+                       ux,
+                       uy,
+                       std::abs(ux) + std::abs(uy),
+                       length,
+                       slope,
+                       std::abs(slope) * 0.7072 * cell,
+                       tz,
+                       u.ix,
+                       u.iy,
+                       fan[j].second,
+                       true};
+            lengths[j] = rays[j].length;
+            fastSlopes[j] = rays[j].slope >= 0 ? rays[j].slope : kNoFastTest;
+        }
+        // The ray's lowest height [m] over its samples at distances [from, to] from the target
+        // (clipped to the walk's [step, length)), or NaN if there is none.
+        auto lowestBetween = [&](const Ray& r, double from, double to) {
+            from = std::max(from, step);
+            to = std::min(to, r.length);
+            if (!(from <= to)) return std::numeric_limits<double>::quiet_NaN();
+            return r.tz + std::min(r.slope * from, r.slope * to) + r.rise - kHeightSlack_m;
+        };
+        // The same over a square of centre (cx, cy) and half side h [m], widened by the slack:
+        // where the line crosses it (its support across and along the ray).
+        auto lowestOver = [&](const Ray& r, double cx, double cy, double h) {
+            const double ex = cx - r.tx, ey = cy - r.ty;
+            const double reach = (h + kSlack_m) * r.sumAbsU;
+            if (std::abs(r.ux * ey - r.uy * ex) > reach)
+                return std::numeric_limits<double>::quiet_NaN();
+            const double along = r.ux * ex + r.uy * ey;
+            return lowestBetween(r, along - reach, along + reach);
+        };
+        constexpr int kUnitShift = 2, kUnitCells = 1 << kUnitShift;
+        constexpr int kUnits = BinGrid::kBlockCells / kUnitCells;  // per side of a block
+        // Per block, when first needed: limit_m of each unit's highest cell bound, rounded up
+        // to a float (compared 16 at a time).
+        std::vector<int32_t> unitTableOf;
+        std::vector<float> unitLimits;
+        auto roundUp = [](double v) {  // to within 1e-6 of v, far above float rounding
+            return std::isfinite(v) ? float(v + 1e-6 * std::abs(v)) : float(v);
+        };
+        auto unitsOf = [&](unsigned blockSlot, int bx, int by) {
+            if (unitTableOf.empty()) unitTableOf.assign(regionBound.size(), -1);
+            int32_t& t = unitTableOf[blockSlot];
+            if (t >= 0) return &unitLimits[size_t(t)];
+            t = int32_t(unitLimits.size());
+            float units[kUnits * kUnits];
+            std::fill(units, units + kUnits * kUnits, -std::numeric_limits<float>::infinity());
+            // The block's cells inside the window, a row at a time: its slots are one or two
+            // contiguous runs.
+            const VisibilityIndex& index = grid.visibilityIndex();
+            const int ixLo = std::max(bx * BinGrid::kBlockCells, w.ix0);
+            const int ixHi = std::min((bx + 1) * BinGrid::kBlockCells, w.ix0 + w.nx);
+            const int iyLo = std::max(by * BinGrid::kBlockCells, w.iy0);
+            const int iyHi = std::min((by + 1) * BinGrid::kBlockCells, w.iy0 + w.ny);
+            int sx0 = ixLo - w.ix0 + grid.store().originSlotX();
+            if (sx0 >= w.nx) sx0 -= w.nx;
+            const int firstRun = std::min(ixHi - ixLo, w.nx - sx0);  // cells before the wrap
+            float row[BinGrid::kBlockCells];
+            for (int iy = iyLo; iy < iyHi; iy++) {
+                int sy = iy - w.iy0 + grid.store().originSlotY();
+                if (sy >= w.ny) sy -= w.ny;
+                std::fill(row, row + BinGrid::kBlockCells, -std::numeric_limits<float>::infinity());
+                float* out = row + (ixLo - bx * BinGrid::kBlockCells);
+                const size_t base = size_t(sy) * size_t(w.nx);
+                for (int k = 0; k < firstRun; k++) out[k] = index.cellMaxHeight_m(base + sx0 + k);
+                for (int k = firstRun; k < ixHi - ixLo; k++)
+                    out[k] = index.cellMaxHeight_m(base + (k - firstRun));
+                float* unitRow = units + ((iy - by * BinGrid::kBlockCells) >> kUnitShift) * kUnits;
+                for (int c = 0; c < kUnits; c++)
+                    for (int k = 0; k < kUnitCells; k++)
+                        unitRow[c] = std::max(unitRow[c], row[c * kUnitCells + k]);
+            }
+            for (const float b : units) unitLimits.push_back(roundUp(limit_m(b)));
+            return &unitLimits[size_t(t)];
+        };
+        // Whether the ray may meet a conflicting bin in block (bx, by), over which it passes
+        // no lower than blockLow_m: its units, then their cells (not the target's, nor updated
+        // ones: the walk skips them).
+        auto mayConflictInBlock = [&](const Ray& r, unsigned blockSlot, int bx, int by,
+                                      double blockLow_m) {
+            const float* units = unitsOf(blockSlot, bx, by);
+            // Rounded down, so a unit above the line in doubles is above it in floats.
+            const double line_m = blockLow_m + minConflictMargin;
+            const float lineF = float(line_m - 1e-6 * std::abs(line_m));
+            uint32_t high = 0;  // the units above the ray's lowest height over the block
+#ifdef __SSE2__
+            const __m128 line4 = _mm_set1_ps(lineF);
+            for (int k = 0; k < kUnits * kUnits; k += 4)
+                high |= uint32_t(_mm_movemask_ps(_mm_cmpgt_ps(_mm_loadu_ps(units + k), line4)))
+                        << k;
+#else
+            for (int k = 0; k < kUnits * kUnits; k++) high |= units[k] > lineF ? 1u << k : 0u;
+#endif
+            if (high == 0) return false;
+            // lowestOver for each unit, from the first unit's offsets and a unit's steps.
+            const double unit_m = kUnitCells * cell;
+            const double ex = (bx * BinGrid::kBlockCells + 0.5 * kUnitCells) * cell - r.tx;
+            const double ey = (by * BinGrid::kBlockCells + 0.5 * kUnitCells) * cell - r.ty;
+            const double cross0 = r.ux * ey - r.uy * ex, along0 = r.ux * ex + r.uy * ey;
+            const double stepX = r.ux * unit_m, stepY = r.uy * unit_m;
+            const double reach = (0.5 * unit_m + kSlack_m) * r.sumAbsU;
+            for (; high != 0; high &= high - 1) {
+                const int k = __builtin_ctz(high), i = k % kUnits, j = k / kUnits;
+                const double cross = cross0 + j * stepX - i * stepY;
+                if (std::abs(cross) > reach) continue;
+                const double along = along0 + i * stepX + j * stepY;
+                const double unitLow_m = lowestBetween(r, along - reach, along + reach);
+                if (!(units[k] > unitLow_m + minConflictMargin)) continue;
+                const int ix0 = bx * BinGrid::kBlockCells + i * kUnitCells;
+                const int iy0 = by * BinGrid::kBlockCells + j * kUnitCells;
+                // Its cells likewise, from the unit's first cell.
+                const double cellCross0 =
+                    cross - (0.5 * kUnitCells - 0.5) * (stepX - stepY) / kUnitCells;
+                const double cellAlong0 =
+                    along - (0.5 * kUnitCells - 0.5) * (stepX + stepY) / kUnitCells;
+                const double cellStepX = stepX / kUnitCells, cellStepY = stepY / kUnitCells;
+                const double cellReach = (0.5 * cell + kSlack_m) * r.sumAbsU;
+                for (int cy = 0; cy < kUnitCells; cy++)
+                    for (int cx = 0; cx < kUnitCells; cx++) {
+                        const int ix = ix0 + cx, iy = iy0 + cy;
+                        const double cellCross = cellCross0 + cy * cellStepX - cx * cellStepY;
+                        if (std::abs(cellCross) > cellReach || (ix == r.ix && iy == r.iy)) continue;
+                        const double cellAlong = cellAlong0 + cx * cellStepX + cy * cellStepY;
+                        const double cellLow_m =
+                            lowestBetween(r, cellAlong - cellReach, cellAlong + cellReach);
+                        if (boundMayConflict(grid.cellMaxHeight_m(ix, iy), cellLow_m) &&
+                            !grid.updatedThisCycle(ix, iy))
+                            return true;
+                    }
+            }
+            return false;
+        };
+        // Keys are exact to far better than this for squares at least kNearSensor_m away.
+        constexpr double kKeySlack = 1e-6, kNearSensor_m = 1e-3;
+        const double sx = sensor_m.x(), sy = sensor_m.y(), sz = sensor_m.z();
+        const double inCell_m = 0.7072 * cell;  // rise = |slope| inCell_m
+        for (int by = tableY0; by < tableY0 + int(tableNy) && nRays > 0; by++)
+            for (int bx = tableX0; bx < tableX0 + int(tableNx); bx++) {
+                const unsigned slot = unsigned(bx - tableX0) + unsigned(by - tableY0) * tableNx;
+                const double blockLimit_m = limit_m(regionBound[slot]);
+                if (!(blockLimit_m > lowestRay_m - kHeightSlack_m + minConflictMargin))
+                    continue;  // below every ray
+                const double x0 = bx * block_m - kSlack_m, x1 = (bx + 1) * block_m + kSlack_m;
+                const double y0 = by * block_m - kSlack_m, y1 = (by + 1) * block_m + kSlack_m;
+                // Distances from the sensor to the (widened) block: nearest and farthest.
+                const double gapX = std::max({x0 - sx, sx - x1, 0.0});
+                const double gapY = std::max({y0 - sy, sy - y1, 0.0});
+                const double farX = std::max(std::abs(x0 - sx), std::abs(x1 - sx));
+                const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
+                const double near_m = std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m;
+                const double far_m = std::sqrt(farX * farX + farY * farY) + kSlack_m;
+                // A ray reaching beyond the block (length >= far_m + step) and rising towards
+                // the sensor passes over it no lower than sz - slope far_m + slope inCell_m
+                // (tz + slope length is sz): clear if its slope is at most maxSlope (1e-8 m
+                // spare for the rounding of the quotient and of tz + slope d).
+                const double maxSlope =
+                    (sz - blockLimit_m + minConflictMargin - 1e-8) / (far_m - inCell_m);
+                const double reachesBeyond_m = far_m + step;
+                // No sample of a ray shorter than this lies in the block (1e-9 m spare).
+                const double nearStep_m = near_m + step - 1e-9;
+                const double cx = (bx + 0.5) * block_m, cy = (by + 0.5) * block_m;
+                // The rays within the block's angle: keys in [lo, hi], which may pass key 0 (the
+                // +x direction) on either side; all of them near the sensor.
+                size_t ranges[2][2] = {{0, nRays}, {0, 0}};
+                if (std::max(gapX, gapY) >= kNearSensor_m) {
+                    const bool acrossZero = x1 > sx && y0 <= sy && sy <= y1;
+                    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+                    for (const double x : {x0, x1})
+                        for (const double y : {y0, y1}) {
+                            double k = pseudoAngle(x - sx, y - sy);
+                            if (acrossZero && k < 2) k += 4;
+                            lo = std::min(lo, k);
+                            hi = std::max(hi, k);
+                        }
+                    lo -= kKeySlack;
+                    hi += kKeySlack;
+                    if (hi - lo < 2) {  // less than half a turn, as a square away from the sensor
+                        auto first = [&](double k) {  // the first ray of key >= k
+                            return size_t(std::lower_bound(keys.begin(), keys.end(), k) -
+                                          keys.begin());
+                        };
+                        auto after = [&](double k) {  // the first ray of key > k
+                            return size_t(std::upper_bound(keys.begin(), keys.end(), k) -
+                                          keys.begin());
+                        };
+                        ranges[0][0] = first(lo);
+                        ranges[0][1] = after(hi);
+                        if (lo < 0) {  // and from lo + 4 to the end
+                            ranges[1][0] = first(lo + 4);
+                            ranges[1][1] = nRays;
+                        } else if (hi >= 4) {  // and from the start to hi - 4
+                            ranges[1][1] = after(hi - 4);
+                        }
+                    }
+                }
+                for (const auto& range : ranges)
+                    for (size_t j = range[0]; j < range[1]; j++) {
+                        // On the line, a sample at distance d from the target lies length - d
+                        // from the sensor: none in the block if length < nearStep_m.
+                        const double length = lengths[j];
+                        if (length < nearStep_m) continue;
+                        if (length >= reachesBeyond_m && fastSlopes[j] <= maxSlope) continue;
+                        Ray& r = rays[j];
+                        if (!r.clear) continue;  // already to be walked
+                        // Both bounds hold: the larger one.
+                        const double low_m =
+                            std::max(lowestBetween(r, length - far_m, length - near_m),
+                                     lowestOver(r, cx, cy, 0.5 * block_m));
+                        if (blockLimit_m > low_m + minConflictMargin &&
+                            mayConflictInBlock(r, slot, bx, by, low_m))
+                            r.clear = false;
+                    }
+            }
+        for (const Ray& r : rays) rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
+    }
+
     // The sample distances along a ray, as the walk accumulates them (d += step, not k step,
     // whose rounding differs): the same for every ray, so computed once, as far as a ray needs.
     std::vector<double> sampleAt{0.0, step};
@@ -189,7 +526,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     // conflicting bin, in walking order; samples elsewhere are skipped (see below).
     std::vector<std::pair<double, double>> stretches;
 
-    for (const BinGrid::UpdatedCell& u : updated) {
+    for (size_t i = 0; i < updated.size(); i++) {
+        const BinGrid::UpdatedCell& u = updated[i];
         const double tz = u.maxHeight_m;
         const float decrement = vis.certaintyDecrement * float(u.points);
         // The certainty of the cell's surface (CellSurface) before its own edit (below); needed
@@ -221,6 +559,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
 
         // Walk the line of sight from the updated cell back to the sensor.
+        if (!rayState.empty() && rayState[i] != kWalk) {  // decided by the fan test above
+            stats.raysCast += rayState[i] == kClear;
+            continue;
+        }
         const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
         const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
         const double length = std::sqrt(dx * dx + dy * dy);  // libm hypot is several times slower

@@ -28,7 +28,10 @@ namespace multibin {
  * ends where the rest of the ray passes above every block that near the sensor, a cell is tested
  * only if its block's bound lies above the ray by the smallest conflict margin, and an update
  * whose whole region (the blocks between the sensor and the updated cells) lies below every line
- * of sight costs no walk at all. The bins edited are
+ * of sight costs no walk at all. Before any walk, the fan of rays is tested at once: each block
+ * against the rays within its angle from the sensor, then, where a block is too high for a ray,
+ * its squares of 4 x 4 cells and their cells; a ray that passes above all of them by the
+ * smallest conflict margin is not walked (on rough terrain, most rays). The bins edited are
  * exactly those of a walk to the highest bin stored anywhere; the cost grows with the distinct
  * updated cells, not with the points, and with the relief near the lines of sight. */
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
