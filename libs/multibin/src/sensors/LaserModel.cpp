@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -65,13 +67,20 @@ const std::vector<Eigen::Vector3f>& beamDirections(const mrpt::obs::CObservation
     struct Cache {
         size_t beams = 0;
         float aperture = 0;
-        bool rightToLeft = true, built = false;
+        uint8_t rightToLeft = 0;
+        bool built = false;
         std::vector<Eigen::Vector3f> directions;
     };
     thread_local Cache cache;
     const size_t n = scan.getScanSize();
+    // The scanning direction's byte, not the bool: a corrupt file can hold any byte there, and
+    // loading it as a bool is undefined (MRPT's getScanAngle reads it itself; the same byte gives
+    // the same angles).
+    uint8_t rightToLeft;
+    static_assert(sizeof(scan.rightToLeft) == 1, "a bool of one byte");
+    std::memcpy(&rightToLeft, &scan.rightToLeft, 1);
     if (!cache.built || cache.beams != n || !(cache.aperture == scan.aperture) ||
-        cache.rightToLeft != scan.rightToLeft) {
+        cache.rightToLeft != rightToLeft) {
         cache.directions.resize(n);
         for (size_t i = 0; i < n; i++) {
             const float a = scan.getScanAngle(i);
@@ -79,7 +88,7 @@ const std::vector<Eigen::Vector3f>& beamDirections(const mrpt::obs::CObservation
         }
         cache.beams = n;
         cache.aperture = scan.aperture;
-        cache.rightToLeft = scan.rightToLeft;
+        cache.rightToLeft = rightToLeft;
         cache.built = true;
     }
     return cache.directions;
