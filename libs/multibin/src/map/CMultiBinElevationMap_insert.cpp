@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: observation dispatch, pose PDFs and the insertion core. */
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationRobotPose.h>
+#include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/system/datetime.h>
 #include "CMultiBinElevationMap_impl.h"
 #include "multibin/util/Counters.h"
@@ -221,6 +223,10 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
+    // A camera's frame (stereo pair, depth image): its rays skip the visibility fan test.
+    const bool cameraFrame =
+        dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs) != nullptr ||
+        dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs) != nullptr;
     if (isDualGrid()) recenterRelative(robotPose.mean.x(), robotPose.mean.y());
     const bool grow = !isDualGrid() && growthNeeded(sensorPoints, propagator);
     if (grow || sensed.depthFrameError) {
@@ -261,7 +267,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                        s.tooUncertain += ownGateRejected;
                        return s;
                    },
-                   sensor_m)
+                   sensor_m, cameraFrame)
                    .accepted > 0;
     }
     // The window stays as it is: propagate and fuse block by block (bit-identical result).
@@ -270,7 +276,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
                    return g.insertSensorPoints(propagator, sensorPoints, params, continuityBound_m);
                },
-               sensor_m)
+               sensor_m, cameraFrame)
                .accepted > 0;
 }
 
@@ -349,7 +355,7 @@ multibin::InsertStats CMultiBinElevationMap::insertPoints(
 
 multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     multibin::BinGrid& grid, const FuseIntoGrid& fuse,
-    const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    const std::optional<Eigen::Vector3d>& sensorOrigin_m, bool cameraFrame) {
     const multibin::BinUpdateParams params = binUpdateParams();
     grid.beginCycle();
     grid.setInsertionThreads(insertionOptions.insertion_threads);
@@ -358,7 +364,8 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     m_impl->stats += s;
     if (sensorOrigin_m) {
         const multibin::VisibilityStats v = multibin::applyVisibilityConstraint(
-            grid, *sensorOrigin_m, insertionOptions.visibility, params);
+            grid, *sensorOrigin_m, insertionOptions.visibility, params,
+            cameraFrame ? multibin::RayFan::Skip : multibin::RayFan::Test);
         m_impl->visibilityStats.raysCast += v.raysCast;
         m_impl->visibilityStats.cellsVisited += v.cellsVisited;
         m_impl->visibilityStats.binsRemoved += v.binsRemoved;

@@ -44,9 +44,31 @@ void VisibilityParams::validate() const {
     visitKeys(*this, OptionChecker("CMultiBinElevationMap insertion option"));
 }
 
+namespace {
+/** A ray of the fan test (applyVisibilityConstraint). */
+struct FanRay {
+    double tx, ty, ux, uy, sumAbsU, length, slope, rise, tz;
+    int ix, iy;
+    uint32_t updatedIndex;
+    bool clear;  // no square it passes over can conflict (so far)
+};
+
+/** applyVisibilityConstraint's arrays, kept between calls on each thread: a frame's thousands of
+ * rays would otherwise take fresh pages from the system on every update. */
+struct VisibilityScratch {
+    std::vector<float> regionBound, towardsSensor, unitLimits;
+    std::vector<uint8_t> rayState;
+    std::vector<std::pair<double, uint32_t>> fan, bucketed;
+    std::vector<uint32_t> start;
+    std::vector<double> keys, lengths, fastSlopes;
+    std::vector<FanRay> rays;
+    std::vector<int32_t> unitTableOf;
+};
+}  // namespace
+
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
                                           const VisibilityParams& vis,
-                                          const BinUpdateParams& binParams) {
+                                          const BinUpdateParams& binParams, RayFan fanTest) {
     VisibilityStats stats;
     if (!vis.enabled) return stats;
     const double cell = grid.cellSize_m();
@@ -95,7 +117,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     const std::vector<BinGrid::UpdatedCell>& updated = grid.updatedCells();
     // The region's block bounds copied into a dense table (exact copies; up to 1 MB): the walks
     // below look them up there, without the block table's wrap-around and tags.
-    std::vector<float> regionBound;
+    thread_local VisibilityScratch scratch;
+    std::vector<float>& regionBound = scratch.regionBound;
+    regionBound.clear();
     int tableX0 = 0, tableY0 = 0;
     unsigned tableNx = 0, tableNy = 0;
     auto blockBound = [&](int bx, int by) {
@@ -109,7 +133,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     // 1e-15 m of the sensor, where the ray is at the sensor's height: checked once, below), so
     // a ray, or the rest of its walk, ends where it passes above that bound. Empty when the
     // sensor's block is outside the table or blocks near it are higher than the sensor.
-    std::vector<float> towardsSensor;
+    std::vector<float>& towardsSensor = scratch.towardsSensor;
+    towardsSensor.clear();
     auto restBound = [&](int bx, int by) {
         const unsigned sx = unsigned(bx - tableX0), sy = unsigned(by - tableY0);
         return sx < tableNx && sy < tableNy ? towardsSensor[sx + sy * tableNx]
@@ -207,13 +232,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     // rayState[i] for updated cell i: kWalk, kClear (its ray edits nothing) or kNoRay (shorter
     // than a cell); empty: the test did not run.
     enum : uint8_t { kWalk, kClear, kNoRay };
-    std::vector<uint8_t> rayState;
+    std::vector<uint8_t>& rayState = scratch.rayState;
+    rayState.clear();
     constexpr double kMaxCoordinate_m = 1e5, kMaxHeight_m = 1e4, kHeightSlack_m = 1e-9;
     const double regionExtent_m = std::max(
         {std::abs(sensor_m.x()), std::abs(sensor_m.y()), std::abs(double(tableX0)) * block_m,
          std::abs(double(tableY0)) * block_m, std::abs(double(tableX0) + tableNx) * block_m,
          std::abs(double(tableY0) + tableNy) * block_m});
-    if (!regionBound.empty() && std::abs(sensor_m.z()) < kMaxHeight_m &&
+    if (fanTest == RayFan::Test && !regionBound.empty() && std::abs(sensor_m.z()) < kMaxHeight_m &&
         regionExtent_m < kMaxCoordinate_m) {
         // A bound as the tests below compare it: boundMayConflict(b, z) is limit(b) > z + margin.
         auto limit_m = [&](float max_m) {
@@ -221,13 +247,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                        ? tolerantBound_m(max_m)
                        : -std::numeric_limits<double>::infinity();
         };
-        struct Ray {
-            double tx, ty, ux, uy, sumAbsU, length, slope, rise, tz;
-            int ix, iy;
-            uint32_t updatedIndex;
-            bool clear;  // no square it passes over can conflict (so far)
-        };
-        std::vector<std::pair<double, uint32_t>> fan;  // pseudoAngle from the sensor, cell
+        auto& fan = scratch.fan;  // pseudoAngle from the sensor, cell
+        fan.clear();
         fan.reserve(updated.size());
         rayState.assign(updated.size(), kWalk);
         double lowestRay_m = sensor_m.z();
@@ -274,13 +295,15 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     largestDrop = fan[j - 1].first - fan[j].first, wrap = j;
             if (largestDrop > 2) std::rotate(fan.begin(), fan.begin() + wrap, fan.end());
             if (!insertionSort(2 * n)) {
-                std::vector<uint32_t> start(n + 1, 0);
+                std::vector<uint32_t>& start = scratch.start;
+                start.assign(n + 1, 0);
                 auto bucketOf = [&](double key) {  // keys lie in [0, 4)
                     return std::min(size_t(std::max(key, 0.0) * (0.25 * double(n))), n - 1);
                 };
                 for (const auto& entry : fan) start[bucketOf(entry.first) + 1]++;
                 for (size_t b = 1; b <= n; b++) start[b] += start[b - 1];
-                std::vector<std::pair<double, uint32_t>> bucketed(n);
+                auto& bucketed = scratch.bucketed;
+                bucketed.resize(n);
                 for (const auto& entry : fan) bucketed[start[bucketOf(entry.first)]++] = entry;
                 fan.swap(bucketed);
                 if (!insertionSort(8 * n)) std::sort(fan.begin(), fan.end());
@@ -290,8 +313,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         // In key order; lengths and slopes apart for the blocks' loop over rays.
         const size_t nRays = fan.size();
         // fastSlopes: the slope, or +infinity where the fast test below does not apply.
-        std::vector<double> keys(nRays), lengths(nRays), fastSlopes(nRays);
-        std::vector<Ray> rays(nRays);
+        std::vector<double>& keys = scratch.keys;
+        std::vector<double>& lengths = scratch.lengths;
+        std::vector<double>& fastSlopes = scratch.fastSlopes;
+        keys.assign(nRays, 0.0);
+        lengths.assign(nRays, 0.0);
+        fastSlopes.assign(nRays, 0.0);
+        std::vector<FanRay>& rays = scratch.rays;
+        rays.assign(nRays, FanRay{});
         for (size_t j = 0; j < nRays; j++) {
             keys[j] = fan[j].first;
             const BinGrid::UpdatedCell& u = updated[fan[j].second];
@@ -318,7 +347,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
         // The ray's lowest height [m] over its samples at distances [from, to] from the target
         // (clipped to the walk's [step, length)), or NaN if there is none.
-        auto lowestBetween = [&](const Ray& r, double from, double to) {
+        auto lowestBetween = [&](const FanRay& r, double from, double to) {
             from = std::max(from, step);
             to = std::min(to, r.length);
             if (!(from <= to)) return std::numeric_limits<double>::quiet_NaN();
@@ -326,7 +355,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         };
         // The same over a square of centre (cx, cy) and half side h [m], widened by the slack:
         // where the line crosses it (its support across and along the ray).
-        auto lowestOver = [&](const Ray& r, double cx, double cy, double h) {
+        auto lowestOver = [&](const FanRay& r, double cx, double cy, double h) {
             const double ex = cx - r.tx, ey = cy - r.ty;
             const double reach = (h + kSlack_m) * r.sumAbsU;
             if (std::abs(r.ux * ey - r.uy * ex) > reach)
@@ -338,8 +367,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         constexpr int kUnits = BinGrid::kBlockCells / kUnitCells;  // per side of a block
         // Per block, when first needed: limit_m of each unit's highest cell bound, rounded up
         // to a float (compared 16 at a time).
-        std::vector<int32_t> unitTableOf;
-        std::vector<float> unitLimits;
+        std::vector<int32_t>& unitTableOf = scratch.unitTableOf;
+        std::vector<float>& unitLimits = scratch.unitLimits;
+        unitTableOf.clear();
+        unitLimits.clear();
         auto roundUp = [](double v) {  // to within 1e-6 of v, far above float rounding
             return std::isfinite(v) ? float(v + 1e-6 * std::abs(v)) : float(v);
         };
@@ -381,7 +412,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         // Whether the ray may meet a conflicting bin in block (bx, by), over which it passes
         // no lower than blockLow_m: its units, then their cells (not the target's, nor updated
         // ones: the walk skips them).
-        auto mayConflictInBlock = [&](const Ray& r, unsigned blockSlot, int bx, int by,
+        auto mayConflictInBlock = [&](const FanRay& r, unsigned blockSlot, int bx, int by,
                                       double blockLow_m) {
             const float* units = unitsOf(blockSlot, bx, by);
             // Rounded down, so a unit above the line in doubles is above it in floats.
@@ -505,7 +536,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                         const double length = lengths[j];
                         if (length < nearStep_m) continue;
                         if (length >= reachesBeyond_m && fastSlopes[j] <= maxSlope) continue;
-                        Ray& r = rays[j];
+                        FanRay& r = rays[j];
                         if (!r.clear) continue;  // already to be walked
                         // Both bounds hold: the larger one.
                         const double low_m =
@@ -516,7 +547,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                             r.clear = false;
                     }
             }
-        for (const Ray& r : rays) rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
+        for (const FanRay& r : rays) rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
     }
 
     // The sample distances along a ray, as the walk accumulates them (d += step, not k step,

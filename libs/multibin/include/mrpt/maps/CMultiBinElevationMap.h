@@ -379,9 +379,11 @@ private:
     /** The insertion core of one update cycle: BinGrid::insertPoints or insertSensorPoints. */
     using FuseIntoGrid =
         std::function<multibin::InsertStats(multibin::BinGrid&, const multibin::BinUpdateParams&)>;
-    /** One update cycle of `grid`: insertion core, then the visibility constraint. */
+    /** One update cycle of `grid`: insertion core, then the visibility constraint (with the
+     * fan test for a scan's rays, not for a camera frame's: multibin::RayFan). */
     multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid, const FuseIntoGrid& fuse,
-                                         const std::optional<Eigen::Vector3d>& sensorOrigin_m);
+                                         const std::optional<Eigen::Vector3d>& sensorOrigin_m,
+                                         bool cameraFrame = false);
     /** recenter() on (x, y) relative to mapOrigin() [m]. */
     void recenterRelative(double x_m, double y_m);
     /** mapOrigin() if fixed, else the origin data at (x, y) [m, pose frame] would fix. */

@@ -34,8 +34,15 @@ namespace multibin {
  * smallest conflict margin is not walked (on rough terrain, most rays). The bins edited are
  * exactly those of a walk to the highest bin stored anywhere; the cost grows with the distinct
  * updated cells, not with the points, and with the relief near the lines of sight. */
+/** How the updated cells' lines of sight are tested before any walk: the fan test (a scan's
+ * rays: laser, lidar), or the walk's own tests alone (a camera frame's thousands of rays over
+ * rough ground, where ordering and testing the fan measured slower than the walks it saves).
+ * The bins edited are the same either way. */
+enum class RayFan { Test, Skip };
+
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
                                           const VisibilityParams& visibility,
-                                          const BinUpdateParams& binParams);
+                                          const BinUpdateParams& binParams,
+                                          RayFan fan = RayFan::Test);
 
 }  // namespace multibin
