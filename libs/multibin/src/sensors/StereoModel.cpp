@@ -16,6 +16,7 @@
 
 #include "../util/HelperThread.h"
 #include "RayPoint.h"
+#include "multibin/util/Counters.h"
 #include "multibin/util/VectorClones.h"
 
 namespace multibin::sensors {
@@ -441,6 +442,12 @@ Eigen::Matrix3d StereoCovarianceTable::pointCovariance(int u, int v, double d) c
     return C;
 }
 
+StereoPixelCounts& StereoPixelCounts::operator+=(const StereoPixelCounts& o) {
+    return util::addMembers(*this, o, &StereoPixelCounts::pixels, &StereoPixelCounts::noDisparity,
+                            &StereoPixelCounts::tooNear, &StereoPixelCounts::outOfRange,
+                            &StereoPixelCounts::kept);
+}
+
 StereoPixelCounts StereoCovarianceTable::appendPoints(const DisparityImage& disp, int step,
                                                       double minDepth_m, double minRange_m,
                                                       double maxRange_m, PointsWithCov& out,
@@ -498,12 +505,7 @@ StereoPixelCounts StereoCovarianceTable::appendPoints(const DisparityImage& disp
     helper.wait();
     if (lowerError) std::rethrow_exception(lowerError);
     out.insert(out.end(), lower.begin(), lower.end());
-    counts.pixels += lowerCounts.pixels;
-    counts.kept += lowerCounts.kept;
-    counts.noDisparity += lowerCounts.noDisparity;
-    counts.tooNear += lowerCounts.tooNear;
-    counts.outOfRange += lowerCounts.outOfRange;
-    return counts;
+    return counts += lowerCounts;
 }
 
 void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const StereoModelOptions& opts,

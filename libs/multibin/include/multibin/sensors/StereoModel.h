@@ -67,6 +67,7 @@ struct StereoPixelCounts {
     size_t tooNear = 0;      //!< depth under minDepth_m
     size_t outOfRange = 0;   //!< range outside [minRange_m, maxRange_m]
     size_t kept = 0;         //!< appended as points
+    StereoPixelCounts& operator+=(const StereoPixelCounts& o);
 };
 
 /** Per-pixel table of the calibration part of the pixel covariance, computed once for a
