@@ -54,13 +54,16 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
 }
 
 namespace {
+/** Points per block of the covariance pass. */
+constexpr size_t kBlock = 256;
+
 /** n s(r)^2 v v^T of each of `count` rays (x, y, z from the sensor [m], `pointsInCell` points in
  * their cell): the six entries into `out`, and whether the ray has a direction (0 < r finite).
  * Branch-free, so it vectorises. */
 MULTIBIN_VECTOR_CLONES
 void frameSharedTerms(const DepthModelOptions& opts, const double* xs, const double* ys,
                       const double* zs, const uint32_t* pointsInCell, size_t count,
-                      double (*out)[256], uint8_t* hasDirection) {
+                      double (*out)[kBlock], uint8_t* hasDirection) {
     for (size_t i = 0; i < count; i++) {
         const double x = xs[i], y = ys[i], z = zs[i];
         const double r = std::sqrt(x * x + y * y + z * z);
@@ -119,7 +122,6 @@ size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d&
         for (size_t i = 0; i < n; i++) perPoint[i] = sparse[key(cell[i])];
     }
     // The covariance pass, a block at a time: the terms in arrays (vectorised), then added.
-    constexpr size_t kBlock = 256;
     alignas(64) double x[kBlock], y[kBlock], z[kBlock], term[6][kBlock];
     alignas(64) uint8_t hasDirection[kBlock];
     for (size_t begin = 0; begin < n; begin += kBlock) {

@@ -91,7 +91,6 @@ public:
      * 16 blocks of 256) is propagated and classified on a helper thread while this thread
      * updates the bins in point order: the same bins bit for bit, on two cores. 1 by default. */
     void setInsertionThreads(int threads) { m_insertionThreads = threads; }
-    int insertionThreads() const { return m_insertionThreads; }
 
     /** Fuses one height measurement into cell (ix, iy), which must be inside the window.
      * Returns false if a gate refused it (counted in `stats`). */
