@@ -1,8 +1,6 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: observation dispatch, pose PDFs and the insertion core. */
-#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationRobotPose.h>
-#include <mrpt/obs/CObservationStereoImages.h>
 #include <mrpt/system/datetime.h>
 #include "CMultiBinElevationMap_impl.h"
 #include "multibin/util/Counters.h"
@@ -223,10 +221,6 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
 
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
-    // A camera's frame (stereo pair, depth image): its rays skip the visibility fan test.
-    const bool cameraFrame =
-        dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs) != nullptr ||
-        dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs) != nullptr;
     if (isDualGrid()) recenterRelative(robotPose.mean.x(), robotPose.mean.y());
     const bool grow = !isDualGrid() && growthNeeded(sensorPoints, propagator);
     if (grow || sensed.depthFrameError) {
@@ -267,7 +261,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                        s.tooUncertain += ownGateRejected;
                        return s;
                    },
-                   sensor_m, cameraFrame)
+                   sensor_m, sensed.cameraFrame)
                    .accepted > 0;
     }
     // The window stays as it is: propagate and fuse block by block (bit-identical result).
@@ -276,7 +270,7 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
                    return g.insertSensorPoints(propagator, sensorPoints, params, continuityBound_m);
                },
-               sensor_m, cameraFrame)
+               sensor_m, sensed.cameraFrame)
                .accepted > 0;
 }
 

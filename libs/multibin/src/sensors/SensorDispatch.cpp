@@ -50,6 +50,7 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
     out.continuityBound_m = std::numeric_limits<double>::infinity();
     out.stats = {};
     out.depthFrameError = false;
+    out.cameraFrame = false;
     if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
         out.sensorPose = scan->sensorPose;
         if (chooseModel(obs, opts, K::laser, {K::laser, K::lidar}) == K::lidar) {
@@ -74,6 +75,7 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
     }
     if (const auto* stereo = dynamic_cast<const mrpt::obs::CObservationStereoImages*>(&obs)) {
         chooseModel(obs, opts, K::stereo, {K::stereo});
+        out.cameraFrame = true;
         stereoToPoints(*stereo, opts.stereo, minRange_m, maxRange_m,
                        state.stereoTables[stereo->sensorLabel], out.points, out.stats.stereo,
                        threads);
@@ -91,6 +93,7 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
     if (const auto* depth = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs)) {
         // One frame of one camera. A point cloud may merge frames or sensors: no term.
         out.depthFrameError = opts.depth.sharesFrameError();
+        out.cameraFrame = true;
         return onlyModel(*depth, K::depth, depthScanToPoints, opts.depth, out.stats.depth);
     }
     if (const auto* cloud = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(&obs)) {

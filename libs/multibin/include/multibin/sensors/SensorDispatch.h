@@ -51,6 +51,9 @@ struct SensorPoints {
      * (DepthModelOptions::sharesFrameError()): the map adds it per cell
      * (addFrameSharedCovariance()). Point clouds, which may merge frames, get none. */
     bool depthFrameError = false;
+    /** One camera frame (a stereo pair, a depth image): thousands of rays fanning over a
+     * rectangle, not a scan's fan (the visibility constraint tests them differently). */
+    bool cameraFrame = false;
     /** What the model did with this observation's readings (only its own kind is non-zero). */
     SensorModelStats stats;
 };
