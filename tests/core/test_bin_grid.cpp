@@ -498,10 +498,11 @@ TEST(BinGrid, FusedSensorInsertionIsBitIdenticalToTwoSteps) {
         fusedPipelined.setInsertionThreads(2);
         BinUpdateParams p;
         PointsWithCov mapPoints;
-        propagator.apply(sensorPoints, mapPoints);
-        const InsertStats a = twoSteps.insertPoints(mapPoints, p, bound);
+        PoseVariances pose;  // the pose's part, which the fused path keeps per bin (Bin.h)
+        propagator.apply(sensorPoints, mapPoints, &pose);
+        const InsertStats a = twoSteps.insertPoints(mapPoints, p, bound, &pose);
         const InsertStats b = fused.insertSensorPoints(propagator, sensorPoints, p, bound);
-        const InsertStats c = twoStepsPipelined.insertPoints(mapPoints, p, bound);
+        const InsertStats c = twoStepsPipelined.insertPoints(mapPoints, p, bound, &pose);
         const InsertStats d = fusedPipelined.insertSensorPoints(propagator, sensorPoints, p, bound);
         EXPECT_GT(a.accepted, 15000u);
         for (const InsertStats* s : {&b, &c, &d}) expectSameStats(a, *s);
@@ -577,9 +578,10 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
             stereo += sensed.points.size() > 2000;
             const PosePropagator propagator(pdf, sensed.sensorPose);
             PointsWithCov mapPoints;
-            propagator.apply(sensed.points, mapPoints);
+            PoseVariances pose;
+            propagator.apply(sensed.points, mapPoints, &pose);
             twoSteps->insertPoints(mapPoints, sensed.continuityBound_m,
-                                   propagator.sensorOriginInMap_m());
+                                   propagator.sensorOriginInMap_m(), &pose);
             // Growing map: every point that may grow the map (within max_size_m / 2 of the
             // sensor, passing the eq 13 gate) lies inside its window afterwards, i.e. the fused
             // path was never taken when the window had to grow.

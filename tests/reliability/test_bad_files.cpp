@@ -188,7 +188,7 @@ TEST(BadInputFiles, SerializedMapOfAnUnknownVersionIsRejected) {
     const auto at = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
     ASSERT_NE(at, bytes.end());
     const size_t versionByte = size_t(at - bytes.begin()) + name.size();
-    ASSERT_EQ(bytes[versionByte], 3u);  // version 3 today (payload checksum, plane moments)
+    ASSERT_EQ(bytes[versionByte], 4u);  // version 4 today (checksum, plane moments, pose codes)
     bytes[versionByte] = 7;
     expectRejected(bytes, "version");
 }

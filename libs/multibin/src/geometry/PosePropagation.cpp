@@ -66,6 +66,10 @@ void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const Point
                     q7 = q[7], q8 = q[8], q9 = q[9];
         const float s0 = s[0], s1 = s[1], s2 = s[2], s3 = s[3], s4 = s[4], s5 = s[5];
         float* __restrict o = out.v[3 + e];
+        // The pose's part of the entries xx and yy (their mean) and zz, kept apart too.
+        float* __restrict pose = e == 5 ? out.poseVariance_m2[0] : out.poseVariance_m2[1];
+        const bool keepPose = e == 0 || e == 3 || e == 5;
+        const float poseShare = e == 5 ? 1.f : 0.5f;
         for (size_t i = 0; i < n; i++) {
             const float robot = q0 + q1 * x[i] + q2 * y[i] + q3 * z[i] + q4 * mono[0][i] +
                                 q5 * mono[1][i] + q6 * mono[2][i] + q7 * mono[3][i] +
@@ -73,6 +77,7 @@ void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const Point
             const float sensor =
                 s0 * c0[i] + s1 * c1[i] + s2 * c2[i] + s3 * c3[i] + s4 * c4[i] + s5 * c5[i];
             o[i] = robot + sensor;
+            if (keepPose) pose[i] = (e == 3 ? pose[i] : 0.f) + poseShare * robot;  // yy: + xx/2
         }
     }
 }
@@ -173,9 +178,9 @@ PointWithCov PosePropagator::apply(const PointWithCov& in) const {
     return out;
 }
 
-void PosePropagator::apply(const PointsWithCov& in, PointsWithCov& out) const {
+void PosePropagator::apply(const PointsWithCov& in, PointsWithCov& out, PoseVariances* pose) const {
     out.resize(in.size());
-    apply(in.data(), out.data(), in.size());
+    apply(in.data(), out.data(), in.size(), pose);
 }
 
 void PointBlock::gather(const PointWithCov* in, size_t n) {
@@ -198,12 +203,21 @@ void PosePropagator::applyBlock(const PointWithCov* in, size_t n, PointBlock& ou
     propagateBlock(m_k, n, src, out);
 }
 
-void PosePropagator::apply(const PointWithCov* in, PointWithCov* out, size_t n) const {
+void PosePropagator::apply(const PointWithCov* in, PointWithCov* out, size_t n,
+                           PoseVariances* pose) const {
+    if (pose) {
+        pose->height_m2.resize(n);
+        pose->horizontal_m2.resize(n);
+    }
     PointBlock dst;
     for (size_t begin = 0; begin < n; begin += kBlock) {
         const size_t m = std::min(kBlock, n - begin);
         applyBlock(in + begin, m, dst);  // reads in[begin ..) before out[begin ..) is written
         scatter(dst, m, out + begin);
+        if (pose) {
+            std::copy_n(dst.poseVariance_m2[0], m, pose->height_m2.data() + begin);
+            std::copy_n(dst.poseVariance_m2[1], m, pose->horizontal_m2.data() + begin);
+        }
     }
 }
 

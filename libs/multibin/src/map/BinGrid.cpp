@@ -59,6 +59,10 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
     } else {
         fuse(bin.height_m, bin.variance_m2, other.height_m, other.variance_m2);
         mergePlaneMoments(bin.plane, other.plane);
+        bin.poseHeightSigmaCode =
+            leastPoseSigmaCode(bin.poseHeightSigmaCode, other.poseHeightSigmaCode);
+        bin.poseHorizontalSigmaCode =
+            leastPoseSigmaCode(bin.poseHorizontalSigmaCode, other.poseHorizontalSigmaCode);
         bin.certainty += other.certainty;
         util::addSaturating(bin.pointCount, other.pointCount);
     }
@@ -90,12 +94,14 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
         return false;
     }
     return fuseMeasurement(slot(ix, iy), ix, iy, n, height_m, variance_m2, params,
-                           continuityBound_m, stats, std::nanf(""), std::nanf(""));
+                           continuityBound_m, stats, std::nanf(""), std::nanf(""), std::nanf(""),
+                           std::nanf(""));
 }
 
 bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height_m,
                               double variance_m2, const BinUpdateParams& params,
-                              double continuityBound_m, InsertStats& stats, float x_m, float y_m) {
+                              double continuityBound_m, InsertStats& stats, float x_m, float y_m,
+                              float poseHeightVariance_m2, float poseHorizontalVariance_m2) {
     Bin& bin = BinStore::bin(findOrAddBin(s, n));
     if (!passesEq14(bin, height_m, continuityBound_m)) {
         stats.continuityRejected++;
@@ -105,6 +111,7 @@ bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height
     if (!std::isnan(x_m))  // a height without a place (insertHeight) says nothing of the slope
         addPlanePoint(bin.plane, float(x_m - cellCenter_m(ix)), float(y_m - cellCenter_m(iy)),
                       float(height_m), float(1.0 / variance_m2));
+    notePoseVariance(bin, poseHeightVariance_m2, poseHorizontalVariance_m2);
     stats.accepted++;
     m_index.noteUpdate(s, ix, iy, height_m, 1);
     return true;
@@ -250,16 +257,25 @@ void waitUntil(Ready&& ready) {
 }  // namespace
 
 InsertStats BinGrid::insertPoints(const PointsWithCov& mapPoints, const BinUpdateParams& params,
-                                  double continuityBound_m) {
-    return insertPoints(mapPoints.data(), mapPoints.size(), params, continuityBound_m);
+                                  double continuityBound_m, const PoseVariances* pose) {
+    return insertPoints(mapPoints.data(), mapPoints.size(), params, continuityBound_m, pose);
 }
 
 InsertStats BinGrid::insertPoints(const PointWithCov* mapPoints, size_t count,
-                                  const BinUpdateParams& params, double continuityBound_m) {
+                                  const BinUpdateParams& params, double continuityBound_m,
+                                  const PoseVariances* pose) {
+    if (pose && (pose->height_m2.size() < count || pose->horizontal_m2.size() < count))
+        throw std::invalid_argument("BinGrid::insertPoints: fewer pose variances than points");
     return insertBlocks(
         count,
-        [mapPoints](size_t begin, size_t m, PointBlock& block) {
+        [mapPoints, pose](size_t begin, size_t m, PointBlock& block) {
             block.gather(mapPoints + begin, m);
+            if (pose) {
+                std::copy_n(pose->height_m2.data() + begin, m, block.poseVariance_m2[0]);
+                std::copy_n(pose->horizontal_m2.data() + begin, m, block.poseVariance_m2[1]);
+            } else {
+                for (float* v : block.poseVariance_m2) std::fill_n(v, m, std::nanf(""));
+            }
         },
         params, continuityBound_m);
 }
@@ -371,6 +387,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         PlaneMoments plane;
         double cellX_m = 0, cellY_m = 0;  // the cell's centre [m]
         double maxHeight_m = 0;
+        float poseHeightVariance_m2 = 0, poseHorizontalVariance_m2 = 0;  // least of the run's
         bool frozen = false;  // the bin has zero variance: its height cannot move
     } run;
     auto closeRun = [&]() {
@@ -382,6 +399,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         }
         bin.plane = run.plane;
         addCertainty(bin.certainty, params.certaintyIncrement, run.points);
+        notePoseVariance(bin, run.poseHeightVariance_m2, run.poseHorizontalVariance_m2);
         util::addSaturating(bin.pointCount, run.points);
         m_index.noteUpdate(run.slot, run.ix, run.iy, run.maxHeight_m, run.points);
         run.bin = kNoBin;
@@ -413,10 +431,12 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
             const double weight = cb.weight[i];
             const size_t s = size_t(cb.slot[i]);
             const int16_t n = static_cast<int16_t>(cb.bin[i]);
+            const float poseHeight_m2 = pts.poseVariance_m2[0][i];
+            const float poseHorizontal_m2 = pts.poseVariance_m2[1][i];
             if (perPoint) {
                 fuseMeasurement(s, cb.ix[i], cb.iy[i], n, h,
                                 std::max<double>(pts.v[8][i], kMinFusedVariance_m2), params,
-                                continuityBound_m, stats, x, y);
+                                continuityBound_m, stats, x, y, poseHeight_m2, poseHorizontal_m2);
                 continue;
             }
             if (run.bin == kNoBin || run.slot != s || run.n != n) {
@@ -428,6 +448,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
                 run.iy = cb.iy[i];
                 run.points = 0;
                 run.maxHeight_m = h;
+                run.poseHeightVariance_m2 = poseHeight_m2;
+                run.poseHorizontalVariance_m2 = poseHorizontal_m2;
                 const Bin& bin = BinStore::bin(run.bin);
                 run.plane = bin.plane;
                 run.cellX_m = cellCenter_m(run.ix);
@@ -440,6 +462,10 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
             addPlanePoint(run.plane, float(x - run.cellX_m), float(y - run.cellY_m), float(h),
                           float(weight));
             run.maxHeight_m = std::max(run.maxHeight_m, h);
+            // NaN (not known) stays NaN: a map-frame block is all NaN.
+            run.poseHeightVariance_m2 = std::min(run.poseHeightVariance_m2, poseHeight_m2);
+            run.poseHorizontalVariance_m2 =
+                std::min(run.poseHorizontalVariance_m2, poseHorizontal_m2);
             run.points++;
             stats.accepted++;
         }

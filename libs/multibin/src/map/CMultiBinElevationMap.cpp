@@ -445,7 +445,7 @@ bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
 }
 
 bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, double& height_m,
-                                         double& sigma_m) const {
+                                         double& sigma_m, bool sharedPosePart) const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     const Eigen::Vector2d& o = m_impl->origin_m;
     const auto estimate = subCell ? multibin::heightAt : multibin::surfaceAt;
@@ -454,7 +454,7 @@ bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, d
                   binUpdateParams(), insertionOptions.relief_sigma, c))
         return false;
     height_m = c.height_m;
-    sigma_m = std::sqrt(c.variance_m2);
+    sigma_m = std::sqrt(sharedPosePart ? c.reportedVariance_m2() : c.variance_m2);
     return true;
 }
 

@@ -21,8 +21,10 @@ void CMultiBinElevationMap::dem_update_map() {
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             double h, s;
-            if (cellHeight(o.x() + m_impl->grid.cellCenter_m(w.ix0 + c),
-                           o.y() + m_impl->grid.cellCenter_m(w.iy0 + r), h, s))
+            // Without the pose part the cells share (CellSurface::poseVariance_m2): it moves a
+            // gap's neighbours together, so it does not weigh one against another.
+            if (surfaceQuery(false, o.x() + m_impl->grid.cellCenter_m(w.ix0 + c),
+                             o.y() + m_impl->grid.cellCenter_m(w.iy0 + r), h, s, false))
                 raster.setMeasured(c, r, float(h), float(s));
         }
     m_impl->fill = multibin::fill::fillGaps(raster, insertionOptions.fill);

@@ -227,7 +227,8 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
         // Growth is sized by all map-frame points, and a depth frame's shared error is counted
         // per map cell: propagate them first.
         PointsWithCov mapPoints;
-        propagator.apply(sensorPoints, mapPoints);
+        multibin::PoseVariances pose;
+        propagator.apply(sensorPoints, mapPoints, &pose);
         if (grow) growToCover(mapPoints, sensor_m);
         multibin::BinGrid& grid = gridFor(obs);
         size_t ownGateRejected = 0;
@@ -252,12 +253,12 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                    grid,
                    [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
                        if (!sensed.depthFrameError)
-                           return g.insertPoints(mapPoints, params, continuityBound_m);
+                           return g.insertPoints(mapPoints, params, continuityBound_m, &pose);
                        // Eq 13 was applied to each point's own variance above.
                        multibin::BinUpdateParams shared = params;
                        shared.maxElevationUncertainty_m = std::numeric_limits<double>::infinity();
                        multibin::InsertStats s =
-                           g.insertPoints(mapPoints, shared, continuityBound_m);
+                           g.insertPoints(mapPoints, shared, continuityBound_m, &pose);
                        s.tooUncertain += ownGateRejected;
                        return s;
                    },
@@ -335,14 +336,14 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
 
 multibin::InsertStats CMultiBinElevationMap::insertPoints(
     const PointsWithCov& mapPoints, double continuityBound_m,
-    const std::optional<Eigen::Vector3d>& sensorOrigin_m) {
+    const std::optional<Eigen::Vector3d>& sensorOrigin_m, const multibin::PoseVariances* pose) {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
     m_impl->originFixed = true;  // the points are relative to it
     return insertIntoGrid(
         isDualGrid() ? m_impl->local : m_impl->grid,
         [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
-            return g.insertPoints(mapPoints, params, continuityBound_m);
+            return g.insertPoints(mapPoints, params, continuityBound_m, pose);
         },
         sensorOrigin_m);
 }

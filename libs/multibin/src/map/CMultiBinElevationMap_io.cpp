@@ -36,7 +36,8 @@ void forEachMoment(Moments& m, Visit&& visit) {
         visit(*v);
 }
 
-/** A grid: its window, then each non-empty cell with its bins (each with its plane moments). */
+/** A grid: its window, then each non-empty cell with its bins (each with its plane moments and
+ * its pose sigma codes). */
 void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid) {
     const multibin::CellWindow& w = grid.window();
     out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
@@ -57,6 +58,7 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
             grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
                 out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
                 forEachMoment(b.plane, [&](const float& v) { out << v; });
+                out << b.poseHeightSigmaCode << b.poseHorizontalSigmaCode;
             });
         }
 }
@@ -67,9 +69,10 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
 
 /** Reads a grid whose window may have at most maxSideCells cells per side (the stored options'
  * own limit), checked before anything is allocated; its bins carry plane moments if
- * `withPlane` (version 3; before, a loaded bin has none). */
+ * `withPlane` (version 3; before, a loaded bin has none) and pose sigma codes if `withPose`
+ * (version 4; before, not known). */
 void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double cellSize_m,
-              double maxSideCells, bool withPlane) {
+              double maxSideCells, bool withPlane, bool withPose) {
     int32_t ix0, iy0, nx, ny;
     in >> ix0 >> iy0 >> nx >> ny;
     if (nx < 0 || ny < 0 || double(nx) > maxSideCells || double(ny) > maxSideCells)
@@ -103,6 +106,7 @@ void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double
                 if (!finite || !(m.weight >= 0) || !(m.sxx >= 0) || !(m.syy >= 0) || !(m.szz >= 0))
                     corrupt("invalid plane moments");
             }
+            if (withPose) in >> b.poseHeightSigmaCode >> b.poseHorizontalSigmaCode;
             grid.appendBin(ix, iy, b);
         }
     }
@@ -118,9 +122,9 @@ struct StoredMap {
 };
 
 /** The body: options text, grid(s), and (from version 1) the bin count and tag; from version 3
- * each bin carries its plane moments. */
+ * each bin carries its plane moments, from version 4 its pose sigma codes. */
 StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
-    const bool withPlane = version >= 3;
+    const bool withPlane = version >= 3, withPose = version >= 4;
     StoredMap m;
     // Same layout as MRPT's string (uint32 length, bytes), read with a bound first.
     uint32_t textBytes = 0;
@@ -141,11 +145,11 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
     const double singleSide_m = std::max({c.max_size_m, c.max_x - c.min_x, c.max_y - c.min_y});
     if (c.dual_grid) {
         readGrid(in, grid, c.global_resolution_m, c.global_size_m / c.global_resolution_m + 2,
-                 withPlane);
+                 withPlane, withPose);
         readGrid(in, local, c.local_resolution_m, c.local_size_m / c.local_resolution_m + 2,
-                 withPlane);
+                 withPlane, withPose);
     } else {
-        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2, withPlane);
+        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2, withPlane, withPose);
     }
     if (version >= 1) {
         uint32_t tag = 0;
@@ -160,12 +164,13 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
 }
 }  // namespace
 
-uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 3; }
+uint8_t CMultiBinElevationMap::serializeGetVersion() const { return 4; }
 
 namespace {
-/** Versions 2 and 3 wrap the body (the payload) as: uint64 payload bytes, the payload, the CRC-32
+/** Versions 2 to 4 wrap the body (the payload) as: uint64 payload bytes, the payload, the CRC-32
  * of the payload. A flipped bit anywhere in it is an error before anything is parsed. Version 3's
- * body is version 1's with each bin's plane moments after its estimate. */
+ * body is version 1's with each bin's plane moments after its estimate; version 4's adds the
+ * bin's two pose sigma codes (Bin.h) after the moments. */
 constexpr size_t kPayloadChunkBytes = size_t(1) << 20;
 }  // namespace
 
@@ -218,7 +223,8 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
             apply(readBody(in, version));
             break;
         case 2:
-        case 3: {
+        case 3:
+        case 4: {
             uint64_t n = 0;
             in >> n;
             // Read in chunks: the buffer grows only as bytes arrive, whatever length is claimed.

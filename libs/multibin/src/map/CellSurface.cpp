@@ -16,6 +16,7 @@ bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, 
     const double floor_m2 = p.varianceFloor_m2;
     HeightInformation surface;
     surface.add(win->height_m, std::max<double>(win->variance_m2, floor_m2));
+    uint8_t poseHeightCode = win->poseHeightSigmaCode;
     out.certainty = win->certainty;
     out.firstBin = out.lastBin = win->index;
     for (const int dir : {-1, 1}) {
@@ -30,11 +31,13 @@ bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, 
             if ((next->height_m - h) * (next->height_m - h) > 9.0 * (v + vNow)) break;
             surface.add(next->height_m, v);
             out.certainty += next->certainty;
+            poseHeightCode = leastPoseSigmaCode(poseHeightCode, next->poseHeightSigmaCode);
             (dir < 0 ? out.firstBin : out.lastBin) = n;
         }
     }
     out.height_m = surface.height_m();
     out.variance_m2 = std::max(surface.variance_m2(), floor_m2);
+    out.poseVariance_m2 = poseVariance_m2(poseHeightCode);
     return true;
 }
 
@@ -72,6 +75,8 @@ bool combineGrids(bool haveG, const CellSurface& g, bool haveL, const CellSurfac
         out.height_m = both.height_m();
         out.variance_m2 = both.variance_m2();
         out.certainty = g.certainty + l.certainty;
+        // Both grids' points were seen from the same poses: their shared part stays.
+        out.poseVariance_m2 = std::min(g.poseVariance_m2, l.poseVariance_m2);
     } else {
         out = l.certainty >= g.certainty ? l : g;
     }
@@ -83,6 +88,7 @@ struct CellPlane {
     CellSurface surface;
     PlaneMoments moments;
     double points = 0;
+    uint8_t poseHorizontalSigmaCode = 0;  //!< least over its bins (BinUpdate.h)
 };
 
 /** The most surfaces of one cell heightAt tells apart. */
@@ -93,17 +99,23 @@ void planeOfBins(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, 
     HeightInformation h;
     out.moments = PlaneMoments{};
     out.points = 0;
+    out.poseHorizontalSigmaCode = 0;
+    uint8_t poseHeightCode = 0;
     out.surface.certainty = 0;
     grid.forEachBin(ix, iy, [&](const Bin& b) {
         if (b.certainty <= 0 || b.index < out.surface.firstBin || b.index > out.surface.lastBin)
             return;
         h.add(b.height_m, std::max<double>(b.variance_m2, p.varianceFloor_m2));
         out.surface.certainty += b.certainty;
+        poseHeightCode = leastPoseSigmaCode(poseHeightCode, b.poseHeightSigmaCode);
+        out.poseHorizontalSigmaCode =
+            leastPoseSigmaCode(out.poseHorizontalSigmaCode, b.poseHorizontalSigmaCode);
         mergePlaneMoments(out.moments, b.plane);
         out.points += b.pointCount;
     });
     out.surface.height_m = h.height_m();
     out.surface.variance_m2 = std::max(h.variance_m2(), p.varianceFloor_m2);
+    out.surface.poseVariance_m2 = poseVariance_m2(poseHeightCode);
 }
 
 /** The surfaces of a cell, most certain first: runs of certain bins with contiguous indices
@@ -259,6 +271,11 @@ bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateP
         window.weight > 0 ? (g.chi2 - 1) * windowPoints / double(window.weight) : 0.0;
     out.variance_m2 =
         std::max(hVar, m.weight > 0 ? g.chi2 / m.weight : 0.0) + relief_m2 + g.variance(ex, ey);
+    // A pose error moves the surface sideways too, shared by the points like its height part: on
+    // a slope g the height at a fixed place changes by g . (horizontal shift).
+    out.poseVariance_m2 =
+        own.surface.poseVariance_m2 +
+        poseVariance_m2(own.poseHorizontalSigmaCode) * (g.gx * g.gx + g.gy * g.gy);
     if (reliefSigma) addOtherBinsSpread(grid, ix, iy, out);
     return true;
 }

@@ -30,6 +30,7 @@
 namespace multibin {
 class BinGrid;
 class PosePropagator;
+struct PoseVariances;
 struct EsriAsciiGrid;
 namespace fill {
 struct FillResult;
@@ -221,11 +222,14 @@ public:
      * for sensors the map does not model): one update cycle. The points and the sensor origin are
      * relative to mapOrigin() (single precision; the first call fixes an automatic origin where
      * it is). `continuityBound_m` is eq 14's Delta_zmax. With a sensor origin the visibility
-     * constraint follows. The grid does not grow here (see insertObservation). */
+     * constraint follows. The grid does not grow here (see insertObservation). `pose`: the
+     * pose's part of each point's variances (PosePropagator::apply's), which the reported sigma
+     * keeps (CellSurface.h); without it none is known. */
     multibin::InsertStats insertPoints(
         const multibin::PointsWithCov& mapPoints,
         double continuityBound_m = std::numeric_limits<double>::infinity(),
-        const std::optional<Eigen::Vector3d>& sensorOrigin_m = std::nullopt);
+        const std::optional<Eigen::Vector3d>& sensorOrigin_m = std::nullopt,
+        const multibin::PoseVariances* pose = nullptr);
 
     /** @name Queries @{ */
     const multibin::BinGrid& grid() const;
@@ -357,9 +361,11 @@ private:
     bool internal_canComputeObservationLikelihood(
         const mrpt::obs::CObservation& obs) const override;
 
-    /** heightAt() (subCell) or cellHeight(): the map's surface at (x, y) in the pose frame. */
-    bool surfaceQuery(bool subCell, double x_m, double y_m, double& height_m,
-                      double& sigma_m) const;
+    /** heightAt() (subCell) or cellHeight(): the map's surface at (x, y) in the pose frame;
+     * sigma without the pose part the points share if not `sharedPosePart` (the gap filling's
+     * input). */
+    bool surfaceQuery(bool subCell, double x_m, double y_m, double& height_m, double& sigma_m,
+                      bool sharedPosePart = true) const;
     /** surfaceQuery() where measured; else, with includeFilled, the last gap filling's height
      * where it filled the cell of (x, y). */
     HeightSource elevationQuery(bool subCell, double x_m, double y_m, double& height_m,

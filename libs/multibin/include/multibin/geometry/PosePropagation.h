@@ -32,9 +32,18 @@ struct PointBlock {
     static constexpr size_t kCapacity = 256;
     /** x, y, z [m], then the covariance entries xx, xy, xz, yy, yz, zz [m^2]. */
     alignas(64) float v[9][kCapacity];
+    /** The pose's part of each point's map-frame height variance and of its horizontal variance
+     * (the mean of xx and yy) [m^2]: written by the propagation; NaN where not known. */
+    alignas(64) float poseVariance_m2[2][kCapacity];
 
-    /** Copies `in[0 .. n)`, n <= kCapacity. */
+    /** Copies `in[0 .. n)`, n <= kCapacity (v only). */
     void gather(const PointWithCov* in, size_t n);
+};
+
+/** The pose's part of points' map-frame height and horizontal variance [m^2], a value per point
+ * (PointBlock::poseVariance_m2's, for points that travel as PointWithCov). */
+struct PoseVariances {
+    std::vector<float> height_m2, horizontal_m2;
 };
 
 class PosePropagator {
@@ -45,12 +54,14 @@ public:
     /** One point; `in.cov_m2` is the sensor-frame covariance. */
     PointWithCov apply(const PointWithCov& in) const;
 
-    /** A batch; `out` is resized to match `in` (no allocation once it has the capacity). */
-    void apply(const PointsWithCov& in, PointsWithCov& out) const;
+    /** A batch; `out` is resized to match `in` (no allocation once it has the capacity). With
+     * `pose`, also the pose's part of each point's variances. */
+    void apply(const PointsWithCov& in, PointsWithCov& out, PoseVariances* pose = nullptr) const;
 
     /** A batch from `in[0 .. n)` into `out[0 .. n)`; the ranges may be the same (in place) but
      * must not otherwise overlap. */
-    void apply(const PointWithCov* in, PointWithCov* out, size_t n) const;
+    void apply(const PointWithCov* in, PointWithCov* out, size_t n,
+               PoseVariances* pose = nullptr) const;
 
     /** A block: `in[0 .. n)` (n <= PointBlock::kCapacity) into `out`, the same values as
      * apply(). */

@@ -28,8 +28,14 @@ struct BinEstimate {
     float certainty = 0;    //!< certainty counter c (eqs 13-14)
     uint32_t pointCount = 0;
     int16_t index = 0;  //!< vertical bin index n: covers [n, n+1) * binHeight [m]
-    uint16_t reserved = 0;
-    PlaneMoments plane;  //!< the slope inside the cell (serialized from version 3)
+    /** What the robot's pose uncertainty contributes to its points' height and horizontal
+     * position, least over the points (codes of BinUpdate.h's poseSigmaCode; 0: not known). A
+     * pose error is shared by every point of a frame and, drifting, by consecutive frames, so
+     * fusing more points does not average it away: the reported variance keeps it as a floor
+     * (serialized from version 4). */
+    uint8_t poseHeightSigmaCode = 0;
+    uint8_t poseHorizontalSigmaCode = 0;  //!< the same for the horizontal position
+    PlaneMoments plane;                   //!< the slope inside the cell (serialized from version 3)
 };
 
 /** A bin as BinStore keeps it: its estimate and the storage link to the next bin of its cell

@@ -16,6 +16,7 @@
 namespace multibin {
 
 class PosePropagator;
+struct PoseVariances;
 
 /** The 2.5D grid of multi-bin cells: the storage (BinStore: cells, bins, the moving window), the
  * update rule applied to points (the gates of eqs 13-14 and the Kalman update of eq 15 from
@@ -69,13 +70,17 @@ public:
     /** @name The insertion core
      * @{ */
     /** Fuses points given in the map frame (eqs 13-15). `continuityBound_m` is Delta_zmax of eq 14
-     * for a laser scan, or infinity (stereo, depth: eq 13 only). */
+     * for a laser scan, or infinity (stereo, depth: eq 13 only). `pose`: the pose's part of
+     * each point's variances (PosePropagator::apply's), kept by the bins (Bin.h); without it
+     * the points have none known. */
     InsertStats insertPoints(const PointsWithCov& mapPoints, const BinUpdateParams& params,
-                             double continuityBound_m = std::numeric_limits<double>::infinity());
-    /** The same for `count` points from `mapPoints`. */
+                             double continuityBound_m = std::numeric_limits<double>::infinity(),
+                             const PoseVariances* pose = nullptr);
+    /** The same for `count` points from `mapPoints` (and `pose`'s first `count`). */
     InsertStats insertPoints(const PointWithCov* mapPoints, size_t count,
                              const BinUpdateParams& params,
-                             double continuityBound_m = std::numeric_limits<double>::infinity());
+                             double continuityBound_m = std::numeric_limits<double>::infinity(),
+                             const PoseVariances* pose = nullptr);
 
     /** Moves sensor-frame points to the map frame with `propagator` (PosePropagator::apply, on
      * blocks of 256 points) and fuses them as insertPoints does, so the map-frame batch never
@@ -134,7 +139,7 @@ public:
      * vertical extent. */
     size_t memoryBytes() const { return BinStore::memoryBytes() + m_index.memoryBytes(); }
 
-    /** Reported standard deviation of a bin: sqrt(max(variance, floor)) [m]. */
+    /** Standard deviation of a bin's estimate (binSigma_m) [m]. */
     static double sigma_m(const BinEstimate& b, const BinUpdateParams& p) {
         return binSigma_m(b, p);
     }
@@ -154,7 +159,8 @@ private:
     bool fuseMeasurement(size_t slot, int ix, int iy, int16_t n, double height_m,
                          double variance_m2, const BinUpdateParams& params,
                          double continuityBound_m, InsertStats& stats, float x_m,
-                         float y_m);  //!< its place feeds the plane moments; NaN: no place
+                         float y_m,  //!< its place feeds the plane moments; NaN: no place
+                         float poseHeightVariance_m2, float poseHorizontalVariance_m2);
 
     VisibilityIndex m_index;
     int m_insertionThreads = 1;

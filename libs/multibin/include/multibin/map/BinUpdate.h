@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 
 #include "multibin/map/Bin.h"
 #include "multibin/map/MapTypes.h"
@@ -130,7 +132,60 @@ inline bool passesEq14(const BinEstimate& bin, double height_m, double continuit
     return !(bin.certainty > 0 && std::abs(height_m - bin.height_m) > continuityBound_m);
 }
 
-/** Reported standard deviation of a bin: sqrt(max(variance, floor)) [m]. */
+/** @name The pose part of a bin's points, kept as a floor of its reported variance
+ * A standard deviation in one byte: code c >= 1 stands for 1 um * 1.05^(c - 1) (1 um to 0.24 m,
+ * 5 % steps: a floor needs no more), 0 for "not known" (no point with a pose part yet, or a map
+ * saved before version 4).
+ * @{ */
+namespace detail {
+/** kPoseSigmaVariance_m2[c]: the variance [m^2] code c stands for (index 0 unused). */
+struct PoseSigmaTable {
+    float variance_m2[256];
+    PoseSigmaTable() {
+        variance_m2[0] = 0;
+        for (int c = 1; c < 256; c++) {
+            const double sigma_m = 1e-6 * std::pow(1.05, c - 1);
+            variance_m2[c] = static_cast<float>(sigma_m * sigma_m);
+        }
+    }
+};
+inline const PoseSigmaTable kPoseSigmaTable;
+}  // namespace detail
+
+/** The variance [m^2] of a code (0 for "not known"). */
+inline double poseVariance_m2(uint8_t code) { return detail::kPoseSigmaTable.variance_m2[code]; }
+
+/** The code whose variance is the largest not above `variance_m2` (1 for 1 um or less, 255 for
+ * 0.24 m or more); NaN gives 0 (not known). */
+inline uint8_t poseSigmaCode(double variance_m2) {
+    if (!(variance_m2 >= 0)) return 0;
+    const float* t = detail::kPoseSigmaTable.variance_m2;
+    const float* at = std::upper_bound(t + 1, t + 256, static_cast<float>(variance_m2));
+    return static_cast<uint8_t>(std::max<ptrdiff_t>(1, at - t - 1));
+}
+
+/** The least of two codes that are known (0: not known). */
+inline uint8_t leastPoseSigmaCode(uint8_t a, uint8_t b) {
+    return a == 0 ? b : b == 0 ? a : std::min(a, b);
+}
+
+/** Lowers `code` to that of `variance_m2` if it is smaller (or `code` is 0, not known); NaN
+ * leaves it. Encodes only when it lowers: most updates of a bin do not. */
+inline void lowerPoseSigmaCode(uint8_t& code, float variance_m2) {
+    if (code == 0 ? variance_m2 >= 0 : variance_m2 < detail::kPoseSigmaTable.variance_m2[code])
+        code = poseSigmaCode(variance_m2);
+}
+
+/** Points whose pose parts of the height and horizontal variance are at least these [m^2] were
+ * fused into `bin` (NaN: not known, e.g. points given in the map frame). */
+inline void notePoseVariance(BinEstimate& bin, float height_m2, float horizontal_m2) {
+    lowerPoseSigmaCode(bin.poseHeightSigmaCode, height_m2);
+    lowerPoseSigmaCode(bin.poseHorizontalSigmaCode, horizontal_m2);
+}
+/** @} */
+
+/** Standard deviation of a bin's estimate: sqrt(max(variance, floor)) [m]; the visibility
+ * constraint's margin. (The variance a query reports also keeps the pose part: CellSurface.h.) */
 inline double binSigma_m(const BinEstimate& b, const BinUpdateParams& p) {
     return std::sqrt(std::max<double>(b.variance_m2, p.varianceFloor_m2));
 }

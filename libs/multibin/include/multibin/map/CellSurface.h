@@ -19,6 +19,17 @@ struct CellSurface {
     double variance_m2 = 0;         //!< with the floor, and the relief if asked for [m^2]
     double certainty = 0;           //!< the certainty of the bins merged into the surface
     int firstBin = 0, lastBin = 0;  //!< the bin indices merged into the surface
+    /** The pose's part of the height variance, which the surface's points share (the least
+     * over its bins, Bin.h; for heightAt plus the slope's share of the horizontal part) [m^2].
+     * Eq 15 fuses points as independent, so variance_m2 holds it divided among the points; a
+     * pose error common to a frame (and, drifting, to the frames after it) does not average
+     * away, so the variance a query reports adds it back once (reportedVariance_m2; one point
+     * counts it twice: on the safe side). The fusion of bins and grids, and the gap filling,
+     * weigh by variance_m2 alone (the pose error moves neighbours together), so heights are
+     * what they were without it. */
+    double poseVariance_m2 = 0;
+
+    double reportedVariance_m2() const { return variance_m2 + poseVariance_m2; }
 };
 
 /** The surface of cell (ix, iy) of `grid`; false if it holds no certain bin (or lies outside
