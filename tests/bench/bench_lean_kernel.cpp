@@ -346,36 +346,6 @@ static void BM_MapInsertSensorPoints(benchmark::State& state) {
 }
 BENCHMARK(BM_MapInsertSensorPoints)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
 
-/** The map's path from the kernel's own input: each scan's sensor-frame points (structure of
- * arrays) through the map's range-only sensor model into one reused buffer, then inserted. */
-static void BM_MapInsertScans(benchmark::State& state) {
-    const Prepared& p = prepared();
-    std::vector<PosePropagator> propagators;
-    for (const Scan& s : p.scans) propagators.emplace_back(s.robotPose, kLaserOnRobot);
-    BinUpdateParams params;
-    params.binHeight_m = kBinHeight_m;
-    params.maxElevationUncertainty_m = kMaxUncertainty_m;
-    const int origin = int(std::floor(kGridOrigin_m / kCell_m));
-    BinGrid grid(kCell_m);
-    grid.reset(kCell_m, CellWindow{origin, origin, kGridCells, kGridCells});
-    PointsWithCov pts;
-    for (auto _ : state) {
-        for (size_t k = 0; k < p.scans.size(); k++) {
-            const Scan& s = p.scans[k];
-            pts.resize(s.x.size());
-            for (size_t i = 0; i < s.x.size(); i++) {
-                const Eigen::Vector3f q(s.x[i], s.y[i], s.z[i]);
-                pts[i].point_m = q;
-                pts[i].cov_m2 = rangeOnlyCovariance(q.normalized(), rangeSigma_m(q.norm()));
-            }
-            grid.beginCycle();
-            benchmark::DoNotOptimize(grid.insertSensorPoints(propagators[k], pts, params));
-        }
-    }
-    setCounters(state);
-}
-BENCHMARK(BM_MapInsertScans)->Unit(benchmark::kMillisecond);
-
 static void BM_MrptHeightGridMean(benchmark::State& state) {
     std::vector<PointsWithCov> mapPoints;
     const auto sensorPoints = sensorPointsOfScans();

@@ -66,19 +66,25 @@ void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const Point
                     q7 = q[7], q8 = q[8], q9 = q[9];
         const float s0 = s[0], s1 = s[1], s2 = s[2], s3 = s[3], s4 = s[4], s5 = s[5];
         float* __restrict o = out.v[3 + e];
-        // The pose's part of the entries xx and yy (their mean) and zz, kept apart too.
-        float* __restrict pose = e == 5 ? out.poseVariance_m2[0] : out.poseVariance_m2[1];
-        const bool keepPose = e == 0 || e == 3 || e == 5;
-        const float poseShare = e == 5 ? 1.f : 0.5f;
+        alignas(64) float robotPart[kBlock];
         for (size_t i = 0; i < n; i++) {
             const float robot = q0 + q1 * x[i] + q2 * y[i] + q3 * z[i] + q4 * mono[0][i] +
                                 q5 * mono[1][i] + q6 * mono[2][i] + q7 * mono[3][i] +
                                 q8 * mono[4][i] + q9 * mono[5][i];
             const float sensor =
                 s0 * c0[i] + s1 * c1[i] + s2 * c2[i] + s3 * c3[i] + s4 * c4[i] + s5 * c5[i];
+            robotPart[i] = robot;
             o[i] = robot + sensor;
-            if (keepPose) pose[i] = (e == 3 ? pose[i] : 0.f) + poseShare * robot;  // yy: + xx/2
         }
+        // The pose's part of zz, and of the mean of xx and yy, kept apart too (separate loops:
+        // a select in the loop above keeps GCC from vectorising it).
+        float* __restrict height = out.poseVariance_m2[0];
+        float* __restrict horizontal = out.poseVariance_m2[1];
+        if (e == 5) std::copy_n(robotPart, n, height);
+        if (e == 0)
+            for (size_t i = 0; i < n; i++) horizontal[i] = 0.5f * robotPart[i];
+        if (e == 3)
+            for (size_t i = 0; i < n; i++) horizontal[i] += 0.5f * robotPart[i];
     }
 }
 }  // namespace

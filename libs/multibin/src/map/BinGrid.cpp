@@ -387,7 +387,9 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         PlaneMoments plane;
         double cellX_m = 0, cellY_m = 0;  // the cell's centre [m]
         double maxHeight_m = 0;
-        float poseHeightVariance_m2 = 0, poseHorizontalVariance_m2 = 0;  // least of the run's
+        // Its first point's pose parts: the run's points are neighbours of one frame, whose pose
+        // parts differ by far less than the codes' steps (BinUpdate.h).
+        float poseHeightVariance_m2 = 0, poseHorizontalVariance_m2 = 0;
         bool frozen = false;  // the bin has zero variance: its height cannot move
     } run;
     auto closeRun = [&]() {
@@ -431,12 +433,11 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
             const double weight = cb.weight[i];
             const size_t s = size_t(cb.slot[i]);
             const int16_t n = static_cast<int16_t>(cb.bin[i]);
-            const float poseHeight_m2 = pts.poseVariance_m2[0][i];
-            const float poseHorizontal_m2 = pts.poseVariance_m2[1][i];
             if (perPoint) {
                 fuseMeasurement(s, cb.ix[i], cb.iy[i], n, h,
                                 std::max<double>(pts.v[8][i], kMinFusedVariance_m2), params,
-                                continuityBound_m, stats, x, y, poseHeight_m2, poseHorizontal_m2);
+                                continuityBound_m, stats, x, y, pts.poseVariance_m2[0][i],
+                                pts.poseVariance_m2[1][i]);
                 continue;
             }
             if (run.bin == kNoBin || run.slot != s || run.n != n) {
@@ -448,8 +449,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
                 run.iy = cb.iy[i];
                 run.points = 0;
                 run.maxHeight_m = h;
-                run.poseHeightVariance_m2 = poseHeight_m2;
-                run.poseHorizontalVariance_m2 = poseHorizontal_m2;
+                run.poseHeightVariance_m2 = pts.poseVariance_m2[0][i];
+                run.poseHorizontalVariance_m2 = pts.poseVariance_m2[1][i];
                 const Bin& bin = BinStore::bin(run.bin);
                 run.plane = bin.plane;
                 run.cellX_m = cellCenter_m(run.ix);
@@ -462,10 +463,6 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
             addPlanePoint(run.plane, float(x - run.cellX_m), float(y - run.cellY_m), float(h),
                           float(weight));
             run.maxHeight_m = std::max(run.maxHeight_m, h);
-            // NaN (not known) stays NaN: a map-frame block is all NaN.
-            run.poseHeightVariance_m2 = std::min(run.poseHeightVariance_m2, poseHeight_m2);
-            run.poseHorizontalVariance_m2 =
-                std::min(run.poseHorizontalVariance_m2, poseHorizontal_m2);
             run.points++;
             stats.accepted++;
         }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "multibin/map/Bin.h"
 #include "multibin/map/MapTypes.h"
@@ -132,36 +133,38 @@ inline bool passesEq14(const BinEstimate& bin, double height_m, double continuit
     return !(bin.certainty > 0 && std::abs(height_m - bin.height_m) > continuityBound_m);
 }
 
-/** @name The pose part of a bin's points, kept as a floor of its reported variance
- * A standard deviation in one byte: code c >= 1 stands for 1 um * 1.05^(c - 1) (1 um to 0.24 m,
- * 5 % steps: a floor needs no more), 0 for "not known" (no point with a pose part yet, or a map
- * saved before version 4).
+/** @name The pose part of a bin's points, kept apart from its fused variance
+ * A variance in one byte: the exponent and the two leading mantissa bits of its float, so code
+ * c >= 1 stands for a variance within 19 % below the true one (sigma within 9 %), from
+ * 2^-40 m^2 (sigma 1 um; anything smaller) to 2^23 m^2; 0 stands for "not known" (no point with
+ * a pose part yet, or a map saved before version 4). Encoding is a shift: no table, no log, so the
+ * insertion core can afford it per run of points.
  * @{ */
 namespace detail {
-/** kPoseSigmaVariance_m2[c]: the variance [m^2] code c stands for (index 0 unused). */
-struct PoseSigmaTable {
-    float variance_m2[256];
-    PoseSigmaTable() {
-        variance_m2[0] = 0;
-        for (int c = 1; c < 256; c++) {
-            const double sigma_m = 1e-6 * std::pow(1.05, c - 1);
-            variance_m2[c] = static_cast<float>(sigma_m * sigma_m);
-        }
-    }
-};
-inline const PoseSigmaTable kPoseSigmaTable;
+/** The float bits of 2^-40, shifted by 21, minus 1: code 1 is 2^-40 m^2. */
+constexpr int32_t kPoseCodeBias = ((127 - 40) << 2) - 1;
+inline uint32_t floatBits(float v) {
+    uint32_t u;
+    std::memcpy(&u, &v, sizeof u);
+    return u;
+}
 }  // namespace detail
 
 /** The variance [m^2] of a code (0 for "not known"). */
-inline double poseVariance_m2(uint8_t code) { return detail::kPoseSigmaTable.variance_m2[code]; }
+inline double poseVariance_m2(uint8_t code) {
+    if (code == 0) return 0;
+    const uint32_t u = uint32_t(int32_t(code) + detail::kPoseCodeBias) << 21;
+    float v;
+    std::memcpy(&v, &u, sizeof v);
+    return v;
+}
 
-/** The code whose variance is the largest not above `variance_m2` (1 for 1 um or less, 255 for
- * 0.24 m or more); NaN gives 0 (not known). */
-inline uint8_t poseSigmaCode(double variance_m2) {
-    if (!(variance_m2 >= 0)) return 0;
-    const float* t = detail::kPoseSigmaTable.variance_m2;
-    const float* at = std::upper_bound(t + 1, t + 256, static_cast<float>(variance_m2));
-    return static_cast<uint8_t>(std::max<ptrdiff_t>(1, at - t - 1));
+/** The code of `variance_m2` (rounded down; 2^-40 m^2 or less, negative rounding included, gives
+ * 1; 2^23 m^2 or more 253); NaN gives 0 (not known). */
+inline uint8_t poseSigmaCode(float variance_m2) {
+    if (variance_m2 != variance_m2) return 0;
+    const float v = std::min(std::max(variance_m2, 0x1p-40f), 0x1p23f);
+    return static_cast<uint8_t>(int32_t(detail::floatBits(v) >> 21) - detail::kPoseCodeBias);
 }
 
 /** The least of two codes that are known (0: not known). */
@@ -169,18 +172,12 @@ inline uint8_t leastPoseSigmaCode(uint8_t a, uint8_t b) {
     return a == 0 ? b : b == 0 ? a : std::min(a, b);
 }
 
-/** Lowers `code` to that of `variance_m2` if it is smaller (or `code` is 0, not known); NaN
- * leaves it. Encodes only when it lowers: most updates of a bin do not. */
-inline void lowerPoseSigmaCode(uint8_t& code, float variance_m2) {
-    if (code == 0 ? variance_m2 >= 0 : variance_m2 < detail::kPoseSigmaTable.variance_m2[code])
-        code = poseSigmaCode(variance_m2);
-}
-
 /** Points whose pose parts of the height and horizontal variance are at least these [m^2] were
  * fused into `bin` (NaN: not known, e.g. points given in the map frame). */
 inline void notePoseVariance(BinEstimate& bin, float height_m2, float horizontal_m2) {
-    lowerPoseSigmaCode(bin.poseHeightSigmaCode, height_m2);
-    lowerPoseSigmaCode(bin.poseHorizontalSigmaCode, horizontal_m2);
+    bin.poseHeightSigmaCode = leastPoseSigmaCode(bin.poseHeightSigmaCode, poseSigmaCode(height_m2));
+    bin.poseHorizontalSigmaCode =
+        leastPoseSigmaCode(bin.poseHorizontalSigmaCode, poseSigmaCode(horizontal_m2));
 }
 /** @} */
 
