@@ -264,6 +264,10 @@ TEST(CMultiBinElevationMap, SerializationRoundTripIsBitExactThroughClassRegistry
                 EXPECT_EQ(a->certainty, b->certainty);
                 EXPECT_EQ(std::memcmp(&a->plane, &b->plane, sizeof a->plane), 0)
                     << "plane moments of cell " << ix << ", " << iy;
+                // The pose parts (serialized since version 4): the reported sigma keeps them.
+                EXPECT_NE(a->poseHeightSigmaCode, 0);
+                EXPECT_EQ(a->poseHeightSigmaCode, b->poseHeightSigmaCode);
+                EXPECT_EQ(a->poseHorizontalSigmaCode, b->poseHorizontalSigmaCode);
             }
         }
     // The sub-cell surface (from the plane moments, serialized since version 3) answers the same

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "SurfaceAccuracy.h"
+#include "multibin/map/BinUpdate.h"
 #include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
@@ -139,4 +140,87 @@ TEST(SubCellSurface, IntersectLine3DMeetsTheSubCellSurface) {
     mrpt::math::TPoint3D p;
     ASSERT_TRUE(hit.getPoint(p));
     EXPECT_NEAR(p.z, h, 1e-6);
+}
+
+TEST(PoseSharedVariance, CodesRoundDownWithinAQuarterOctave) {
+    // The byte a bin keeps per pose part (BinUpdate.h): never above the variance it stands for,
+    // at most 19 % below it, monotone; NaN is "not known" and loses to any known code.
+    using multibin::poseSigmaCode;
+    using multibin::poseVariance_m2;
+    EXPECT_EQ(poseSigmaCode(std::nanf("")), 0);
+    EXPECT_EQ(poseVariance_m2(0), 0.0);
+    EXPECT_EQ(poseSigmaCode(0.f), 1);
+    EXPECT_EQ(poseSigmaCode(-1e-9f), 1);  // rounding below zero: the least code
+    uint8_t previous = 0;
+    for (double v = 1e-12; v < 1e6; v *= 1.01) {
+        const uint8_t c = poseSigmaCode(float(v));
+        ASSERT_GE(c, previous) << v;
+        previous = c;
+        EXPECT_LE(poseVariance_m2(c), float(v)) << v;
+        EXPECT_GE(poseVariance_m2(c), 0.8 * v) << v;  // 2^-(1/4) = 0.84
+    }
+    EXPECT_EQ(multibin::leastPoseSigmaCode(0, 7), 7);
+    EXPECT_EQ(multibin::leastPoseSigmaCode(9, 0), 9);
+    EXPECT_EQ(multibin::leastPoseSigmaCode(9, 7), 7);
+}
+
+TEST(PoseSharedVariance, FramesSharingOnePoseErrorStayWithin3Sigma) {
+    // Ten pitched laser scans of a slope from one drifting pose estimate: every frame's pose is
+    // wrong by the same error, drawn from the pose PDF the map is given (as between two
+    // corrections of a walking robot's odometry). Eq 15 fuses the ~100 points of a cell as
+    // independent, so their fused sigma falls far below the pose error they share; the reported
+    // sigma must keep the pose part (with the slope's share of its horizontal part for
+    // heightAt). Without it the truth was inside 3 sigma at 49 % (heightAt) and 79 % (cell
+    // value) of the query points.
+    auto slope = [](double x, double y) { return 0.3 * x + 0.1 * y; };
+    std::vector<mrpt::obs::CObservation2DRangeScan::Ptr> scans;
+    std::vector<mrpt::poses::CPose3D> truePoses;
+    for (int k = 0; k < 10; k++) {
+        truePoses.emplace_back(0.1 + 0.005 * k, 0.6, slope(0.1 + 0.005 * k, 0.6), 0, 0, 0);
+        scans.push_back(test_scenes::pitchedScanOver(slope, truePoses.back(), 0.26, 0.785));
+    }
+    const double sigmas[6] = {0.003, 0.003, 0.004, 0.004, 0.003, 0.003};  // x y z yaw pitch roll
+    mrpt::math::CMatrixDouble66 cov;
+    cov.setZero();
+    for (int i = 0; i < 6; i++) cov(i, i) = sigmas[i] * sigmas[i];
+    std::mt19937 rng(11);
+    std::normal_distribution<double> n01;
+    std::uniform_real_distribution<double> ux(0.30, 0.345), uy(0.45, 0.75);  // the scans' strip
+    size_t queries = 0, cellInside = 0, planeInside = 0;
+    double planeSigmaSum_m = 0;
+    for (int trial = 0; trial < 60; trial++) {
+        CMultiBinElevationMap map = test_scenes::fixedSquareMap(kCell_m, 1.2, 0.0005);
+        double e[6];
+        for (double& v : e) v = n01(rng);
+        for (int k = 0; k < 10; k++) {
+            const mrpt::poses::CPose3D& t = truePoses[size_t(k)];
+            mrpt::poses::CPose3DPDFGaussian estimate;
+            estimate.mean =
+                mrpt::poses::CPose3D(t.x() + sigmas[0] * e[0], t.y() + sigmas[1] * e[1],
+                                     t.z() + sigmas[2] * e[2], t.yaw() + sigmas[3] * e[3],
+                                     t.pitch() + sigmas[4] * e[4], t.roll() + sigmas[5] * e[5]);
+            estimate.cov = cov;
+            mrpt::obs::CObservation2DRangeScan noisy = *scans[size_t(k)];
+            for (size_t i = 0; i < noisy.getScanSize(); i++) {
+                const float r = noisy.getScanRange(i);
+                if (noisy.getScanRangeValidity(i))
+                    noisy.setScanRange(i, float(r + (0.0006 + 0.0039 * r) * n01(rng)));
+            }
+            ASSERT_TRUE(map.insertObservation(noisy, estimate));
+        }
+        for (int q = 0; q < 20; q++) {
+            const double x = ux(rng), y = uy(rng);
+            double h, s, hc, sc;
+            if (!map.heightAt(x, y, h, s) || !map.cellHeight(x, y, hc, sc)) continue;
+            queries++;
+            planeInside += std::abs(h - slope(x, y)) <= 3 * s;
+            cellInside += std::abs(hc - slope(x, y)) <= 3 * sc;
+            planeSigmaSum_m += s;
+        }
+    }
+    ASSERT_GT(queries, 1000u);
+    EXPECT_GE(double(planeInside) / double(queries), 0.95);
+    EXPECT_GE(double(cellInside) / double(queries), 0.95);
+    // Not by an absurd sigma: the pose part of a point's height here is about 4.2 mm.
+    EXPECT_LT(planeSigmaSum_m / double(queries), 0.008);
 }
