@@ -66,7 +66,9 @@ bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m
  * spread of the cell's other certain bins (a step inside the cell) is added as in
  * addReliefVariance. A cell whose points give no plane (fewer than 4, or collinear) and no agreeing
  * neighbour falls back to a gradient 0 +- kUnknownSlope. With a dual grid, combined as surfaceAt
- * does. False if neither grid has a surface there. */
+ * does. The pose part the points share is apart, in poseVariance_m2 (with |g|^2 times the
+ * horizontal part): reportedVariance_m2() is what a query reports. False if neither grid has a
+ * surface there. */
 bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
               const BinUpdateParams& params, bool reliefSigma, CellSurface& out);
 
