@@ -60,10 +60,18 @@ struct VisibilityScratch {
     std::vector<uint8_t> rayState;
     std::vector<std::pair<double, uint32_t>> fan, bucketed;
     std::vector<uint32_t> start;
-    std::vector<double> keys, lengths, fastSlopes;
+    std::vector<double> keys, lengths, fastSlopes, groupFastSlopes, lengthOf;
     std::vector<FanRay> rays;
     std::vector<int32_t> unitTableOf;
 };
+
+/** This thread's scratch arrays. Out of line so that the caller holds a plain reference: named
+ * directly, a thread_local of this shared library is looked up again (__tls_get_addr) at almost
+ * every use inside the constraint's lambdas (13 % of its instructions). */
+__attribute__((noinline)) VisibilityScratch& threadScratch() {
+    thread_local VisibilityScratch scratch;
+    return scratch;
+}
 }  // namespace
 
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
@@ -117,7 +125,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     const std::vector<BinGrid::UpdatedCell>& updated = grid.updatedCells();
     // The region's block bounds copied into a dense table (exact copies; up to 1 MB): the walks
     // below look them up there, without the block table's wrap-around and tags.
-    thread_local VisibilityScratch scratch;
+    VisibilityScratch& scratch = threadScratch();
     std::vector<float>& regionBound = scratch.regionBound;
     regionBound.clear();
     int tableX0 = 0, tableY0 = 0;
@@ -140,6 +148,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         return sx < tableNx && sy < tableNy ? towardsSensor[sx + sy * tableNx]
                                             : std::numeric_limits<float>::infinity();
     };
+    // The sensor's block, and whether the blocks around it lie below it (towardsSensor's
+    // condition).
+    int sensorBx = 0, sensorBy = 0;
+    bool rectangleUsable = false;
     if (!updated.empty()) {
         int ixLo = grid.cellIndex(sensor_m.x()), ixHi = ixLo;
         int iyLo = grid.cellIndex(sensor_m.y()), iyHi = iyLo;
@@ -159,10 +171,19 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const int byHi = BinGrid::blockOf(std::min(iyHi + 1, w.iy0 + w.ny - 1));
         if (bxHi >= bxLo && byHi >= byLo &&
             double(bxHi - bxLo + 1) * double(byHi - byLo + 1) <= double(1 << 18)) {
+            // The region's table and its bound in one pass.
+            tableX0 = bxLo;
+            tableY0 = byLo;
+            tableNx = unsigned(bxHi - bxLo + 1);
+            tableNy = unsigned(byHi - byLo + 1);
+            regionBound.resize(size_t(tableNx) * tableNy);
             float bound_m = -std::numeric_limits<float>::infinity();
             for (int by = byLo; by <= byHi; by++)
-                for (int bx = bxLo; bx <= bxHi; bx++)
-                    bound_m = std::max(bound_m, grid.blockMaxHeight_m(bx, by));
+                for (int bx = bxLo; bx <= bxHi; bx++) {
+                    const float b = grid.blockMaxHeight_m(bx, by);
+                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = b;
+                    bound_m = std::max(bound_m, b);
+                }
             // Every sample lies in this region: its bound caps what a ray can meet.
             stopHeight = std::min(stopHeight, tolerantBound_m(bound_m) + vis.margin_m);
             if (!boundMayConflict(bound_m, lowest_m)) {
@@ -176,47 +197,40 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 return stats;
             }
-            // Rays to walk: the region's tables (a second pass, which the common case above
-            // never needs).
-            tableX0 = bxLo;
-            tableY0 = byLo;
-            tableNx = unsigned(bxHi - bxLo + 1);
-            tableNy = unsigned(byHi - byLo + 1);
-            regionBound.resize(size_t(tableNx) * tableNy);
-            for (int by = byLo; by <= byHi; by++)
-                for (int bx = bxLo; bx <= bxHi; bx++)
-                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] =
-                        grid.blockMaxHeight_m(bx, by);
-            const int sbx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
-            const int sby = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
+            sensorBx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
+            sensorBy = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
             float nearSensor_m = -std::numeric_limits<float>::infinity();
-            for (int by = sby - 1; by <= sby + 1; by++)
-                for (int bx = sbx - 1; bx <= sbx + 1; bx++)
+            for (int by = sensorBy - 1; by <= sensorBy + 1; by++)
+                for (int bx = sensorBx - 1; bx <= sensorBx + 1; bx++)
                     nearSensor_m = std::max(nearSensor_m, blockBound(bx, by));
-            if (sbx >= bxLo && sbx <= bxHi && sby >= byLo && sby <= byHi &&
-                !boundMayConflict(nearSensor_m, sensor_m.z() - 1e-6)) {
-                // Rows, then the blocks of a row, outwards from the sensor's: a block's
-                // rectangle is itself and the rectangles of its neighbours towards the sensor.
-                auto outwards = [](int from, int lo, int hi) {
-                    std::vector<int> order{from};
-                    for (int k = 1; from - k >= lo || from + k <= hi; k++) {
-                        if (from - k >= lo) order.push_back(from - k);
-                        if (from + k <= hi) order.push_back(from + k);
-                    }
-                    return order;
-                };
-                towardsSensor.resize(regionBound.size());
-                const std::vector<int> columns = outwards(sbx, bxLo, bxHi);
-                for (int by : outwards(sby, byLo, byHi))
-                    for (int bx : columns) {
-                        float r = blockBound(bx, by);
-                        if (bx != sbx) r = std::max(r, restBound(bx + (bx < sbx ? 1 : -1), by));
-                        if (by != sby) r = std::max(r, restBound(bx, by + (by < sby ? 1 : -1)));
-                        towardsSensor[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = r;
-                    }
-            }
+            rectangleUsable = sensorBx >= bxLo && sensorBx <= bxHi && sensorBy >= byLo &&
+                              sensorBy <= byHi &&
+                              !boundMayConflict(nearSensor_m, sensor_m.z() - 1e-6);
         }
     }
+    // towardsSensor, built only when some ray is to be walked (the fan test below, where it
+    // runs, decides a scan's rays without it). Rows, then the blocks of a row, outwards from the
+    // sensor's: a block's rectangle is itself and the rectangles of its neighbours towards the
+    // sensor.
+    auto buildTowardsSensor = [&]() {
+        auto outwards = [](int from, int lo, int hi) {
+            std::vector<int> order{from};
+            for (int k = 1; from - k >= lo || from + k <= hi; k++) {
+                if (from - k >= lo) order.push_back(from - k);
+                if (from + k <= hi) order.push_back(from + k);
+            }
+            return order;
+        };
+        towardsSensor.resize(regionBound.size());
+        const std::vector<int> columns = outwards(sensorBx, tableX0, tableX0 + int(tableNx) - 1);
+        for (int by : outwards(sensorBy, tableY0, tableY0 + int(tableNy) - 1))
+            for (int bx : columns) {
+                float r = blockBound(bx, by);
+                if (bx != sensorBx) r = std::max(r, restBound(bx + (bx < sensorBx ? 1 : -1), by));
+                if (by != sensorBy) r = std::max(r, restBound(bx, by + (by < sensorBy ? 1 : -1)));
+                towardsSensor[unsigned(bx - tableX0) + unsigned(by - tableY0) * tableNx] = r;
+            }
+    };
 
     // The fan of rays at once (every ray starts at the sensor): a ray is proven clear, and not
     // walked, when nothing it passes over can hold a bin above it by the smallest conflict
@@ -251,6 +265,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         fan.clear();
         fan.reserve(updated.size());
         rayState.assign(updated.size(), kWalk);
+        std::vector<double>& lengthOf = scratch.lengthOf;  // per updated cell
+        lengthOf.resize(updated.size());
         double lowestRay_m = sensor_m.z();
         for (size_t i = 0; i < updated.size(); i++) {
             const BinGrid::UpdatedCell& u = updated[i];
@@ -258,12 +274,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
             const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
             const double length = std::sqrt(dx * dx + dy * dy);  // as the walk's
+            lengthOf[i] = length;
             if (length < cell) {
                 rayState[i] = kNoRay;
-            } else if (!towardsSensor.empty() &&
-                       !boundMayConflict(restBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
-                                         std::min(tz, sensor_m.z()) - kSlack_m)) {
-                rayState[i] = kClear;  // the rectangle towards the sensor, as the walk's test
             } else if (std::abs(tz) < kMaxHeight_m) {
                 fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(i));
                 lowestRay_m = std::min(lowestRay_m, tz);
@@ -285,14 +298,22 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             return true;
         };
         if (const size_t n = fan.size(); n > 1) {
-            size_t descents = 0;
-            for (size_t j = 1; j < n; j++) descents += fan[j - 1].first > fan[j].first;
-            if (2 * descents > n) std::reverse(fan.begin(), fan.end());  // mostly clockwise
-            size_t wrap = 0;                                             // after the largest drop
-            double largestDrop = 0;
-            for (size_t j = 1; j < n; j++)
-                if (fan[j - 1].first - fan[j].first > largestDrop)
-                    largestDrop = fan[j - 1].first - fan[j].first, wrap = j;
+            // One pass: the descents, and where the largest drop and the largest rise are (the
+            // largest drop once reversed).
+            size_t descents = 0, drop = 0, rise = 0;
+            double largestDrop = 0, largestRise = 0;
+            for (size_t j = 1; j < n; j++) {
+                const double change = fan[j].first - fan[j - 1].first;
+                descents += change < 0;
+                if (-change > largestDrop) largestDrop = -change, drop = j;
+                if (change > largestRise) largestRise = change, rise = j;
+            }
+            size_t wrap = drop;      // after the largest drop
+            if (2 * descents > n) {  // mostly clockwise
+                std::reverse(fan.begin(), fan.end());
+                largestDrop = largestRise;
+                wrap = n - rise;
+            }
             if (largestDrop > 2) std::rotate(fan.begin(), fan.begin() + wrap, fan.end());
             if (!insertionSort(2 * n)) {
                 std::vector<uint32_t>& start = scratch.start;
@@ -310,6 +331,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             }
         }
         constexpr double kNoFastTest = std::numeric_limits<double>::infinity();
+        constexpr size_t kGroup = 8;
         // In key order; lengths and slopes apart for the blocks' loop over rays.
         const size_t nRays = fan.size();
         // fastSlopes: the slope, or +infinity where the fast test below does not apply.
@@ -327,8 +349,11 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double tz = u.maxHeight_m;
             const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
             const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
-            const double length = std::sqrt(dx * dx + dy * dy);
-            const double slope = (sensor_m.z() - tz) / length, ux = dx / length, uy = dy / length;
+            const double length = lengthOf[fan[j].second];
+            // One division: the tests below allow far more than its rounding.
+            const double invLength = 1.0 / length;
+            const double slope = (sensor_m.z() - tz) * invLength, ux = dx * invLength,
+                         uy = dy * invLength;
             rays[j] = {tx,
                        ty,
                        ux,
@@ -345,6 +370,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             lengths[j] = rays[j].length;
             fastSlopes[j] = rays[j].slope >= 0 ? rays[j].slope : kNoFastTest;
         }
+        // The steepest fastSlopes of each group of kGroup rays in key order (a last, partial
+        // group is taken ray by ray).
+        std::vector<double>& groupFastSlopes = scratch.groupFastSlopes;
+        groupFastSlopes.assign(nRays / kGroup, 0.0);
+        for (size_t j = 0; j + kGroup <= nRays; j += kGroup)
+            groupFastSlopes[j / kGroup] =
+                *std::max_element(fastSlopes.begin() + j, fastSlopes.begin() + j + kGroup);
         // The ray's lowest height [m] over its samples at distances [from, to] from the target
         // (clipped to the walk's [step, length)), or NaN if there is none.
         auto lowestBetween = [&](const FanRay& r, double from, double to) {
@@ -485,13 +517,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
                 const double near_m = std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m;
                 const double far_m = std::sqrt(farX * farX + farY * farY) + kSlack_m;
-                // A ray reaching beyond the block (length >= far_m + step) and rising towards
-                // the sensor passes over it no lower than sz - slope far_m + slope inCell_m
-                // (tz + slope length is sz): clear if its slope is at most maxSlope (1e-8 m
-                // spare for the rounding of the quotient and of tz + slope d).
+                // A ray rising towards the sensor passes over the block no lower than
+                // sz - slope far_m + slope inCell_m (its samples there lie at most far_m from
+                // the sensor, and tz + slope length is sz), wherever it ends: clear if its slope
+                // is at most maxSlope (1e-8 m spare for the rounding of the quotient and of
+                // tz + slope d).
                 const double maxSlope =
                     (sz - blockLimit_m + minConflictMargin - 1e-8) / (far_m - inCell_m);
-                const double reachesBeyond_m = far_m + step;
                 // No sample of a ray shorter than this lies in the block (1e-9 m spare).
                 const double nearStep_m = near_m + step - 1e-9;
                 const double cx = (bx + 0.5) * block_m, cy = (by + 0.5) * block_m;
@@ -531,11 +563,17 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 for (const auto& range : ranges)
                     for (size_t j = range[0]; j < range[1]; j++) {
+                        // A whole group of rays at once where none is steeper than maxSlope.
+                        if (j % kGroup == 0 && j + kGroup <= range[1] &&
+                            groupFastSlopes[j / kGroup] <= maxSlope) {
+                            j += kGroup - 1;
+                            continue;
+                        }
                         // On the line, a sample at distance d from the target lies length - d
                         // from the sensor: none in the block if length < nearStep_m.
                         const double length = lengths[j];
                         if (length < nearStep_m) continue;
-                        if (length >= reachesBeyond_m && fastSlopes[j] <= maxSlope) continue;
+                        if (fastSlopes[j] <= maxSlope) continue;
                         FanRay& r = rays[j];
                         if (!r.clear) continue;  // already to be walked
                         // Both bounds hold: the larger one.
@@ -549,6 +587,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             }
         for (const FanRay& r : rays) rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
     }
+    if (rectangleUsable &&
+        (rayState.empty() || std::find(rayState.begin(), rayState.end(), kWalk) != rayState.end()))
+        buildTowardsSensor();
 
     // The sample distances along a ray, as the walk accumulates them (d += step, not k step,
     // whose rounding differs): the same for every ray, so computed once, as far as a ray needs.
