@@ -377,24 +377,33 @@ std::pair<size_t, size_t> checkFansOverRocks(uint32_t seed, int sceneCount, bool
                              (unit(rng) < 0.2 ? 0.1 * unit(rng) : 0.0);
             update.push_back(pointAt(g.cellCenter_m(ix), g.cellCenter_m(iy), z, 0.003));
         }
-        // Rays ending in their block's farthest cell from the sensor, a near miss beside them.
+        // Rays ending in their block's farthest cell from the sensor, or a cell or so inside its
+        // nearest corner (so the ray's first samples lie barely inside the block), a near miss
+        // beside them.
         PointsWithCov nearMisses;
         for (size_t k = 0, n0 = update.size(); farCornerTargets && k < n0; k++) {
-            if (unit(rng) < 0.5) continue;
+            const double kind = unit(rng);
+            if (kind < 0.5) continue;
+            const bool far = kind < 0.85;
             const int bx = BinGrid::blockOf(g.cellIndex(update[k].point_m.x()));
             const int by = BinGrid::blockOf(g.cellIndex(update[k].point_m.y()));
+            // The block's first row or column faces away from the sensor or towards it.
+            const bool lowX = g.cellCenter_m(bx * BinGrid::kBlockCells) < sx;
+            const bool lowY = g.cellCenter_m(by * BinGrid::kBlockCells) < sy;
+            const int inX = far ? 0 : int(unit(rng) * 2.99), inY = far ? 0 : int(unit(rng) * 2.99);
             const int ix =
-                bx * BinGrid::kBlockCells +
-                (g.cellCenter_m(bx * BinGrid::kBlockCells) < sx ? 0 : BinGrid::kBlockCells - 1);
+                bx * BinGrid::kBlockCells + (lowX == far ? inX : BinGrid::kBlockCells - 1 - inX);
             const int iy =
-                by * BinGrid::kBlockCells +
-                (g.cellCenter_m(by * BinGrid::kBlockCells) < sy ? 0 : BinGrid::kBlockCells - 1);
+                by * BinGrid::kBlockCells + (lowY == far ? inY : BinGrid::kBlockCells - 1 - inY);
             if (!w.contains(ix, iy)) continue;
             const double tx = g.cellCenter_m(ix), ty = g.cellCenter_m(iy), tz = ground(tx, ty);
             const double dx = sx - tx, dy = sy - ty, length = std::hypot(dx, dy);
             if (length < 4 * cell) continue;
             update.push_back(pointAt(tx, ty, tz, 0.003));
-            const double d = (0.5 + 1.5 * unit(rng)) * cell, slope = (sz - tz) / length;
+            // Just past the target's cell: there the slope test's bound is tightest.
+            const double d =
+                (0.5 + 0.6 * unit(rng)) * cell / std::max(std::abs(dx), std::abs(dy)) * length;
+            const double slope = (sz - tz) / length;
             const double x = tx + dx / length * d, y = ty + dy / length * d;
             if (g.cellIndex(x) == ix && g.cellIndex(y) == iy) continue;
             const double conflictAt = tz + slope * d + std::abs(slope) * 0.7072 * cell + 0.026;
@@ -456,7 +465,7 @@ TEST(Visibility, FanTestEditsTheSameBinsAsTheGlobalWalkOverRocks) {
 TEST(Visibility, FanTestEditsTheSameBinsAsTheGlobalWalkForRaysEndingAtABlocksFarCorner) {
     // The slope test bounds a ray over a block by its height at the block's farthest distance
     // from the sensor, whether or not the ray reaches that far (its samples never lie farther).
-    const auto [edits, rays] = checkFansOverRocks(20261125, 120, true);
+    const auto [edits, rays] = checkFansOverRocks(20261125, 300, true);
     std::cout << rays << " rays, " << edits << " bins edited\n";
     EXPECT_GT(edits, 500u) << "the scenes must exercise the constraint";
 }

@@ -60,7 +60,7 @@ struct VisibilityScratch {
     std::vector<uint8_t> rayState;
     std::vector<std::pair<double, uint32_t>> fan, bucketed;
     std::vector<uint32_t> start;
-    std::vector<double> keys, lengths, fastSlopes, groupFastSlopes, lengthOf;
+    std::vector<double> keys, lengths, fastSlopes, groupFastSlopes;
     std::vector<FanRay> rays;
     std::vector<int32_t> unitTableOf;
 };
@@ -261,12 +261,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                        ? tolerantBound_m(max_m)
                        : -std::numeric_limits<double>::infinity();
         };
-        auto& fan = scratch.fan;  // pseudoAngle from the sensor, cell
+        // The rays (in the order of the updated cells) and their keys: pseudoAngle from the
+        // sensor, ray.
+        std::vector<FanRay>& rays = scratch.rays;
+        rays.clear();
+        auto& fan = scratch.fan;
         fan.clear();
-        fan.reserve(updated.size());
         rayState.assign(updated.size(), kWalk);
-        std::vector<double>& lengthOf = scratch.lengthOf;  // per updated cell
-        lengthOf.resize(updated.size());
         double lowestRay_m = sensor_m.z();
         for (size_t i = 0; i < updated.size(); i++) {
             const BinGrid::UpdatedCell& u = updated[i];
@@ -274,12 +275,18 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
             const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
             const double length = std::sqrt(dx * dx + dy * dy);  // as the walk's
-            lengthOf[i] = length;
             if (length < cell) {
                 rayState[i] = kNoRay;
             } else if (std::abs(tz) < kMaxHeight_m) {
-                fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(i));
+                fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(rays.size()));
                 lowestRay_m = std::min(lowestRay_m, tz);
+                // One division: the tests below allow far more than its rounding.
+                const double invLength = 1.0 / length;
+                const double slope = (sensor_m.z() - tz) * invLength, ux = dx * invLength,
+                             uy = dy * invLength;
+                rays.push_back({tx, ty, ux, uy, std::abs(ux) + std::abs(uy), length, slope,
+                                std::abs(slope) * 0.7072 * cell, tz, u.ix, u.iy, uint32_t(i),
+                                true});
             }
         }
         // The rays in key order, as the blocks below take them. A scan's come in beam order,
@@ -338,38 +345,17 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         std::vector<double>& keys = scratch.keys;
         std::vector<double>& lengths = scratch.lengths;
         std::vector<double>& fastSlopes = scratch.fastSlopes;
-        keys.assign(nRays, 0.0);
-        lengths.assign(nRays, 0.0);
-        fastSlopes.assign(nRays, 0.0);
-        std::vector<FanRay>& rays = scratch.rays;
-        rays.assign(nRays, FanRay{});
+        keys.resize(nRays);
+        lengths.resize(nRays);
+        fastSlopes.resize(nRays);
         for (size_t j = 0; j < nRays; j++) {
+            const FanRay& r = rays[fan[j].second];
             keys[j] = fan[j].first;
-            const BinGrid::UpdatedCell& u = updated[fan[j].second];
-            const double tz = u.maxHeight_m;
-            const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
-            const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
-            const double length = lengthOf[fan[j].second];
-            // One division: the tests below allow far more than its rounding.
-            const double invLength = 1.0 / length;
-            const double slope = (sensor_m.z() - tz) * invLength, ux = dx * invLength,
-                         uy = dy * invLength;
-            rays[j] = {tx,
-                       ty,
-                       ux,
-                       uy,
-                       std::abs(ux) + std::abs(uy),
-                       length,
-                       slope,
-                       std::abs(slope) * 0.7072 * cell,
-                       tz,
-                       u.ix,
-                       u.iy,
-                       fan[j].second,
-                       true};
-            lengths[j] = rays[j].length;
-            fastSlopes[j] = rays[j].slope >= 0 ? rays[j].slope : kNoFastTest;
+            lengths[j] = r.length;
+            fastSlopes[j] = r.slope >= 0 ? r.slope : kNoFastTest;
         }
+        const double longestRay_m =
+            nRays > 0 ? *std::max_element(lengths.begin(), lengths.end()) : 0.0;
         // The steepest fastSlopes of each group of kGroup rays in key order (a last, partial
         // group is taken ray by ray).
         std::vector<double>& groupFastSlopes = scratch.groupFastSlopes;
@@ -526,6 +512,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     (sz - blockLimit_m + minConflictMargin - 1e-8) / (far_m - inCell_m);
                 // No sample of a ray shorter than this lies in the block (1e-9 m spare).
                 const double nearStep_m = near_m + step - 1e-9;
+                if (longestRay_m < nearStep_m) continue;  // beyond every ray
                 const double cx = (bx + 0.5) * block_m, cy = (by + 0.5) * block_m;
                 // The rays within the block's angle: keys in [lo, hi], which may pass key 0 (the
                 // +x direction) on either side; all of them near the sensor.
@@ -574,12 +561,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                         const double length = lengths[j];
                         if (length < nearStep_m) continue;
                         if (fastSlopes[j] <= maxSlope) continue;
-                        FanRay& r = rays[j];
+                        FanRay& r = rays[fan[j].second];
                         if (!r.clear) continue;  // already to be walked
-                        // Both bounds hold: the larger one.
+                        // Both bounds hold: the larger one, the second only where the first
+                        // does not clear the ray (a NaN first one: no sample in the block).
+                        const double between_m = lowestBetween(r, length - far_m, length - near_m);
+                        if (!(blockLimit_m > between_m + minConflictMargin)) continue;
                         const double low_m =
-                            std::max(lowestBetween(r, length - far_m, length - near_m),
-                                     lowestOver(r, cx, cy, 0.5 * block_m));
+                            std::max(between_m, lowestOver(r, cx, cy, 0.5 * block_m));
                         if (blockLimit_m > low_m + minConflictMargin &&
                             mayConflictInBlock(r, slot, bx, by, low_m))
                             r.clear = false;
