@@ -208,11 +208,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                               !boundMayConflict(nearSensor_m, sensor_m.z() - 1e-6);
         }
     }
-    // towardsSensor, built only when some ray is to be walked (the fan test below, where it
-    // runs, decides a scan's rays without it). Rows, then the blocks of a row, outwards from the
-    // sensor's: a block's rectangle is itself and the rectangles of its neighbours towards the
-    // sensor.
-    auto buildTowardsSensor = [&]() {
+    // towardsSensor: rows, then the blocks of a row, outwards from the sensor's: a block's
+    // rectangle is itself and the rectangles of its neighbours towards the sensor.
+    if (rectangleUsable) {
         auto outwards = [](int from, int lo, int hi) {
             std::vector<int> order{from};
             for (int k = 1; from - k >= lo || from + k <= hi; k++) {
@@ -230,7 +228,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 if (by != sensorBy) r = std::max(r, restBound(bx, by + (by < sensorBy ? 1 : -1)));
                 towardsSensor[unsigned(bx - tableX0) + unsigned(by - tableY0) * tableNx] = r;
             }
-    };
+    }
 
     // The fan of rays at once (every ray starts at the sensor): a ray is proven clear, and not
     // walked, when nothing it passes over can hold a bin above it by the smallest conflict
@@ -277,6 +275,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double length = std::sqrt(dx * dx + dy * dy);  // as the walk's
             if (length < cell) {
                 rayState[i] = kNoRay;
+            } else if (!towardsSensor.empty() &&
+                       !boundMayConflict(restBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
+                                         std::min(tz, sensor_m.z()) - kSlack_m)) {
+                rayState[i] = kClear;  // the rectangle towards the sensor, as the walk's test
             } else if (std::abs(tz) < kMaxHeight_m) {
                 fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(rays.size()));
                 lowestRay_m = std::min(lowestRay_m, tz);
@@ -576,9 +578,6 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             }
         for (const FanRay& r : rays) rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
     }
-    if (rectangleUsable &&
-        (rayState.empty() || std::find(rayState.begin(), rayState.end(), kWalk) != rayState.end()))
-        buildTowardsSensor();
 
     // The sample distances along a ray, as the walk accumulates them (d += step, not k step,
     // whose rounding differs): the same for every ray, so computed once, as far as a ray needs.
