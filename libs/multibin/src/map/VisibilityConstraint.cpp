@@ -411,22 +411,35 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             int sx0 = ixLo - w.ix0 + grid.store().originSlotX();
             if (sx0 >= w.nx) sx0 -= w.nx;
             const int firstRun = std::min(ixHi - ixLo, w.nx - sx0);  // cells before the wrap
-            float row[BinGrid::kBlockCells];
+            const int originY = grid.store().originSlotY();
+            const int column0 = ixLo - bx * BinGrid::kBlockCells;  // of the first cell read
+            // Usually the block's rows lie whole in one run: a unit's row is 4 adjacent slots.
+            const bool wholeRows = column0 == 0 && firstRun == BinGrid::kBlockCells;
             for (int iy = iyLo; iy < iyHi; iy++) {
-                int sy = iy - w.iy0 + grid.store().originSlotY();
+                int sy = iy - w.iy0 + originY;
                 if (sy >= w.ny) sy -= w.ny;
-                std::fill(row, row + BinGrid::kBlockCells, -std::numeric_limits<float>::infinity());
-                float* out = row + (ixLo - bx * BinGrid::kBlockCells);
-                const size_t base = size_t(sy) * size_t(w.nx);
-                for (int k = 0; k < firstRun; k++) out[k] = index.cellMaxHeight_m(base + sx0 + k);
-                for (int k = firstRun; k < ixHi - ixLo; k++)
-                    out[k] = index.cellMaxHeight_m(base + (k - firstRun));
+                const size_t base = size_t(sy) * size_t(w.nx), first = base + size_t(sx0);
                 float* unitRow = units + ((iy - by * BinGrid::kBlockCells) >> kUnitShift) * kUnits;
-                for (int c = 0; c < kUnits; c++)
-                    for (int k = 0; k < kUnitCells; k++)
-                        unitRow[c] = std::max(unitRow[c], row[c * kUnitCells + k]);
+                if (wholeRows) {
+                    for (int c = 0; c < kUnits; c++) {
+                        float m = unitRow[c];
+                        for (int k = 0; k < kUnitCells; k++)
+                            m = std::max(m,
+                                         index.cellMaxHeight_m(first + size_t(c * kUnitCells + k)));
+                        unitRow[c] = m;
+                    }
+                    continue;
+                }
+                for (int k = 0; k < ixHi - ixLo; k++) {
+                    const size_t slot =
+                        k < firstRun ? first + size_t(k) : base + size_t(k - firstRun);
+                    float& u = unitRow[(column0 + k) >> kUnitShift];
+                    u = std::max(u, index.cellMaxHeight_m(slot));
+                }
             }
-            for (const float b : units) unitLimits.push_back(roundUp(limit_m(b)));
+            unitLimits.resize(size_t(t) + kUnits * kUnits);
+            for (int k = 0; k < kUnits * kUnits; k++)
+                unitLimits[size_t(t) + size_t(k)] = roundUp(limit_m(units[k]));
             return &unitLimits[size_t(t)];
         };
         // Whether the ray may meet a conflicting bin in block (bx, by), over which it passes
