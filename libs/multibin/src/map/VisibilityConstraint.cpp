@@ -60,10 +60,18 @@ struct VisibilityScratch {
     std::vector<uint8_t> rayState;
     std::vector<std::pair<double, uint32_t>> fan, bucketed;
     std::vector<uint32_t> start;
-    std::vector<double> keys, lengths, fastSlopes;
+    std::vector<double> keys, lengths, fastSlopes, groupFastSlopes;
     std::vector<FanRay> rays;
     std::vector<int32_t> unitTableOf;
 };
+
+/** This thread's scratch arrays. Out of line so that the caller holds a plain reference: named
+ * directly, a thread_local of this shared library is looked up again (__tls_get_addr) at almost
+ * every use inside the constraint's lambdas (13 % of its instructions). */
+__attribute__((noinline)) VisibilityScratch& threadScratch() {
+    thread_local VisibilityScratch scratch;
+    return scratch;
+}
 }  // namespace
 
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
@@ -117,7 +125,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     const std::vector<BinGrid::UpdatedCell>& updated = grid.updatedCells();
     // The region's block bounds copied into a dense table (exact copies; up to 1 MB): the walks
     // below look them up there, without the block table's wrap-around and tags.
-    thread_local VisibilityScratch scratch;
+    VisibilityScratch& scratch = threadScratch();
     std::vector<float>& regionBound = scratch.regionBound;
     regionBound.clear();
     int tableX0 = 0, tableY0 = 0;
@@ -140,6 +148,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         return sx < tableNx && sy < tableNy ? towardsSensor[sx + sy * tableNx]
                                             : std::numeric_limits<float>::infinity();
     };
+    // The sensor's block, and whether the blocks around it lie below it (towardsSensor's
+    // condition).
+    int sensorBx = 0, sensorBy = 0;
+    bool rectangleUsable = false;
     if (!updated.empty()) {
         int ixLo = grid.cellIndex(sensor_m.x()), ixHi = ixLo;
         int iyLo = grid.cellIndex(sensor_m.y()), iyHi = iyLo;
@@ -159,10 +171,19 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         const int byHi = BinGrid::blockOf(std::min(iyHi + 1, w.iy0 + w.ny - 1));
         if (bxHi >= bxLo && byHi >= byLo &&
             double(bxHi - bxLo + 1) * double(byHi - byLo + 1) <= double(1 << 18)) {
+            // The region's table and its bound in one pass.
+            tableX0 = bxLo;
+            tableY0 = byLo;
+            tableNx = unsigned(bxHi - bxLo + 1);
+            tableNy = unsigned(byHi - byLo + 1);
+            regionBound.resize(size_t(tableNx) * tableNy);
             float bound_m = -std::numeric_limits<float>::infinity();
             for (int by = byLo; by <= byHi; by++)
-                for (int bx = bxLo; bx <= bxHi; bx++)
-                    bound_m = std::max(bound_m, grid.blockMaxHeight_m(bx, by));
+                for (int bx = bxLo; bx <= bxHi; bx++) {
+                    const float b = grid.blockMaxHeight_m(bx, by);
+                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = b;
+                    bound_m = std::max(bound_m, b);
+                }
             // Every sample lies in this region: its bound caps what a ray can meet.
             stopHeight = std::min(stopHeight, tolerantBound_m(bound_m) + vis.margin_m);
             if (!boundMayConflict(bound_m, lowest_m)) {
@@ -176,46 +197,37 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 return stats;
             }
-            // Rays to walk: the region's tables (a second pass, which the common case above
-            // never needs).
-            tableX0 = bxLo;
-            tableY0 = byLo;
-            tableNx = unsigned(bxHi - bxLo + 1);
-            tableNy = unsigned(byHi - byLo + 1);
-            regionBound.resize(size_t(tableNx) * tableNy);
-            for (int by = byLo; by <= byHi; by++)
-                for (int bx = bxLo; bx <= bxHi; bx++)
-                    regionBound[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] =
-                        grid.blockMaxHeight_m(bx, by);
-            const int sbx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
-            const int sby = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
+            sensorBx = BinGrid::blockOf(grid.cellIndex(sensor_m.x()));
+            sensorBy = BinGrid::blockOf(grid.cellIndex(sensor_m.y()));
             float nearSensor_m = -std::numeric_limits<float>::infinity();
-            for (int by = sby - 1; by <= sby + 1; by++)
-                for (int bx = sbx - 1; bx <= sbx + 1; bx++)
+            for (int by = sensorBy - 1; by <= sensorBy + 1; by++)
+                for (int bx = sensorBx - 1; bx <= sensorBx + 1; bx++)
                     nearSensor_m = std::max(nearSensor_m, blockBound(bx, by));
-            if (sbx >= bxLo && sbx <= bxHi && sby >= byLo && sby <= byHi &&
-                !boundMayConflict(nearSensor_m, sensor_m.z() - 1e-6)) {
-                // Rows, then the blocks of a row, outwards from the sensor's: a block's
-                // rectangle is itself and the rectangles of its neighbours towards the sensor.
-                auto outwards = [](int from, int lo, int hi) {
-                    std::vector<int> order{from};
-                    for (int k = 1; from - k >= lo || from + k <= hi; k++) {
-                        if (from - k >= lo) order.push_back(from - k);
-                        if (from + k <= hi) order.push_back(from + k);
-                    }
-                    return order;
-                };
-                towardsSensor.resize(regionBound.size());
-                const std::vector<int> columns = outwards(sbx, bxLo, bxHi);
-                for (int by : outwards(sby, byLo, byHi))
-                    for (int bx : columns) {
-                        float r = blockBound(bx, by);
-                        if (bx != sbx) r = std::max(r, restBound(bx + (bx < sbx ? 1 : -1), by));
-                        if (by != sby) r = std::max(r, restBound(bx, by + (by < sby ? 1 : -1)));
-                        towardsSensor[unsigned(bx - bxLo) + unsigned(by - byLo) * tableNx] = r;
-                    }
-            }
+            rectangleUsable = sensorBx >= bxLo && sensorBx <= bxHi && sensorBy >= byLo &&
+                              sensorBy <= byHi &&
+                              !boundMayConflict(nearSensor_m, sensor_m.z() - 1e-6);
         }
+    }
+    // towardsSensor: rows, then the blocks of a row, outwards from the sensor's: a block's
+    // rectangle is itself and the rectangles of its neighbours towards the sensor.
+    if (rectangleUsable) {
+        auto outwards = [](int from, int lo, int hi) {
+            std::vector<int> order{from};
+            for (int k = 1; from - k >= lo || from + k <= hi; k++) {
+                if (from - k >= lo) order.push_back(from - k);
+                if (from + k <= hi) order.push_back(from + k);
+            }
+            return order;
+        };
+        towardsSensor.resize(regionBound.size());
+        const std::vector<int> columns = outwards(sensorBx, tableX0, tableX0 + int(tableNx) - 1);
+        for (int by : outwards(sensorBy, tableY0, tableY0 + int(tableNy) - 1))
+            for (int bx : columns) {
+                float r = blockBound(bx, by);
+                if (bx != sensorBx) r = std::max(r, restBound(bx + (bx < sensorBx ? 1 : -1), by));
+                if (by != sensorBy) r = std::max(r, restBound(bx, by + (by < sensorBy ? 1 : -1)));
+                towardsSensor[unsigned(bx - tableX0) + unsigned(by - tableY0) * tableNx] = r;
+            }
     }
 
     // The fan of rays at once (every ray starts at the sensor): a ray is proven clear, and not
@@ -247,9 +259,12 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                        ? tolerantBound_m(max_m)
                        : -std::numeric_limits<double>::infinity();
         };
-        auto& fan = scratch.fan;  // pseudoAngle from the sensor, cell
+        // The rays (in the order of the updated cells) and their keys: pseudoAngle from the
+        // sensor, ray.
+        std::vector<FanRay>& rays = scratch.rays;
+        rays.clear();
+        auto& fan = scratch.fan;
         fan.clear();
-        fan.reserve(updated.size());
         rayState.assign(updated.size(), kWalk);
         double lowestRay_m = sensor_m.z();
         for (size_t i = 0; i < updated.size(); i++) {
@@ -265,8 +280,15 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                                          std::min(tz, sensor_m.z()) - kSlack_m)) {
                 rayState[i] = kClear;  // the rectangle towards the sensor, as the walk's test
             } else if (std::abs(tz) < kMaxHeight_m) {
-                fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(i));
+                fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(rays.size()));
                 lowestRay_m = std::min(lowestRay_m, tz);
+                // One division: the tests below allow far more than its rounding.
+                const double invLength = 1.0 / length;
+                const double slope = (sensor_m.z() - tz) * invLength, ux = dx * invLength,
+                             uy = dy * invLength;
+                rays.push_back({tx, ty, ux, uy, std::abs(ux) + std::abs(uy), length, slope,
+                                std::abs(slope) * 0.7072 * cell, tz, u.ix, u.iy, uint32_t(i),
+                                true});
             }
         }
         // The rays in key order, as the blocks below take them. A scan's come in beam order,
@@ -285,14 +307,22 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             return true;
         };
         if (const size_t n = fan.size(); n > 1) {
-            size_t descents = 0;
-            for (size_t j = 1; j < n; j++) descents += fan[j - 1].first > fan[j].first;
-            if (2 * descents > n) std::reverse(fan.begin(), fan.end());  // mostly clockwise
-            size_t wrap = 0;                                             // after the largest drop
-            double largestDrop = 0;
-            for (size_t j = 1; j < n; j++)
-                if (fan[j - 1].first - fan[j].first > largestDrop)
-                    largestDrop = fan[j - 1].first - fan[j].first, wrap = j;
+            // One pass: the descents, and where the largest drop and the largest rise are (the
+            // largest drop once reversed).
+            size_t descents = 0, drop = 0, rise = 0;
+            double largestDrop = 0, largestRise = 0;
+            for (size_t j = 1; j < n; j++) {
+                const double change = fan[j].first - fan[j - 1].first;
+                descents += change < 0;
+                if (-change > largestDrop) largestDrop = -change, drop = j;
+                if (change > largestRise) largestRise = change, rise = j;
+            }
+            size_t wrap = drop;      // after the largest drop
+            if (2 * descents > n) {  // mostly clockwise
+                std::reverse(fan.begin(), fan.end());
+                largestDrop = largestRise;
+                wrap = n - rise;
+            }
             if (largestDrop > 2) std::rotate(fan.begin(), fan.begin() + wrap, fan.end());
             if (!insertionSort(2 * n)) {
                 std::vector<uint32_t>& start = scratch.start;
@@ -310,41 +340,31 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             }
         }
         constexpr double kNoFastTest = std::numeric_limits<double>::infinity();
+        constexpr size_t kGroup = 8;
         // In key order; lengths and slopes apart for the blocks' loop over rays.
         const size_t nRays = fan.size();
         // fastSlopes: the slope, or +infinity where the fast test below does not apply.
         std::vector<double>& keys = scratch.keys;
         std::vector<double>& lengths = scratch.lengths;
         std::vector<double>& fastSlopes = scratch.fastSlopes;
-        keys.assign(nRays, 0.0);
-        lengths.assign(nRays, 0.0);
-        fastSlopes.assign(nRays, 0.0);
-        std::vector<FanRay>& rays = scratch.rays;
-        rays.assign(nRays, FanRay{});
+        keys.resize(nRays);
+        lengths.resize(nRays);
+        fastSlopes.resize(nRays);
         for (size_t j = 0; j < nRays; j++) {
+            const FanRay& r = rays[fan[j].second];
             keys[j] = fan[j].first;
-            const BinGrid::UpdatedCell& u = updated[fan[j].second];
-            const double tz = u.maxHeight_m;
-            const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
-            const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
-            const double length = std::sqrt(dx * dx + dy * dy);
-            const double slope = (sensor_m.z() - tz) / length, ux = dx / length, uy = dy / length;
-            rays[j] = {tx,
-                       ty,
-                       ux,
-                       uy,
-                       std::abs(ux) + std::abs(uy),
-                       length,
-                       slope,
-                       std::abs(slope) * 0.7072 * cell,
-                       tz,
-                       u.ix,
-                       u.iy,
-                       fan[j].second,
-                       true};
-            lengths[j] = rays[j].length;
-            fastSlopes[j] = rays[j].slope >= 0 ? rays[j].slope : kNoFastTest;
+            lengths[j] = r.length;
+            fastSlopes[j] = r.slope >= 0 ? r.slope : kNoFastTest;
         }
+        const double longestRay_m =
+            nRays > 0 ? *std::max_element(lengths.begin(), lengths.end()) : 0.0;
+        // The steepest fastSlopes of each group of kGroup rays in key order (a last, partial
+        // group is taken ray by ray).
+        std::vector<double>& groupFastSlopes = scratch.groupFastSlopes;
+        groupFastSlopes.assign(nRays / kGroup, 0.0);
+        for (size_t j = 0; j + kGroup <= nRays; j += kGroup)
+            groupFastSlopes[j / kGroup] =
+                *std::max_element(fastSlopes.begin() + j, fastSlopes.begin() + j + kGroup);
         // The ray's lowest height [m] over its samples at distances [from, to] from the target
         // (clipped to the walk's [step, length)), or NaN if there is none.
         auto lowestBetween = [&](const FanRay& r, double from, double to) {
@@ -391,22 +411,35 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             int sx0 = ixLo - w.ix0 + grid.store().originSlotX();
             if (sx0 >= w.nx) sx0 -= w.nx;
             const int firstRun = std::min(ixHi - ixLo, w.nx - sx0);  // cells before the wrap
-            float row[BinGrid::kBlockCells];
+            const int originY = grid.store().originSlotY();
+            const int column0 = ixLo - bx * BinGrid::kBlockCells;  // of the first cell read
+            // Usually the block's rows lie whole in one run: a unit's row is 4 adjacent slots.
+            const bool wholeRows = column0 == 0 && firstRun == BinGrid::kBlockCells;
             for (int iy = iyLo; iy < iyHi; iy++) {
-                int sy = iy - w.iy0 + grid.store().originSlotY();
+                int sy = iy - w.iy0 + originY;
                 if (sy >= w.ny) sy -= w.ny;
-                std::fill(row, row + BinGrid::kBlockCells, -std::numeric_limits<float>::infinity());
-                float* out = row + (ixLo - bx * BinGrid::kBlockCells);
-                const size_t base = size_t(sy) * size_t(w.nx);
-                for (int k = 0; k < firstRun; k++) out[k] = index.cellMaxHeight_m(base + sx0 + k);
-                for (int k = firstRun; k < ixHi - ixLo; k++)
-                    out[k] = index.cellMaxHeight_m(base + (k - firstRun));
+                const size_t base = size_t(sy) * size_t(w.nx), first = base + size_t(sx0);
                 float* unitRow = units + ((iy - by * BinGrid::kBlockCells) >> kUnitShift) * kUnits;
-                for (int c = 0; c < kUnits; c++)
-                    for (int k = 0; k < kUnitCells; k++)
-                        unitRow[c] = std::max(unitRow[c], row[c * kUnitCells + k]);
+                if (wholeRows) {
+                    for (int c = 0; c < kUnits; c++) {
+                        float m = unitRow[c];
+                        for (int k = 0; k < kUnitCells; k++)
+                            m = std::max(m,
+                                         index.cellMaxHeight_m(first + size_t(c * kUnitCells + k)));
+                        unitRow[c] = m;
+                    }
+                    continue;
+                }
+                for (int k = 0; k < ixHi - ixLo; k++) {
+                    const size_t slot =
+                        k < firstRun ? first + size_t(k) : base + size_t(k - firstRun);
+                    float& u = unitRow[(column0 + k) >> kUnitShift];
+                    u = std::max(u, index.cellMaxHeight_m(slot));
+                }
             }
-            for (const float b : units) unitLimits.push_back(roundUp(limit_m(b)));
+            unitLimits.resize(size_t(t) + kUnits * kUnits);
+            for (int k = 0; k < kUnits * kUnits; k++)
+                unitLimits[size_t(t) + size_t(k)] = roundUp(limit_m(units[k]));
             return &unitLimits[size_t(t)];
         };
         // Whether the ray may meet a conflicting bin in block (bx, by), over which it passes
@@ -485,15 +518,16 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
                 const double near_m = std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m;
                 const double far_m = std::sqrt(farX * farX + farY * farY) + kSlack_m;
-                // A ray reaching beyond the block (length >= far_m + step) and rising towards
-                // the sensor passes over it no lower than sz - slope far_m + slope inCell_m
-                // (tz + slope length is sz): clear if its slope is at most maxSlope (1e-8 m
-                // spare for the rounding of the quotient and of tz + slope d).
+                // A ray rising towards the sensor passes over the block no lower than
+                // sz - slope far_m + slope inCell_m (its samples there lie at most far_m from
+                // the sensor, and tz + slope length is sz), wherever it ends: clear if its slope
+                // is at most maxSlope (1e-8 m spare for the rounding of the quotient and of
+                // tz + slope d).
                 const double maxSlope =
                     (sz - blockLimit_m + minConflictMargin - 1e-8) / (far_m - inCell_m);
-                const double reachesBeyond_m = far_m + step;
                 // No sample of a ray shorter than this lies in the block (1e-9 m spare).
                 const double nearStep_m = near_m + step - 1e-9;
+                if (longestRay_m < nearStep_m) continue;  // beyond every ray
                 const double cx = (bx + 0.5) * block_m, cy = (by + 0.5) * block_m;
                 // The rays within the block's angle: keys in [lo, hi], which may pass key 0 (the
                 // +x direction) on either side; all of them near the sensor.
@@ -531,17 +565,25 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 for (const auto& range : ranges)
                     for (size_t j = range[0]; j < range[1]; j++) {
+                        // A whole group of rays at once where none is steeper than maxSlope.
+                        if (j % kGroup == 0 && j + kGroup <= range[1] &&
+                            groupFastSlopes[j / kGroup] <= maxSlope) {
+                            j += kGroup - 1;
+                            continue;
+                        }
                         // On the line, a sample at distance d from the target lies length - d
                         // from the sensor: none in the block if length < nearStep_m.
                         const double length = lengths[j];
                         if (length < nearStep_m) continue;
-                        if (length >= reachesBeyond_m && fastSlopes[j] <= maxSlope) continue;
-                        FanRay& r = rays[j];
+                        if (fastSlopes[j] <= maxSlope) continue;
+                        FanRay& r = rays[fan[j].second];
                         if (!r.clear) continue;  // already to be walked
-                        // Both bounds hold: the larger one.
+                        // Both bounds hold: the larger one, the second only where the first
+                        // does not clear the ray (a NaN first one: no sample in the block).
+                        const double between_m = lowestBetween(r, length - far_m, length - near_m);
+                        if (!(blockLimit_m > between_m + minConflictMargin)) continue;
                         const double low_m =
-                            std::max(lowestBetween(r, length - far_m, length - near_m),
-                                     lowestOver(r, cx, cy, 0.5 * block_m));
+                            std::max(between_m, lowestOver(r, cx, cy, 0.5 * block_m));
                         if (blockLimit_m > low_m + minConflictMargin &&
                             mayConflictInBlock(r, slot, bx, by, low_m))
                             r.clear = false;
