@@ -613,3 +613,32 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
     EXPECT_EQ(fused->visibilityStats().binsWeakened, twoSteps->visibilityStats().binsWeakened);
     EXPECT_TRUE(binBytes(fused->grid()) == binBytes(twoSteps->grid()));
 }
+
+TEST(BinGrid, PoseVariancesFewerThanThePointsAreAnErrorNamingThem) {
+    // The pose parts travel beside map-frame points (PoseVariances): a shorter list would read
+    // past its end. Refused before any bin changes.
+    BinGrid g(0.1);
+    g.reset(0.1, CellWindow{0, 0, 4, 4});
+    const PointsWithCov pts{pointAt(0.05, 0.05, 0.01, 0.002), pointAt(0.15, 0.05, 0.02, 0.002)};
+    PoseVariances pose;
+    pose.height_m2 = {1e-6f, 1e-6f};
+    pose.horizontal_m2 = {1e-6f};
+    try {
+        g.insertPoints(pts, BinUpdateParams{}, std::numeric_limits<double>::infinity(), &pose);
+        FAIL() << "no error";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("pose variances"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(g.binCount(), 0u);
+    pose.horizontal_m2.push_back(4e-6f);
+    EXPECT_EQ(g.insertPoints(pts, BinUpdateParams{}, std::numeric_limits<double>::infinity(), &pose)
+                  .accepted,
+              2u);
+    g.forEachBin(0, 0, [](const Bin& b) {
+        EXPECT_EQ(b.poseHeightSigmaCode, multibin::poseSigmaCode(1e-6f));
+        EXPECT_EQ(b.poseHorizontalSigmaCode, multibin::poseSigmaCode(1e-6f));
+    });
+    g.forEachBin(1, 0, [](const Bin& b) {
+        EXPECT_EQ(b.poseHorizontalSigmaCode, multibin::poseSigmaCode(4e-6f));
+    });
+}
