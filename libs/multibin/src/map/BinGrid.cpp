@@ -59,10 +59,7 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
     } else {
         fuse(bin.height_m, bin.variance_m2, other.height_m, other.variance_m2);
         mergePlaneMoments(bin.plane, other.plane);
-        bin.poseHeightSigmaCode =
-            leastPoseSigmaCode(bin.poseHeightSigmaCode, other.poseHeightSigmaCode);
-        bin.poseHorizontalSigmaCode =
-            leastPoseSigmaCode(bin.poseHorizontalSigmaCode, other.poseHorizontalSigmaCode);
+        lowerPoseSigmaCodes(bin, other.poseHeightSigmaCode, other.poseHorizontalSigmaCode);
         bin.certainty += other.certainty;
         util::addSaturating(bin.pointCount, other.pointCount);
     }

@@ -172,12 +172,16 @@ inline uint8_t leastPoseSigmaCode(uint8_t a, uint8_t b) {
     return a == 0 ? b : b == 0 ? a : std::min(a, b);
 }
 
+/** Lowers `bin`'s two codes to these where they are less (0: not known, changes nothing). */
+inline void lowerPoseSigmaCodes(BinEstimate& bin, uint8_t heightCode, uint8_t horizontalCode) {
+    bin.poseHeightSigmaCode = leastPoseSigmaCode(bin.poseHeightSigmaCode, heightCode);
+    bin.poseHorizontalSigmaCode = leastPoseSigmaCode(bin.poseHorizontalSigmaCode, horizontalCode);
+}
+
 /** Points whose pose parts of the height and horizontal variance are at least these [m^2] were
  * fused into `bin` (NaN: not known, e.g. points given in the map frame). */
 inline void notePoseVariance(BinEstimate& bin, float height_m2, float horizontal_m2) {
-    bin.poseHeightSigmaCode = leastPoseSigmaCode(bin.poseHeightSigmaCode, poseSigmaCode(height_m2));
-    bin.poseHorizontalSigmaCode =
-        leastPoseSigmaCode(bin.poseHorizontalSigmaCode, poseSigmaCode(horizontal_m2));
+    lowerPoseSigmaCodes(bin, poseSigmaCode(height_m2), poseSigmaCode(horizontal_m2));
 }
 /** @} */
 
