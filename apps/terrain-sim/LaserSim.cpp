@@ -55,7 +55,9 @@ mrpt::obs::CObservation2DRangeScan::Ptr LaserSim::scan(const mrpt::poses::CPose3
         }
         const double rt = t.trueRange_m;
         // Optional errors draw from the stream only when on, so matched runs keep their bytes.
-        double r = rt + bias_[t.surface] + cfg_.sigma(rt) * z * cfg_.errors.tailFactor(rng);
+        const double scale = cfg_.errors.drawnErrorScale;  // 1: the sum below as it always was
+        double r = rt + scale * bias_[t.surface] +
+                   scale * cfg_.sigma(rt) * z * cfg_.errors.tailFactor(rng);
         if (cfg_.rangeBias0_m != 0.0 || cfg_.rangeBiasSlope != 0.0)
             r += cfg_.rangeBias0_m + cfg_.rangeBiasSlope * rt;
         double factor = 1.0;
@@ -65,7 +67,8 @@ mrpt::obs::CObservation2DRangeScan::Ptr LaserSim::scan(const mrpt::poses::CPose3
         }
         if (t.restored < cfg_.darkRestored && !t.outlier) {
             t.dark = true;
-            r += cfg_.darkBias_m + cfg_.darkExtraSigma_m * gauss(rng);
+            r += cfg_.errors.drawnErrorScale *
+                 (cfg_.darkBias_m + cfg_.darkExtraSigma_m * gauss(rng));
         }
         range[k] = r;
     }

@@ -85,6 +85,13 @@ void applyIndependentNoise(ScenarioConfig& cfg) {
     cfg.stereo.cyError_px = 0.5;
 }
 
+void applyExactMeasurements(ScenarioConfig& cfg) {
+    cfg.laser.errors.drawnErrorScale = 0;
+    cfg.stereo.errors.drawnErrorScale = 0;
+    cfg.stereo.haloWidth_px = 0;
+    cfg.trajectory.poseErrorScale = 0;
+}
+
 ScenarioSummary runScenario(const ScenarioConfig& cfg) {
     cfg.laser.errors.validate("laser");
     cfg.stereo.errors.validate("stereo");

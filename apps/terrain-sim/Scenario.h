@@ -40,6 +40,12 @@ struct ScenarioSummary {
  * +0.5 px in u and v). */
 void applyIndependentNoise(ScenarioConfig& cfg);
 
+/** Makes every measurement and pose exact (`--noise exact`): no range or disparity noise, no
+ * per-surface or dark-return range bias, no foreground fattening at stereo depth edges, the
+ * estimated poses equal to the true ones; the written sigmas, pose covariances and ini unchanged,
+ * so a map assumes its usual noise. What a map then misses is what the sensors never saw. */
+void applyExactMeasurements(ScenarioConfig& cfg);
+
 /** Builds the terrain, simulates the scenario and writes PREFIX.rawlog, PREFIX.simplemap,
  * PREFIX_gt.asc, PREFIX.ini and PREFIX_path.txt. Throws std::exception with a one-line message on
  * bad configuration or I/O failure. */

@@ -19,6 +19,10 @@ struct ErrorShape {
      * span) (range for the laser, disparity for stereo). */
     double outlierFraction = 0.0;
     double outlierSpan = 0.5;
+    /** Scale of every drawn measurement error (noise, per-surface and dark-return bias): 1, or
+     * 0 for exact measurements (`--noise exact`). The written sigmas stay the same; the draws
+     * still happen, so the same seed gives the same scene with the errors removed. */
+    double drawnErrorScale = 1.0;
 
     bool heavyTails() const { return tailDof > 0; }
     void validate(const std::string& what) const {

@@ -103,7 +103,8 @@ StereoRender StereoSim::render(const mrpt::poses::CPose3D& robot, std::mt19937_6
     for (int v = 0; v < H; ++v)
         for (int u = 0; u < W; ++u) {
             // Optional errors draw from the stream only when on, so matched runs keep their bytes.
-            const double noise = cfg_.matchingSigma_px * gauss(rng) * cfg_.errors.tailFactor(rng);
+            const double noise = cfg_.errors.drawnErrorScale * cfg_.matchingSigma_px * gauss(rng) *
+                                 cfg_.errors.tailFactor(rng);
             const double d0 = dt.at<float>(v, u);
             if (d0 <= 0 || textureless.at<uint8_t>(v, u)) continue;
             double dmax = d0;

@@ -30,8 +30,9 @@ PoseErrorModel walkErrorModel() {
 namespace {
 
 /** Draws the pose errors along the frames and fills the estimates. */
-void applyErrors(std::vector<Frame>& frames, const PoseErrorModel& model, double rate_hz,
-                 std::mt19937_64& rng) {
+void applyErrors(std::vector<Frame>& frames, const PoseErrorModel& model,
+                 const TrajectoryOptions& o, std::mt19937_64& rng) {
+    const double rate_hz = o.laserRate_hz;
     std::normal_distribution<double> gauss(0.0, 1.0);
     const int period = model.correctionPeriod_s > 0
                            ? std::max(1, int(std::lround(model.correctionPeriod_s * rate_hz)))
@@ -40,9 +41,9 @@ void applyErrors(std::vector<Frame>& frames, const PoseErrorModel& model, double
     for (size_t k = 0; k < frames.size(); ++k) {
         const int since = static_cast<int>(k % period);
         if (since == 0)
-            for (int i = 0; i < 6; ++i) e[i] = model.sigma0[i] * gauss(rng);
+            for (int i = 0; i < 6; ++i) e[i] = o.poseErrorScale * model.sigma0[i] * gauss(rng);
         else
-            for (int i = 0; i < 6; ++i) e[i] += model.sigmaStep[i] * gauss(rng);
+            for (int i = 0; i < 6; ++i) e[i] += o.poseErrorScale * model.sigmaStep[i] * gauss(rng);
         const auto& p = frames[k].truth;
         frames[k].estimate.mean =
             mrpt::poses::CPose3D(p.x() + e[0], p.y() + e[1], p.z() + e[2], p.yaw() + e[3],
@@ -74,7 +75,7 @@ std::vector<Frame> mockupTrajectory(const Terrain& terrain, const TrajectoryOpti
         f.stereo = k % every == 0;
         frames.push_back(f);
     }
-    applyErrors(frames, mockupErrorModel(), o.laserRate_hz, rng);
+    applyErrors(frames, mockupErrorModel(), o, rng);
     return frames;
 }
 
@@ -118,7 +119,7 @@ std::vector<Frame> walkTrajectory(const Terrain& terrain, const TrajectoryOption
         f.stereo = k % every == 0;
         frames.push_back(f);
     }
-    applyErrors(frames, walkErrorModel(), o.laserRate_hz, rng);
+    applyErrors(frames, walkErrorModel(), o, rng);
     return frames;
 }
 

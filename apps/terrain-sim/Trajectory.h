@@ -44,6 +44,9 @@ struct TrajectoryOptions {
     double endMargin_m = 0.1;    //!< walk ends this far beyond the tiles [m]; mockup: stops
                                  //!< 0.3 m before their far edge
     int maxFrames = 0;           //!< if > 0, stop after this many frames (tests, previews)
+    /** Scale of the drawn pose errors: 1, or 0 for exact poses (`--noise exact`; the written
+     * covariances unchanged, the draws still made). */
+    double poseErrorScale = 1.0;
 };
 
 /** The paper's mock-up set-up: the rig held by an industrial arm at constant height above the

@@ -30,8 +30,10 @@ const char* kUsage =
     "  --max-frames N       stop after N frames (default: the whole trajectory)\n"
     "Sensor errors the library's models do not describe (doc/terrain-sim.md; default: none,\n"
     "the noise drawn from the models' own sigmas with exact calibration):\n"
-    "  --noise matched|independent  independent: all of the below at their stated values\n"
-    "                       (doc/independent-evaluation.md); the options below override it\n"
+    "  --noise matched|independent|exact  independent: all of the below at their stated\n"
+    "                       values (doc/independent-evaluation.md); the options below override\n"
+    "                       it. exact: no noise, bias, stereo fattening or pose error at all\n"
+    "                       (the written sigmas and pose PDFs unchanged)\n"
     "  --tail-dof N         Student-t noise with N > 2 dof at the same sigma, laser and stereo\n"
     "                       (0: Gaussian)\n"
     "  --outliers F         share of laser ranges and stereo disparities replaced by the true\n"
@@ -105,8 +107,11 @@ int main(int argc, char** argv) {
             const std::string v = argv[i + 1];
             if (v == "independent")
                 terrain_sim::applyIndependentNoise(cfg);
+            else if (v == "exact")
+                terrain_sim::applyExactMeasurements(cfg);
             else if (v != "matched")
-                throw std::invalid_argument("--noise: '" + v + "' is not matched or independent");
+                throw std::invalid_argument("--noise: '" + v +
+                                            "' is not matched, independent or exact");
         }
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];

@@ -6,6 +6,7 @@
 
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
@@ -26,21 +27,35 @@ struct SurfaceAccuracy {
     size_t drawn = 0;                //!< points drawn to find `points` where all answer
 };
 
+/** One scored query point: each method's error [m] and the truth's relief in its cell. */
+struct QueryPointErrors {
+    std::array<double, 4> error_m;  //!< floor, nearest, bilinear, heightAt: answer - truth [m]
+    double cellRelief_m;            //!< highest minus lowest truth sample of the point's cell [m]
+    double x_m, y_m, truth_m;       //!< the query point and the true height there [m]
+};
+
 /** `count` uniformly random points in [x0, x1) x [y0, y1) (seed `seed`) where the truth, every
  * method and the four cells around the point (for bilinear) have a height. `truth(x, y)` is the
  * true height (NaN if unknown); the cell mean is the mean of `truth` over a 10 x 10 grid of
  * sub-samples of the cell (NaN if any is). */
-inline SurfaceAccuracy measureSurfaceAccuracy(
-    const mrpt::maps::CMultiBinElevationMap& map,
-    const std::function<double(double, double)>& truth, double x0, double x1, double y0, double y1,
-    size_t count, unsigned seed, std::vector<std::array<double, 4>>* errors = nullptr) {
+inline SurfaceAccuracy measureSurfaceAccuracy(const mrpt::maps::CMultiBinElevationMap& map,
+                                              const std::function<double(double, double)>& truth,
+                                              double x0, double x1, double y0, double y1,
+                                              size_t count, unsigned seed,
+                                              std::vector<QueryPointErrors>* errors = nullptr) {
     const double s = map.dem_get_resolution();
     auto cellIndex = [s](double v) { return static_cast<int>(std::floor(v / s)); };
-    auto cellMean = [&](int ix, int iy) {
-        double sum = 0;
+    // The cell's mean of the truth; also its relief (max - min of the samples).
+    auto cellMean = [&](int ix, int iy, double& relief_m) {
+        double sum = 0, lo = INFINITY, hi = -INFINITY;
         for (int j = 0; j < 10; j++)
-            for (int i = 0; i < 10; i++)
-                sum += truth((ix + (i + 0.5) / 10) * s, (iy + (j + 0.5) / 10) * s);
+            for (int i = 0; i < 10; i++) {
+                const double t = truth((ix + (i + 0.5) / 10) * s, (iy + (j + 0.5) / 10) * s);
+                sum += t;
+                lo = std::min(lo, t);
+                hi = std::max(hi, t);
+            }
+        relief_m = hi - lo;
         return sum / 100;
     };
     auto cellValue = [&](int ix, int iy, double& h) {
@@ -57,7 +72,8 @@ inline SurfaceAccuracy measureSurfaceAccuracy(
         const double x = ux(rng), y = uy(rng);
         const double t = truth(x, y);
         if (!std::isfinite(t)) continue;
-        const double floorValue = cellMean(cellIndex(x), cellIndex(y));
+        double relief_m;
+        const double floorValue = cellMean(cellIndex(x), cellIndex(y), relief_m);
         double hNear, sNear, hAt, sAt;
         if (!std::isfinite(floorValue) || !map.cellHeight(x, y, hNear, sNear) ||
             !map.heightAt(x, y, hAt, sAt))
@@ -73,7 +89,7 @@ inline SurfaceAccuracy measureSurfaceAccuracy(
             (1 - fy) * ((1 - fx) * h00 + fx * h10) + fy * ((1 - fx) * h01 + fx * h11);
         const double e[4] = {floorValue - t, hNear - t, hBilinear - t, hAt - t};
         for (int k = 0; k < 4; k++) se[k] += e[k] * e[k];
-        if (errors) errors->push_back({e[0], e[1], e[2], e[3]});
+        if (errors) errors->push_back({{e[0], e[1], e[2], e[3]}, relief_m, x, y, t});
         if (std::abs(e[3]) <= 3 * sAt) within++;
         if (std::abs(e[1]) <= 3 * sNear) nearestWithin++;
         a.points++;

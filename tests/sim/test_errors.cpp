@@ -324,3 +324,53 @@ TEST(SensorErrors, IndependentNoiseKeepsTheWrittenIni) {
     EXPECT_DOUBLE_EQ(independent.stereo.baselineError_m, 0.0003);
     EXPECT_EQ(matched.laser.errors.tailDof, 0);  // the default draws the model's Gaussian
 }
+
+// --noise exact: the same ini, every laser range exactly the ray-cast one (no noise, no surface
+// or dark-return bias), and the estimated poses equal to the true ones with the matched run's
+// covariances; the matched run's ranges and poses are off by their noise.
+TEST(SensorErrors, ExactMeasurementsKeepTheIniAndTheirErrorsAreZero) {
+    ScenarioConfig matched;
+    matched.terrainFiles = {"x.asc"};
+    ScenarioConfig exact = matched;
+    applyExactMeasurements(exact);
+    EXPECT_EQ(mapperIni(matched), mapperIni(exact));
+
+    auto largestRangeError_m = [](const LaserConfig& cfg) {
+        const Terrain t = flatGround();
+        const SurfaceTexture tex(t, 3, 0);
+        const LaserSim laser(cfg, t, tex, 3);
+        std::mt19937_64 rng(103);
+        std::vector<BeamTruth> truth;
+        double largest = 0;
+        for (int s = 0; s < 20; ++s) {
+            const auto scan = laser.scan(mrpt::poses::CPose3D(0.001 * s, 0, 0, 0.01 * s, 0, 0),
+                                         syntheticStamp(0), rng, &truth);
+            for (int k = 0; k < 683; ++k)
+                if (truth[k].surface >= 0 && !truth[k].dropout && scan->getScanRangeValidity(k))
+                    largest = std::max(
+                        largest, std::abs(scan->getScanRange(k) - truth[k].trueRange_m));
+        }
+        return largest;
+    };
+    EXPECT_LT(largestRangeError_m(exact.laser), 1e-6);  // float ranges
+    EXPECT_GT(largestRangeError_m(matched.laser), 1e-3);
+
+    const Terrain t = flatGround();
+    for (const ScenarioConfig* c : {&matched, &exact}) {
+        TrajectoryOptions o = c->trajectory;
+        o.maxFrames = 40;
+        std::mt19937_64 rng(5);
+        const auto frames = walkTrajectory(t, o, rng);
+        ASSERT_EQ(frames.size(), 40u);
+        double largest = 0;
+        for (const Frame& f : frames) {
+            const auto d = f.estimate.mean.asVectorVal() - f.truth.asVectorVal();
+            largest = std::max(largest, d.array().abs().maxCoeff());
+            EXPECT_GT(f.estimate.cov(0, 0), 0.0);  // the written covariance stays
+        }
+        if (c == &exact)
+            EXPECT_LT(largest, 1e-12);
+        else
+            EXPECT_GT(largest, 1e-3);
+    }
+}
