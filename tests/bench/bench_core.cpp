@@ -15,6 +15,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/BinGrid.h"
+#include "multibin/map/CellSurface.h"
 #include "multibin/map/VisibilityConstraint.h"
 
 using namespace multibin;
@@ -406,5 +407,41 @@ static void BM_Memory(benchmark::State& state) {
     state.counters["bytes_per_bin"] = double(bytes) / double(bins);
 }
 BENCHMARK(BM_Memory)->Arg(0)->Arg(1)->Arg(2)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+/** Height queries at random points of a rough slope, 20 mm cells, 30 points a cell: /0 the cell's
+ * value (surfaceAt, what cellHeight answers), /1 the sub-cell surface (heightAt, the planes of
+ * the four cells around the point blended). Items: queries. */
+static void BM_HeightQuery(benchmark::State& state) {
+    const double cell_m = 0.02;
+    BinGrid grid(cell_m);
+    grid.reset(cell_m, CellWindow{0, 0, 50, 50});
+    const BinUpdateParams params;
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::normal_distribution<double> n(0.0, 0.002);
+    PointsWithCov pts;
+    for (int i = 0; i < 30 * 2500; i++) {
+        const double x = u(rng), y = u(rng);
+        const double z = 0.3 * x + 0.02 * std::sin(20 * y) + n(rng);
+        pts.push_back(
+            {Eigen::Vector3f(float(x), float(y), float(z)), {1e-6f, 0, 0, 1e-6f, 0, 4e-6f}});
+    }
+    grid.insertPoints(pts, params);
+    std::vector<std::pair<double, double>> queries(10000);
+    for (auto& q : queries) q = {0.05 + 0.9 * u(rng), 0.05 + 0.9 * u(rng)};
+    const bool subCell = state.range(0) == 1;
+    for (auto _ : state) {
+        double sum = 0;
+        for (const auto& [x, y] : queries) {
+            CellSurface s;
+            const bool ok = subCell ? heightAt(grid, nullptr, x, y, params, true, s)
+                                    : surfaceAt(grid, nullptr, x, y, params, true, s);
+            sum += ok ? s.height_m : 0.0;
+        }
+        benchmark::DoNotOptimize(sum);
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(queries.size()));
+}
+BENCHMARK(BM_HeightQuery)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

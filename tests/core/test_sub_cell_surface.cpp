@@ -81,7 +81,10 @@ TEST(SubCellSurface, SigmaGrowsTowardsTheCellEdgeOnASlope) {
     ASSERT_TRUE(map.heightAt(cx + 0.0099, cy + 0.0099, he, se));
     EXPECT_NEAR(hc, 0.5 * cx, 3 * sc);
     EXPECT_NEAR(he, 0.5 * (cx + 0.0099), 3 * se);
-    EXPECT_NEAR(he - hc, 0.5 * 0.0099, 0.001) << "the slope inside the cell";
+    // The slope inside the cell: the cell's constant would be 5 mm off at its corner. (Not
+    // he - hc: the corner's answer blends the planes of the four cells around it, so the
+    // difference carries the centre's noise too.)
+    EXPECT_NEAR(he, 0.5 * (cx + 0.0099), 0.002) << "the slope inside the cell";
     EXPECT_GT(se, sc);
 }
 

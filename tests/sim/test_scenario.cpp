@@ -212,7 +212,7 @@ TEST(TerrainSimCli, BadArgumentsGiveOneLineErrorAndExit1) {
          "larger than the terrain"},
         {"--terrain " + board + " --scenario walk --out /nonexistent/dir/x", "cannot write"},
         {"--terrain " + board + " --scenario walk --noise loud --out x",
-         "not matched or independent"},
+         "not matched, independent or exact"},
         {"--terrain " + board + " --scenario walk --tail-dof 2 --out x", "--tail-dof"},
         {"--terrain " + board + " --scenario walk --outliers 1.5 --out x", "--outliers"},
         {"--terrain " + board + " --scenario walk --laser-range-bias 0.01 --out x",

@@ -218,10 +218,10 @@ bool gradientOf(const PlaneMoments& m, double points, Gradient& g) {
     return true;
 }
 
-/** heightAt on one grid. */
-bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& p,
-                   bool reliefSigma, CellSurface& out) {
-    const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
+/** The plane of cell (ix, iy) at (x_m, y_m), which may lie outside the cell: the surface
+ * that holds the point, its gradient from the cell's and the agreeing neighbours' points. */
+bool planeOfCellAt(const BinGrid& grid, int ix, int iy, double x_m, double y_m,
+                   const BinUpdateParams& p, CellSurface& out) {
     CellPlane planes[kMaxSurfaces];
     const int count = cellPlanes(grid, ix, iy, p, planes);
     if (count == 0) return false;
@@ -276,6 +276,42 @@ bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateP
     out.poseVariance_m2 =
         own.surface.poseVariance_m2 +
         poseVariance_m2(own.poseHorizontalSigmaCode) * (g.gx * g.gx + g.gy * g.gy);
+    return true;
+}
+
+/** heightAt on one grid: the planes of the four cells around the point (whose centres it lies
+ * between) evaluated at the point and blended with bilinear weights, a neighbour's only where it
+ * agrees with the point's own cell within 3 sigma of the planes (never across a step). One
+ * cell's plane carries its few points' noise; the blend averages four such estimates, as
+ * bilinear interpolation of cell values does, while each keeps its slope. */
+bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& p,
+                   bool reliefSigma, CellSurface& out) {
+    const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
+    if (!planeOfCellAt(grid, ix, iy, x_m, y_m, p, out)) return false;
+    const double s = grid.cellSize_m();
+    const int bx = grid.cellIndex(x_m - 0.5 * s), by = grid.cellIndex(y_m - 0.5 * s);
+    const double fx = (x_m - grid.cellCenter_m(bx)) / s, fy = (y_m - grid.cellCenter_m(by)) / s;
+    const CellSurface own = out;
+    double weightSum = 0, heightSum = 0, varianceSum = 0;
+    for (int j = 0; j <= 1; j++)
+        for (int i = 0; i <= 1; i++) {
+            const double w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
+            CellSurface c = own;
+            if (bx + i != ix || by + j != iy) {
+                if (!planeOfCellAt(grid, bx + i, by + j, x_m, y_m, p, c)) continue;
+                const double d = c.height_m - own.height_m;
+                if (d * d > 9.0 * (c.variance_m2 + own.variance_m2)) continue;
+            }
+            weightSum += w;
+            heightSum += w * c.height_m;
+            // The planes share points (each one's window holds its neighbours'): the weighted
+            // mean of their variances, not the variance of a mean of independent estimates.
+            varianceSum += w * c.variance_m2;
+        }
+    if (weightSum > 0) {  // 0 only where the own cell's weight is 0 and no neighbour agrees
+        out.height_m = heightSum / weightSum;
+        out.variance_m2 = varianceSum / weightSum;
+    }
     if (reliefSigma) addOtherBinsSpread(grid, ix, iy, out);
     return true;
 }
