@@ -88,6 +88,31 @@ TEST(SubCellSurface, SigmaGrowsTowardsTheCellEdgeOnASlope) {
     EXPECT_GT(se, sc);
 }
 
+TEST(SubCellSurface, ContinuousAcrossCellEdgesOnOneSurface) {
+    // A gentle noisy slope: each cell's plane carries its points' noise, so the planes of two
+    // neighbouring cells disagree at their common edge by about a millimetre. heightAt blends the
+    // planes of the four cells around the point, the same four on both sides of an edge, so its
+    // answer does not jump there; the gap left is the slope over 2 um.
+    CMultiBinElevationMap map = fixedMap();
+    map.insertPoints(samplePoints(10, 6, [](double x, double y) { return 0.2 * x + 0.1 * y; }));
+    double largestJump_m = 0, sum2 = 0;
+    int edges = 0;
+    for (int i = 3; i < 27; i++)
+        for (const double y : {0.1049, 0.2131, 0.3877, 0.4513}) {
+            const double edge = i * kCell_m;
+            double hl, hr, sl, sr;
+            ASSERT_TRUE(map.heightAt(edge - 1e-6, y, hl, sl));
+            ASSERT_TRUE(map.heightAt(edge + 1e-6, y, hr, sr));
+            largestJump_m = std::max(largestJump_m, std::abs(hr - hl));
+            sum2 += (hr - hl) * (hr - hl);
+            edges++;
+            EXPECT_NEAR(sl, sr, 1e-4) << "x = " << edge << ", y = " << y;
+        }
+    std::cout << "largest jump at a cell edge " << 1e3 * largestJump_m << " mm, rms "
+              << 1e3 * std::sqrt(sum2 / edges) << " mm\n";
+    EXPECT_LT(largestJump_m, 1e-5);
+}
+
 TEST(SubCellSurface, NeverAcrossAStep) {
     // A 10 cm step on a cell boundary (x = 0.3) and one inside a cell (x = 0.511): queried up
     // to 3 mm (3 horizontal point sigmas) from the step, each side keeps its own surface, where
