@@ -218,12 +218,36 @@ bool gradientOf(const PlaneMoments& m, double points, Gradient& g) {
     return true;
 }
 
+/** The surfaces of the 4 x 4 cells from (ix0, iy0): every cell a heightAt query reads (the four
+ * cells around the point and their neighbours), each computed once. */
+class PlanesAround {
+public:
+    PlanesAround(const BinGrid& grid, int ix0, int iy0, const BinUpdateParams& p)
+        : m_ix0(ix0), m_iy0(iy0) {
+        for (int j = 0; j < kSide; j++)
+            for (int i = 0; i < kSide; i++)
+                m_count[j][i] = cellPlanes(grid, ix0 + i, iy0 + j, p, m_planes[j][i]);
+    }
+    /** The planes of cell (ix, iy), which must lie in the 4 x 4; returns how many. */
+    int of(int ix, int iy, const CellPlane*& planes) const {
+        planes = m_planes[iy - m_iy0][ix - m_ix0];
+        return m_count[iy - m_iy0][ix - m_ix0];
+    }
+
+private:
+    static constexpr int kSide = 4;
+    int m_ix0, m_iy0;
+    CellPlane m_planes[kSide][kSide][kMaxSurfaces];
+    int m_count[kSide][kSide];
+};
+
 /** The plane of cell (ix, iy) at (x_m, y_m), which may lie outside the cell: the surface
- * that holds the point, its gradient from the cell's and the agreeing neighbours' points. */
-bool planeOfCellAt(const BinGrid& grid, int ix, int iy, double x_m, double y_m,
-                   const BinUpdateParams& p, CellSurface& out) {
-    CellPlane planes[kMaxSurfaces];
-    const int count = cellPlanes(grid, ix, iy, p, planes);
+ * that holds the point, its gradient from the cell's and the agreeing neighbours' points.
+ * `around` holds the cell and its eight neighbours. */
+bool planeOfCellAt(const BinGrid& grid, const PlanesAround& around, int ix, int iy, double x_m,
+                   double y_m, CellSurface& out) {
+    const CellPlane* planes;
+    const int count = around.of(ix, iy, planes);
     if (count == 0) return false;
     const double s = grid.cellSize_m();
     const double qx = x_m - grid.cellCenter_m(ix), qy = y_m - grid.cellCenter_m(iy);
@@ -238,9 +262,8 @@ bool planeOfCellAt(const BinGrid& grid, int ix, int iy, double x_m, double y_m,
     double windowPoints = own.points;
     for (int dy = -1; dy <= 1; dy++)
         for (int dx = -1; dx <= 1; dx++) {
-            CellPlane nb[kMaxSurfaces];
-            const int nbCount =
-                (dx == 0 && dy == 0) ? 0 : cellPlanes(grid, ix + dx, iy + dy, p, nb);
+            const CellPlane* nb = nullptr;
+            const int nbCount = (dx == 0 && dy == 0) ? 0 : around.of(ix + dx, iy + dy, nb);
             for (int k = 0; k < nbCount; k++) {
                 if (!(nb[k].moments.weight > 0)) continue;
                 const double ex = dx * s + nb[k].moments.mx_m - m.mx_m;
@@ -287,9 +310,10 @@ bool planeOfCellAt(const BinGrid& grid, int ix, int iy, double x_m, double y_m,
 bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& p,
                    bool reliefSigma, CellSurface& out) {
     const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
-    if (!planeOfCellAt(grid, ix, iy, x_m, y_m, p, out)) return false;
     const double s = grid.cellSize_m();
     const int bx = grid.cellIndex(x_m - 0.5 * s), by = grid.cellIndex(y_m - 0.5 * s);
+    const PlanesAround around(grid, bx - 1, by - 1, p);
+    if (!planeOfCellAt(grid, around, ix, iy, x_m, y_m, out)) return false;
     const double fx = (x_m - grid.cellCenter_m(bx)) / s, fy = (y_m - grid.cellCenter_m(by)) / s;
     const CellSurface own = out;
     double weightSum = 0, heightSum = 0, varianceSum = 0;
@@ -298,7 +322,7 @@ bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateP
             const double w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
             CellSurface c = own;
             if (bx + i != ix || by + j != iy) {
-                if (!planeOfCellAt(grid, bx + i, by + j, x_m, y_m, p, c)) continue;
+                if (!planeOfCellAt(grid, around, bx + i, by + j, x_m, y_m, c)) continue;
                 const double d = c.height_m - own.height_m;
                 if (d * d > 9.0 * (c.variance_m2 + own.variance_m2)) continue;
             }
