@@ -257,7 +257,8 @@ public:
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
     /** Height [m] and sigma [m] of the sub-cell surface at (x, y): the plane of the cell's
      * surface evaluated at the point, its gradient from the cell's points and those of the
-     * neighbouring cells on the same surface (never across a step); sigma grows towards the
+     * neighbouring cells on the same surface, blended with the planes of the cells around the
+     * point where they agree (never across a step); sigma grows towards the
      * cell's edges with the gradient's uncertainty (multibin::heightAt in CellSurface.h,
      * doc/sub-cell-surface.md). False if unobserved. */
     bool heightAt(double x_m, double y_m, double& height_m, double& sigma_m) const;

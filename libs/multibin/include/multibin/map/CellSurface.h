@@ -65,10 +65,13 @@ bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m
  * 1): it grows towards the cell's edges and where the slope is uncertain; with `reliefSigma` the
  * spread of the cell's other certain bins (a step inside the cell) is added as in
  * addReliefVariance. A cell whose points give no plane (fewer than 4, or collinear) and no agreeing
- * neighbour falls back to a gradient 0 +- kUnknownSlope. With a dual grid, combined as surfaceAt
- * does. The pose part the points share is apart, in poseVariance_m2 (with |g|^2 times the
- * horizontal part): reportedVariance_m2() is what a query reports. False if neither grid has a
- * surface there. */
+ * neighbour falls back to a gradient 0 +- kUnknownSlope. The answer blends this plane with the
+ * planes of the other three cells whose centres surround the point, each evaluated there, with
+ * bilinear weights, a neighbour's only where it agrees with the cell's within 3 sigma (so the
+ * surface is continuous across cell edges on one surface and never blends across a step); the
+ * variance is the blend's weighted mean. With a dual grid, combined as surfaceAt does. The pose
+ * part the points share is apart, in poseVariance_m2 (with |g|^2 times the horizontal part):
+ * reportedVariance_m2() is what a query reports. False if neither grid has a surface there. */
 bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
               const BinUpdateParams& params, bool reliefSigma, CellSurface& out);
 
