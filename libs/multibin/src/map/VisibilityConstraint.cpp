@@ -446,7 +446,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         // no lower than blockLow_m: its units, then their cells (not the target's, nor updated
         // ones: the walk skips them).
         auto mayConflictInBlock = [&](const FanRay& r, unsigned blockSlot, int bx, int by,
-                                      double blockLow_m) {
+                                      double blockLow_m) __attribute__((always_inline)) {
             const float* units = unitsOf(blockSlot, bx, by);
             // Rounded down, so a unit above the line in doubles is above it in floats.
             const double line_m = blockLow_m + minConflictMargin;
@@ -468,6 +468,27 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double cross0 = r.ux * ey - r.uy * ex, along0 = r.ux * ex + r.uy * ey;
             const double stepX = r.ux * unit_m, stepY = r.uy * unit_m;
             const double reach = (0.5 * unit_m + kSlack_m) * r.sumAbsU;
+#ifdef __SSE2__
+            static_assert(kUnits == 4, "one row of units is two pairs of doubles");
+            {
+                // The units the line passes within reach of, all 16 at once (the same
+                // arithmetic as below, so the same ones): no branch per unit.
+                const __m128d reach2 = _mm_set1_pd(reach);
+                const __m128d absMask = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffff));
+                const __m128d across01 = _mm_mul_pd(_mm_set_pd(1.0, 0.0), _mm_set1_pd(stepY));
+                const __m128d across23 = _mm_mul_pd(_mm_set_pd(3.0, 2.0), _mm_set1_pd(stepY));
+                uint32_t onLine = 0;
+                for (int j = 0; j < kUnits; j++) {
+                    const __m128d row = _mm_set1_pd(cross0 + j * stepX);
+                    const __m128d c01 = _mm_and_pd(_mm_sub_pd(row, across01), absMask);
+                    const __m128d c23 = _mm_and_pd(_mm_sub_pd(row, across23), absMask);
+                    onLine |= uint32_t(_mm_movemask_pd(_mm_cmpngt_pd(c01, reach2)) |
+                                       (_mm_movemask_pd(_mm_cmpngt_pd(c23, reach2)) << 2))
+                              << (kUnits * j);
+                }
+                high &= onLine;
+            }
+#endif
             for (; high != 0; high &= high - 1) {
                 const int k = __builtin_ctz(high), i = k % kUnits, j = k / kUnits;
                 const double cross = cross0 + j * stepX - i * stepY;
@@ -545,13 +566,27 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     lo -= kKeySlack;
                     hi += kKeySlack;
                     if (hi - lo < 2) {  // less than half a turn, as a square away from the sensor
+                        // Binary searches without a branch on the keys (conditional moves):
+                        // the keys' order is no pattern a branch predictor learns.
                         auto first = [&](double k) {  // the first ray of key >= k
-                            return size_t(std::lower_bound(keys.begin(), keys.end(), k) -
-                                          keys.begin());
+                            const double* base = keys.data();
+                            size_t n = nRays;
+                            while (n > 1) {
+                                const size_t half = n / 2;
+                                base = base[half - 1] < k ? base + half : base;
+                                n -= half;
+                            }
+                            return size_t(base - keys.data()) + size_t(n == 1 && *base < k);
                         };
                         auto after = [&](double k) {  // the first ray of key > k
-                            return size_t(std::upper_bound(keys.begin(), keys.end(), k) -
-                                          keys.begin());
+                            const double* base = keys.data();
+                            size_t n = nRays;
+                            while (n > 1) {
+                                const size_t half = n / 2;
+                                base = !(k < base[half - 1]) ? base + half : base;
+                                n -= half;
+                            }
+                            return size_t(base - keys.data()) + size_t(n == 1 && !(k < *base));
                         };
                         ranges[0][0] = first(lo);
                         ranges[0][1] = after(hi);
