@@ -568,25 +568,23 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     if (hi - lo < 2) {  // less than half a turn, as a square away from the sensor
                         // Binary searches without a branch on the keys (conditional moves):
                         // the keys' order is no pattern a branch predictor learns.
-                        auto first = [&](double k) {  // the first ray of key >= k
+                        // The number of leading keys for which `before(key)` holds (the keys
+                        // are sorted, so they are a prefix).
+                        auto prefix = [&](auto before) {
                             const double* base = keys.data();
                             size_t n = nRays;
                             while (n > 1) {
                                 const size_t half = n / 2;
-                                base = base[half - 1] < k ? base + half : base;
+                                base = before(base[half - 1]) ? base + half : base;
                                 n -= half;
                             }
-                            return size_t(base - keys.data()) + size_t(n == 1 && *base < k);
+                            return size_t(base - keys.data()) + size_t(n == 1 && before(*base));
+                        };
+                        auto first = [&](double k) {  // the first ray of key >= k
+                            return prefix([k](double key) { return key < k; });
                         };
                         auto after = [&](double k) {  // the first ray of key > k
-                            const double* base = keys.data();
-                            size_t n = nRays;
-                            while (n > 1) {
-                                const size_t half = n / 2;
-                                base = !(k < base[half - 1]) ? base + half : base;
-                                n -= half;
-                            }
-                            return size_t(base - keys.data()) + size_t(n == 1 && !(k < *base));
+                            return prefix([k](double key) { return !(k < key); });
                         };
                         ranges[0][0] = first(lo);
                         ranges[0][1] = after(hi);
