@@ -139,6 +139,8 @@ struct ClassifiedBlock {
     /** The status the gates after the covariance's give (window, eq 13, bin range): the
      * status of a kCheckSingular point whose covariance isSingularCovariance accepts. */
     alignas(64) uint8_t statusAfterCovariance[kPointBlock];
+    /** poseSigmaCode of the point's pose parts of its height and horizontal variance. */
+    alignas(64) uint8_t poseCode[2][kPointBlock];
 };
 
 /** What the classification needs of the grid, by value (no aliasing with the block). */
@@ -216,6 +218,11 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
         cb.iy[i] = iy;
         cb.bin[i] = BinStore::floorToInt(binQ[i]);
         cb.slot[i] = (uint32_t(sx) + uint32_t(sy) * uint32_t(nx)) * uint32_t(inWindow);
+    }
+    for (int part = 0; part < 2; part++) {
+        const float* __restrict variance = pts.poseVariance_m2[part];
+        uint8_t* __restrict code = cb.poseCode[part];
+        for (size_t i = 0; i < m; i++) code[i] = poseSigmaCode(variance[i]);
     }
 }
 
@@ -384,11 +391,12 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         PlaneMoments plane;
         double cellX_m = 0, cellY_m = 0;  // the cell's centre [m]
         double maxHeight_m = 0;
-        // Its first point's pose parts: the run's points are neighbours of one frame, whose pose
-        // parts differ by far less than the codes' steps (BinUpdate.h).
-        float poseHeightVariance_m2 = 0, poseHorizontalVariance_m2 = 0;
+        // Its first point's pose parts' codes: the run's points are neighbours of one frame,
+        // whose pose parts differ by far less than the codes' steps (BinUpdate.h).
+        uint8_t poseHeightCode = 0, poseHorizontalCode = 0;
         bool frozen = false;  // the bin has zero variance: its height cannot move
     } run;
+    const bool wholeIncrement = isExactWholeFloat(params.certaintyIncrement);
     auto closeRun = [&]() {
         if (run.bin == kNoBin) return;
         Bin& bin = BinStore::bin(run.bin);
@@ -397,8 +405,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
             bin.variance_m2 = static_cast<float>(run.sum.variance_m2());
         }
         bin.plane = run.plane;
-        addCertainty(bin.certainty, params.certaintyIncrement, run.points);
-        notePoseVariance(bin, run.poseHeightVariance_m2, run.poseHorizontalVariance_m2);
+        addCertainty(bin.certainty, params.certaintyIncrement, run.points, wholeIncrement);
+        lowerPoseSigmaCodes(bin, run.poseHeightCode, run.poseHorizontalCode);
         util::addSaturating(bin.pointCount, run.points);
         m_index.noteUpdate(run.slot, run.ix, run.iy, run.maxHeight_m, run.points);
         run.bin = kNoBin;
@@ -446,8 +454,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
                 run.iy = cb.iy[i];
                 run.points = 0;
                 run.maxHeight_m = h;
-                run.poseHeightVariance_m2 = pts.poseVariance_m2[0][i];
-                run.poseHorizontalVariance_m2 = pts.poseVariance_m2[1][i];
+                run.poseHeightCode = cb.poseCode[0][i];
+                run.poseHorizontalCode = cb.poseCode[1][i];
                 const Bin& bin = BinStore::bin(run.bin);
                 run.plane = bin.plane;
                 run.cellX_m = cellCenter_m(run.ix);

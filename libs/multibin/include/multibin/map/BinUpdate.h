@@ -64,21 +64,29 @@ inline void addMeasurement(BinEstimate& bin, double height_m, double variance_m2
     util::addSaturating(bin.pointCount, 1u);
 }
 
+/** Whether `v` is a whole number below 2^24 in magnitude: every such number is a float, so sums
+ * of them that stay below 2^24 are exact in float (addCertainty). */
+inline bool isExactWholeFloat(float v) {
+    constexpr float kExact = 16777216.0f;  // 2^24
+    return std::abs(v) < kExact && float(static_cast<int32_t>(v)) == v;
+}
+
 /** `certainty += increment`, `times` times over, in float: what a bin's certainty counter becomes
  * after `times` measurements. Whole numbers below 2^24 add exactly in float, so for them (the
  * default increment 1 on any counter that was not decremented by a fraction) one addition gives
- * the sequence's result bit for bit; otherwise the sequence is run. */
-inline void addCertainty(float& certainty, float increment, uint32_t times) {
-    constexpr double kExact = 16777216.0;  // 2^24: every integer up to it is a float
-    const auto whole = [](float v) {
-        return std::abs(v) < float(kExact) && float(static_cast<int32_t>(v)) == v;
-    };
+ * the sequence's result bit for bit; otherwise the sequence is run. `wholeIncrement`:
+ * isExactWholeFloat(increment), for callers that add the same increment many times. */
+inline void addCertainty(float& certainty, float increment, uint32_t times, bool wholeIncrement) {
+    constexpr double kExact = 16777216.0;  // 2^24
     const double total = double(certainty) + double(increment) * double(times);
-    if (whole(certainty) && whole(increment) && std::abs(total) <= kExact) {
+    if (wholeIncrement && isExactWholeFloat(certainty) && std::abs(total) <= kExact) {
         certainty = static_cast<float>(total);
         return;
     }
     for (uint32_t k = 0; k < times; k++) certainty += increment;
+}
+inline void addCertainty(float& certainty, float increment, uint32_t times) {
+    addCertainty(certainty, increment, times, isExactWholeFloat(increment));
 }
 
 /** Adds a point at (dx_m, dy_m) from its cell's centre, height z_m, weight w = 1/var_z to the
@@ -162,9 +170,11 @@ inline double poseVariance_m2(uint8_t code) {
 /** The code of `variance_m2` (rounded down; 2^-40 m^2 or less, negative rounding included, gives
  * 1; 2^23 m^2 or more 253); NaN gives 0 (not known). */
 inline uint8_t poseSigmaCode(float variance_m2) {
-    if (variance_m2 != variance_m2) return 0;
+    // Branch-free (a select for NaN), so loops over points vectorise.
+    const bool known = variance_m2 == variance_m2;
     const float v = std::min(std::max(variance_m2, 0x1p-40f), 0x1p23f);
-    return static_cast<uint8_t>(int32_t(detail::floatBits(v) >> 21) - detail::kPoseCodeBias);
+    const int32_t code = int32_t(detail::floatBits(v) >> 21) - detail::kPoseCodeBias;
+    return static_cast<uint8_t>(known ? code : 0);
 }
 
 /** The least of two codes that are known (0: not known). */
