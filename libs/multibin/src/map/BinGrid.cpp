@@ -416,9 +416,13 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
     // Pass 2, in point order: the bin updates of one classified block.
     // Inlined into both loops below: called through a function, the run and the counters live
     // in memory and the bin update is 6 % slower.
-    auto updateBins = [&](const ClassifiedStage& stage) __attribute__((always_inline)) {
+    // Calls fuse(i) for each accepted point i of a block, in order, and counts the others by
+    // reason; returns the accepted count.
+    auto forAccepted = [&](const ClassifiedStage& stage, auto&& fuse)
+        __attribute__((always_inline)) {
         const PointBlock& pts = stage.points;
         const ClassifiedBlock& cb = stage.classes;
+        size_t accepted = stage.count;
         for (size_t i = 0; i < stage.count; i++) {
             if (cb.status[i] != kAccept) {  // rare: counted per reason after the loop
                 uint8_t status = cb.status[i];
@@ -430,47 +434,61 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
                 }
                 if (status != kAccept) {
                     rejected[status]++;
+                    accepted--;
                     continue;
                 }
             }
-            const float x = pts.v[0][i], y = pts.v[1][i];
-            const double h = pts.v[2][i];
-            const double weight = cb.weight[i];
-            const size_t s = size_t(cb.slot[i]);
-            const int16_t n = static_cast<int16_t>(cb.bin[i]);
-            if (perPoint) {
-                fuseMeasurement(s, cb.ix[i], cb.iy[i], n, h,
-                                std::max<double>(pts.v[8][i], kMinFusedVariance_m2), params,
-                                continuityBound_m, stats, x, y, pts.poseVariance_m2[0][i],
-                                pts.poseVariance_m2[1][i]);
-                continue;
-            }
-            if (run.bin == kNoBin || run.slot != s || run.n != n) {
-                closeRun();
-                run.bin = findOrAddBin(s, n);
-                run.slot = s;
-                run.n = n;
-                run.ix = cb.ix[i];
-                run.iy = cb.iy[i];
-                run.points = 0;
-                run.maxHeight_m = h;
-                run.poseHeightCode = cb.poseCode[0][i];
-                run.poseHorizontalCode = cb.poseCode[1][i];
-                const Bin& bin = BinStore::bin(run.bin);
-                run.plane = bin.plane;
-                run.cellX_m = cellCenter_m(run.ix);
-                run.cellY_m = cellCenter_m(run.iy);
-                run.frozen = bin.pointCount > 0 && !(bin.variance_m2 > 0);
-                run.sum = HeightInformation{};
-                if (bin.pointCount > 0 && !run.frozen) run.sum.add(bin.height_m, bin.variance_m2);
-            }
-            run.sum.addWeighted(h, weight);
-            addPlanePoint(run.plane, float(x - run.cellX_m), float(y - run.cellY_m), float(h),
-                          float(weight));
-            run.maxHeight_m = std::max(run.maxHeight_m, h);
-            run.points++;
-            stats.accepted++;
+            fuse(i);
         }
+        return accepted;
+    };
+    auto updateBins = [&](const ClassifiedStage& stage) __attribute__((always_inline)) {
+        const PointBlock& pts = stage.points;
+        const ClassifiedBlock& cb = stage.classes;
+        if (perPoint) {  // fuseMeasurement counts what it accepts or refuses (eq 14)
+            forAccepted(
+                stage, [&](size_t i) __attribute__((always_inline)) {
+                    fuseMeasurement(cb.slot[i], cb.ix[i], cb.iy[i], static_cast<int16_t>(cb.bin[i]),
+                                    pts.v[2][i],
+                                    std::max<double>(pts.v[8][i], kMinFusedVariance_m2), params,
+                                    continuityBound_m, stats, pts.v[0][i], pts.v[1][i],
+                                    pts.poseVariance_m2[0][i], pts.poseVariance_m2[1][i]);
+                });
+            return;
+        }
+        stats.accepted += forAccepted(
+            stage, [&](size_t i) __attribute__((always_inline)) {
+                const float x = pts.v[0][i], y = pts.v[1][i];
+                const double h = pts.v[2][i];
+                const double weight = cb.weight[i];
+                const size_t s = size_t(cb.slot[i]);
+                const int16_t n = static_cast<int16_t>(cb.bin[i]);
+                if (run.bin == kNoBin || run.slot != s || run.n != n) {
+                    closeRun();
+                    run.bin = findOrAddBin(s, n);
+                    run.slot = s;
+                    run.n = n;
+                    run.ix = cb.ix[i];
+                    run.iy = cb.iy[i];
+                    run.points = 0;
+                    run.maxHeight_m = h;
+                    run.poseHeightCode = cb.poseCode[0][i];
+                    run.poseHorizontalCode = cb.poseCode[1][i];
+                    const Bin& bin = BinStore::bin(run.bin);
+                    run.plane = bin.plane;
+                    run.cellX_m = cellCenter_m(run.ix);
+                    run.cellY_m = cellCenter_m(run.iy);
+                    run.frozen = bin.pointCount > 0 && !(bin.variance_m2 > 0);
+                    run.sum = HeightInformation{};
+                    if (bin.pointCount > 0 && !run.frozen)
+                        run.sum.add(bin.height_m, bin.variance_m2);
+                }
+                run.sum.addWeighted(h, weight);
+                addPlanePoint(run.plane, float(x - run.cellX_m), float(y - run.cellY_m), float(h),
+                              float(weight));
+                run.maxHeight_m = std::max(run.maxHeight_m, h);
+                run.points++;
+            });
     };
     // Pass 1 of block j: the points (propagated, for sensor points) and their classes.
     const size_t blocks = (count + kPointBlock - 1) / kPointBlock;
