@@ -91,14 +91,13 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
         return false;
     }
     return fuseMeasurement(slot(ix, iy), ix, iy, n, height_m, variance_m2, params,
-                           continuityBound_m, stats, std::nanf(""), std::nanf(""), std::nanf(""),
-                           std::nanf(""));
+                           continuityBound_m, stats, std::nanf(""), std::nanf(""), 0, 0);
 }
 
 bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height_m,
                               double variance_m2, const BinUpdateParams& params,
                               double continuityBound_m, InsertStats& stats, float x_m, float y_m,
-                              float poseHeightVariance_m2, float poseHorizontalVariance_m2) {
+                              uint8_t poseHeightCode, uint8_t poseHorizontalCode) {
     Bin& bin = BinStore::bin(findOrAddBin(s, n));
     if (!passesEq14(bin, height_m, continuityBound_m)) {
         stats.continuityRejected++;
@@ -108,7 +107,7 @@ bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height
     if (!std::isnan(x_m))  // a height without a place (insertHeight) says nothing of the slope
         addPlanePoint(bin.plane, float(x_m - cellCenter_m(ix)), float(y_m - cellCenter_m(iy)),
                       float(height_m), float(1.0 / variance_m2));
-    notePoseVariance(bin, poseHeightVariance_m2, poseHorizontalVariance_m2);
+    lowerPoseSigmaCodes(bin, poseHeightCode, poseHorizontalCode);
     stats.accepted++;
     m_index.noteUpdate(s, ix, iy, height_m, 1);
     return true;
@@ -452,7 +451,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
                                     pts.v[2][i],
                                     std::max<double>(pts.v[8][i], kMinFusedVariance_m2), params,
                                     continuityBound_m, stats, pts.v[0][i], pts.v[1][i],
-                                    pts.poseVariance_m2[0][i], pts.poseVariance_m2[1][i]);
+                                    cb.poseCode[0][i], cb.poseCode[1][i]);
                 });
             return;
         }

@@ -160,7 +160,8 @@ private:
                          double variance_m2, const BinUpdateParams& params,
                          double continuityBound_m, InsertStats& stats, float x_m,
                          float y_m,  //!< its place feeds the plane moments; NaN: no place
-                         float poseHeightVariance_m2, float poseHorizontalVariance_m2);
+                         uint8_t poseHeightCode,  //!< poseSigmaCode of its pose parts; 0: none
+                         uint8_t poseHorizontalCode);
 
     VisibilityIndex m_index;
     int m_insertionThreads = 1;

@@ -188,11 +188,6 @@ inline void lowerPoseSigmaCodes(BinEstimate& bin, uint8_t heightCode, uint8_t ho
     bin.poseHorizontalSigmaCode = leastPoseSigmaCode(bin.poseHorizontalSigmaCode, horizontalCode);
 }
 
-/** Points whose pose parts of the height and horizontal variance are at least these [m^2] were
- * fused into `bin` (NaN: not known, e.g. points given in the map frame). */
-inline void notePoseVariance(BinEstimate& bin, float height_m2, float horizontal_m2) {
-    lowerPoseSigmaCodes(bin, poseSigmaCode(height_m2), poseSigmaCode(horizontal_m2));
-}
 /** @} */
 
 /** Standard deviation of a bin's estimate: sqrt(max(variance, floor)) [m]; the visibility
