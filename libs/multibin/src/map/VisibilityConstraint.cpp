@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -209,25 +210,27 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
     }
     // towardsSensor: rows, then the blocks of a row, outwards from the sensor's: a block's
-    // rectangle is itself and the rectangles of its neighbours towards the sensor.
+    // rectangle is itself and the rectangles of its neighbours towards the sensor (the same
+    // maxima in any order of evaluation).
     if (rectangleUsable) {
-        auto outwards = [](int from, int lo, int hi) {
-            std::vector<int> order{from};
-            for (int k = 1; from - k >= lo || from + k <= hi; k++) {
-                if (from - k >= lo) order.push_back(from - k);
-                if (from + k <= hi) order.push_back(from + k);
-            }
-            return order;
-        };
+        // In table indices (the sensor's block is in the table); toX / toY: the offset of the
+        // neighbour towards the sensor's column / row, 0 in it.
         towardsSensor.resize(regionBound.size());
-        const std::vector<int> columns = outwards(sensorBx, tableX0, tableX0 + int(tableNx) - 1);
-        for (int by : outwards(sensorBy, tableY0, tableY0 + int(tableNy) - 1))
-            for (int bx : columns) {
-                float r = blockBound(bx, by);
-                if (bx != sensorBx) r = std::max(r, restBound(bx + (bx < sensorBx ? 1 : -1), by));
-                if (by != sensorBy) r = std::max(r, restBound(bx, by + (by < sensorBy ? 1 : -1)));
-                towardsSensor[unsigned(bx - tableX0) + unsigned(by - tableY0) * tableNx] = r;
-            }
+        const ptrdiff_t nx = ptrdiff_t(tableNx), ny = ptrdiff_t(tableNy);
+        const ptrdiff_t sensorX = sensorBx - tableX0, sensorY = sensorBy - tableY0;
+        auto row = [&](ptrdiff_t y, ptrdiff_t toY) {
+            auto block = [&](ptrdiff_t x, ptrdiff_t toX) {
+                const ptrdiff_t i = x + y * nx;
+                float r = regionBound[size_t(i)];
+                if (toX != 0) r = std::max(r, towardsSensor[size_t(i + toX)]);
+                if (toY != 0) r = std::max(r, towardsSensor[size_t(i + toY * nx)]);
+                towardsSensor[size_t(i)] = r;
+            };
+            for (ptrdiff_t x = sensorX; x >= 0; x--) block(x, x == sensorX ? 0 : 1);
+            for (ptrdiff_t x = sensorX + 1; x < nx; x++) block(x, -1);
+        };
+        for (ptrdiff_t y = sensorY; y >= 0; y--) row(y, y == sensorY ? 0 : 1);
+        for (ptrdiff_t y = sensorY + 1; y < ny; y++) row(y, -1);
     }
 
     // The fan of rays at once (every ray starts at the sensor): a ray is proven clear, and not
@@ -358,13 +361,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
         const double longestRay_m =
             nRays > 0 ? *std::max_element(lengths.begin(), lengths.end()) : 0.0;
-        // The steepest fastSlopes of each group of kGroup rays in key order (a last, partial
-        // group is taken ray by ray).
+        // The steepest fastSlopes of each group of kGroup rays in key order (the last one
+        // possibly shorter).
         std::vector<double>& groupFastSlopes = scratch.groupFastSlopes;
-        groupFastSlopes.assign(nRays / kGroup, 0.0);
-        for (size_t j = 0; j + kGroup <= nRays; j += kGroup)
-            groupFastSlopes[j / kGroup] =
-                *std::max_element(fastSlopes.begin() + j, fastSlopes.begin() + j + kGroup);
+        groupFastSlopes.resize((nRays + kGroup - 1) / kGroup);
+        for (size_t j = 0; j < nRays; j += kGroup)
+            groupFastSlopes[j / kGroup] = *std::max_element(
+                fastSlopes.begin() + j, fastSlopes.begin() + std::min(j + kGroup, nRays));
         // The ray's lowest height [m] over its samples at distances [from, to] from the target
         // (clipped to the walk's [step, length)), or NaN if there is none.
         auto lowestBetween = [&](const FanRay& r, double from, double to) {
@@ -415,12 +418,30 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const int column0 = ixLo - bx * BinGrid::kBlockCells;  // of the first cell read
             // Usually the block's rows lie whole in one run: a unit's row is 4 adjacent slots.
             const bool wholeRows = column0 == 0 && firstRun == BinGrid::kBlockCells;
+#ifdef __SSE2__
+            // Then a unit's 4 columns are kept apart over its rows (4 bounds at once), and
+            // reduced to one at the end.
+            static_assert(kUnitCells == 4, "a unit's row is one vector of 4 floats");
+            const float* cellMax_m = index.cellMaxHeights_m();
+            __m128 columns[kUnits * kUnits];
+            if (wholeRows)
+                std::fill(columns, columns + kUnits * kUnits,
+                          _mm_set1_ps(-std::numeric_limits<float>::infinity()));
+#endif
             for (int iy = iyLo; iy < iyHi; iy++) {
                 int sy = iy - w.iy0 + originY;
                 if (sy >= w.ny) sy -= w.ny;
                 const size_t base = size_t(sy) * size_t(w.nx), first = base + size_t(sx0);
-                float* unitRow = units + ((iy - by * BinGrid::kBlockCells) >> kUnitShift) * kUnits;
+                const int unitRowIndex = (iy - by * BinGrid::kBlockCells) >> kUnitShift;
+                float* unitRow = units + unitRowIndex * kUnits;
                 if (wholeRows) {
+#ifdef __SSE2__
+                    __m128* unitColumns = columns + unitRowIndex * kUnits;
+                    for (int c = 0; c < kUnits; c++)
+                        unitColumns[c] =
+                            _mm_max_ps(unitColumns[c],
+                                       _mm_loadu_ps(cellMax_m + first + size_t(c * kUnitCells)));
+#else
                     for (int c = 0; c < kUnits; c++) {
                         float m = unitRow[c];
                         for (int k = 0; k < kUnitCells; k++)
@@ -428,6 +449,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                                          index.cellMaxHeight_m(first + size_t(c * kUnitCells + k)));
                         unitRow[c] = m;
                     }
+#endif
                     continue;
                 }
                 for (int k = 0; k < ixHi - ixLo; k++) {
@@ -437,6 +459,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     u = std::max(u, index.cellMaxHeight_m(slot));
                 }
             }
+#ifdef __SSE2__
+            if (wholeRows)
+                for (int k = 0; k < kUnits * kUnits; k++) {
+                    __m128 m = _mm_max_ps(columns[k], _mm_movehl_ps(columns[k], columns[k]));
+                    m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
+                    units[k] = _mm_cvtss_f32(m);
+                }
+#endif
             unitLimits.resize(size_t(t) + kUnits * kUnits);
             for (int k = 0; k < kUnits * kUnits; k++)
                 unitLimits[size_t(t) + size_t(k)] = roundUp(limit_m(units[k]));
@@ -598,11 +628,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 for (const auto& range : ranges)
                     for (size_t j = range[0]; j < range[1]; j++) {
-                        // A whole group of rays at once where none is steeper than maxSlope.
-                        if (j % kGroup == 0 && j + kGroup <= range[1] &&
-                            groupFastSlopes[j / kGroup] <= maxSlope) {
-                            j += kGroup - 1;
-                            continue;
+                        // The rest of j's group at once where none of the group is steeper
+                        // than maxSlope (at a range's ends, part of a group: a subset).
+                        if (j % kGroup == 0 || j == range[0]) {
+                            const size_t g = j / kGroup;
+                            if (groupFastSlopes[g] <= maxSlope) {
+                                j = std::min((g + 1) * kGroup, range[1]) - 1;
+                                continue;
+                            }
                         }
                         // On the line, a sample at distance d from the target lies length - d
                         // from the sensor: none in the block if length < nearStep_m.
@@ -635,7 +668,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     for (size_t i = 0; i < updated.size(); i++) {
         const BinGrid::UpdatedCell& u = updated[i];
         const double tz = u.maxHeight_m;
-        const float decrement = vis.certaintyDecrement * float(u.points);
+        // Computed where used: most updated cells edit nothing.
+        auto decrement = [&]() { return vis.certaintyDecrement * float(u.points); };
         // The certainty of the cell's surface (CellSurface) before its own edit (below); needed
         // only when a ray meets a conflicting bin. Rays never edit updated cells, so a late
         // look-up gives the same value unless the cell's own edit ran: then it is taken first.
@@ -656,7 +690,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             target();
             grid.editBins(u.ix, u.iy, [&](Bin& b) {
                 if (!conflicts(b, tz)) return true;
-                b.certainty -= decrement;
+                b.certainty -= decrement();
                 stats.binsWeakened++;
                 if (b.certainty > 0) return true;
                 stats.binsRemoved++;
@@ -822,7 +856,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                         stats.binsRemoved++;
                         return false;
                     }
-                    b.certainty -= decrement;
+                    b.certainty -= decrement();
                     stats.binsWeakened++;
                     if (b.certainty > 0) return true;
                     stats.binsRemoved++;
