@@ -249,6 +249,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     enum : uint8_t { kWalk, kClear, kNoRay };
     std::vector<uint8_t>& rayState = scratch.rayState;
     rayState.clear();
+    // Set when the test decided every ray and none is to be walked (rayState is then not
+    // read): the rays it proved clear.
+    bool noWalk = false;
+    size_t raysDecided = 0, raysClear = 0;
     constexpr double kMaxCoordinate_m = 1e5, kMaxHeight_m = 1e4, kHeightSlack_m = 1e-9;
     const double regionExtent_m = std::max(
         {std::abs(sensor_m.x()), std::abs(sensor_m.y()), std::abs(double(tableX0)) * block_m,
@@ -278,10 +282,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double length = std::sqrt(dx * dx + dy * dy);  // as the walk's
             if (length < cell) {
                 rayState[i] = kNoRay;
+                raysDecided++;
             } else if (!towardsSensor.empty() &&
                        !boundMayConflict(restBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
                                          std::min(tz, sensor_m.z()) - kSlack_m)) {
                 rayState[i] = kClear;  // the rectangle towards the sensor, as the walk's test
+                raysDecided++;
+                raysClear++;
             } else if (std::abs(tz) < kMaxHeight_m) {
                 fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(rays.size()));
                 lowestRay_m = std::min(lowestRay_m, tz);
@@ -655,7 +662,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                             r.clear = false;
                     }
             }
-        for (const FanRay& r : rays) rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
+        size_t fanClear = 0;
+        for (const FanRay& r : rays) {
+            rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
+            fanClear += r.clear;
+        }
+        // The rays left out of the fan (heights beyond kMaxHeight_m) are walked.
+        noWalk = raysDecided + fanClear == updated.size();
+        if (noWalk) stats.raysCast += raysClear + fanClear;
     }
 
     // The sample distances along a ray, as the walk accumulates them (d += step, not k step,
@@ -699,6 +713,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
 
         // Walk the line of sight from the updated cell back to the sensor.
+        if (noWalk) continue;                             // counted above
         if (!rayState.empty() && rayState[i] != kWalk) {  // decided by the fan test above
             stats.raysCast += rayState[i] == kClear;
             continue;
