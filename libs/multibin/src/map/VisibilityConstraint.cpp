@@ -425,30 +425,12 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const int column0 = ixLo - bx * BinGrid::kBlockCells;  // of the first cell read
             // Usually the block's rows lie whole in one run: a unit's row is 4 adjacent slots.
             const bool wholeRows = column0 == 0 && firstRun == BinGrid::kBlockCells;
-#ifdef __SSE2__
-            // Then a unit's 4 columns are kept apart over its rows (4 bounds at once), and
-            // reduced to one at the end.
-            static_assert(kUnitCells == 4, "a unit's row is one vector of 4 floats");
-            const float* cellMax_m = index.cellMaxHeights_m();
-            __m128 columns[kUnits * kUnits];
-            if (wholeRows)
-                std::fill(columns, columns + kUnits * kUnits,
-                          _mm_set1_ps(-std::numeric_limits<float>::infinity()));
-#endif
             for (int iy = iyLo; iy < iyHi; iy++) {
                 int sy = iy - w.iy0 + originY;
                 if (sy >= w.ny) sy -= w.ny;
                 const size_t base = size_t(sy) * size_t(w.nx), first = base + size_t(sx0);
-                const int unitRowIndex = (iy - by * BinGrid::kBlockCells) >> kUnitShift;
-                float* unitRow = units + unitRowIndex * kUnits;
+                float* unitRow = units + ((iy - by * BinGrid::kBlockCells) >> kUnitShift) * kUnits;
                 if (wholeRows) {
-#ifdef __SSE2__
-                    __m128* unitColumns = columns + unitRowIndex * kUnits;
-                    for (int c = 0; c < kUnits; c++)
-                        unitColumns[c] =
-                            _mm_max_ps(unitColumns[c],
-                                       _mm_loadu_ps(cellMax_m + first + size_t(c * kUnitCells)));
-#else
                     for (int c = 0; c < kUnits; c++) {
                         float m = unitRow[c];
                         for (int k = 0; k < kUnitCells; k++)
@@ -456,7 +438,6 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                                          index.cellMaxHeight_m(first + size_t(c * kUnitCells + k)));
                         unitRow[c] = m;
                     }
-#endif
                     continue;
                 }
                 for (int k = 0; k < ixHi - ixLo; k++) {
@@ -466,14 +447,6 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                     u = std::max(u, index.cellMaxHeight_m(slot));
                 }
             }
-#ifdef __SSE2__
-            if (wholeRows)
-                for (int k = 0; k < kUnits * kUnits; k++) {
-                    __m128 m = _mm_max_ps(columns[k], _mm_movehl_ps(columns[k], columns[k]));
-                    m = _mm_max_ss(m, _mm_shuffle_ps(m, m, 1));
-                    units[k] = _mm_cvtss_f32(m);
-                }
-#endif
             unitLimits.resize(size_t(t) + kUnits * kUnits);
             for (int k = 0; k < kUnits * kUnits; k++)
                 unitLimits[size_t(t) + size_t(k)] = roundUp(limit_m(units[k]));

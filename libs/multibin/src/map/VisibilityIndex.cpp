@@ -8,7 +8,6 @@ namespace multibin {
 void VisibilityIndex::reset(const CellWindow& w) {
     setWindow(w);
     m_stamps.assign(w.cellCount(), CellStamp{});
-    m_cellMax_m.assign(w.cellCount(), -std::numeric_limits<float>::infinity());
     m_blocks.assign(size_t(m_blockNx) * size_t(m_blockNy), BlockSlot{});
     m_updated.clear();
     m_maxHeight_m = -std::numeric_limits<double>::infinity();
@@ -20,7 +19,6 @@ void VisibilityIndex::regrow(const BinStore& store) {
     // Growth happens between update cycles: the cycle bookkeeping starts afresh (the new slots
     // carry no stamp).
     m_stamps.assign(w.cellCount(), CellStamp{});
-    m_cellMax_m.assign(w.cellCount(), -std::numeric_limits<float>::infinity());
     m_updated.clear();
     m_blocks.assign(size_t(m_blockNx) * size_t(m_blockNy), BlockSlot{});
     store.forEachStoredBin(

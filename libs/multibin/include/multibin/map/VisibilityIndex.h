@@ -35,10 +35,7 @@ public:
     /** The store's window grew: fresh stamps, no updated cell, bounds rebuilt from every bin. */
     void regrow(const BinStore& store);
     /** A cell entered the window at `slot`: it was not updated in this cycle and holds no bin. */
-    void forgetSlot(size_t slot) {
-        m_stamps[slot] = CellStamp{};
-        m_cellMax_m[slot] = -std::numeric_limits<float>::infinity();
-    }
+    void forgetSlot(size_t slot) { m_stamps[slot] = CellStamp{}; }
 
     /** @name Update cycles: which cells one observation updated.
      * @{ */
@@ -54,7 +51,7 @@ public:
     void noteHeight(size_t slot, int ix, int iy, double height_m) {
         m_maxHeight_m = std::max(m_maxHeight_m, height_m);
         raiseBlock(ix, iy, height_m);
-        float& cellMax_m = m_cellMax_m[slot];
+        float& cellMax_m = m_stamps[slot].maxHeight_m;
         cellMax_m = std::max(cellMax_m, static_cast<float>(height_m));
     }
     /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
@@ -64,10 +61,7 @@ public:
     /** An upper bound on the height of every bin of the cell at `slot` [m], as
      * blockMaxHeight_m's for its block (the same rounding and the same conservative removal):
      * the visibility constraint tests a cell's bins only where this says they may conflict. */
-    float cellMaxHeight_m(size_t slot) const { return m_cellMax_m[slot]; }
-    /** cellMaxHeight_m of every slot, in slot order (the store's: rows of the window, wrapped),
-     * so that adjacent cells' bounds can be read together. */
-    const float* cellMaxHeights_m() const { return m_cellMax_m.data(); }
+    float cellMaxHeight_m(size_t slot) const { return m_stamps[slot].maxHeight_m; }
 
     /** @name Local height bound: blocks of kBlockCells x kBlockCells cells. Block (bx, by) holds
      * cells bx kBlockCells .. bx kBlockCells + kBlockCells - 1 (and likewise in y), so a cell's
@@ -98,7 +92,7 @@ public:
 
     /** Memory held [bytes]: stamps, the list of updated cells, the block table. */
     size_t memoryBytes() const {
-        return m_stamps.capacity() * sizeof(CellStamp) + m_cellMax_m.capacity() * sizeof(float) +
+        return m_stamps.capacity() * sizeof(CellStamp) +
                m_updated.capacity() * sizeof(UpdatedCell) + m_blocks.capacity() * sizeof(BlockSlot);
     }
 
@@ -111,9 +105,9 @@ private:
     struct CellStamp {
         uint32_t cycle = 0;         //!< the update cycle that last updated the cell
         uint32_t updatedIndex = 0;  //!< its entry in m_updated, valid in that cycle
+        float maxHeight_m = -std::numeric_limits<float>::infinity();  //!< cellMaxHeight_m
     };
     std::vector<CellStamp> m_stamps;     //!< per slot of the store
-    std::vector<float> m_cellMax_m;      //!< per slot of the store: cellMaxHeight_m
     std::vector<UpdatedCell> m_updated;  //!< cells updated in this cycle, in first-update order
     uint32_t m_cycle = 1;
     double m_maxHeight_m = -std::numeric_limits<double>::infinity();
