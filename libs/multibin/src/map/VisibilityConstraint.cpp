@@ -480,7 +480,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double reach = (0.5 * unit_m + kSlack_m) * r.sumAbsU;
 #ifdef __SSE2__
             static_assert(kUnits == 4, "one row of units is two pairs of doubles");
-            {
+            // Where one or two units are high, their own test below is cheaper than this one.
+            if (const uint32_t rest = high & (high - 1); (rest & (rest - 1)) != 0) {
                 // The units the line passes within reach of, all 16 at once (the same
                 // arithmetic as below, so the same ones): no branch per unit.
                 const __m128d reach2 = _mm_set1_pd(reach);
