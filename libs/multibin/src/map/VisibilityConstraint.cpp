@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -209,25 +210,27 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
     }
     // towardsSensor: rows, then the blocks of a row, outwards from the sensor's: a block's
-    // rectangle is itself and the rectangles of its neighbours towards the sensor.
+    // rectangle is itself and the rectangles of its neighbours towards the sensor (the same
+    // maxima in any order of evaluation).
     if (rectangleUsable) {
-        auto outwards = [](int from, int lo, int hi) {
-            std::vector<int> order{from};
-            for (int k = 1; from - k >= lo || from + k <= hi; k++) {
-                if (from - k >= lo) order.push_back(from - k);
-                if (from + k <= hi) order.push_back(from + k);
-            }
-            return order;
-        };
+        // In table indices (the sensor's block is in the table); toX / toY: the offset of the
+        // neighbour towards the sensor's column / row, 0 in it.
         towardsSensor.resize(regionBound.size());
-        const std::vector<int> columns = outwards(sensorBx, tableX0, tableX0 + int(tableNx) - 1);
-        for (int by : outwards(sensorBy, tableY0, tableY0 + int(tableNy) - 1))
-            for (int bx : columns) {
-                float r = blockBound(bx, by);
-                if (bx != sensorBx) r = std::max(r, restBound(bx + (bx < sensorBx ? 1 : -1), by));
-                if (by != sensorBy) r = std::max(r, restBound(bx, by + (by < sensorBy ? 1 : -1)));
-                towardsSensor[unsigned(bx - tableX0) + unsigned(by - tableY0) * tableNx] = r;
-            }
+        const ptrdiff_t nx = ptrdiff_t(tableNx), ny = ptrdiff_t(tableNy);
+        const ptrdiff_t sensorX = sensorBx - tableX0, sensorY = sensorBy - tableY0;
+        auto row = [&](ptrdiff_t y, ptrdiff_t toY) {
+            auto block = [&](ptrdiff_t x, ptrdiff_t toX) {
+                const ptrdiff_t i = x + y * nx;
+                float r = regionBound[size_t(i)];
+                if (toX != 0) r = std::max(r, towardsSensor[size_t(i + toX)]);
+                if (toY != 0) r = std::max(r, towardsSensor[size_t(i + toY * nx)]);
+                towardsSensor[size_t(i)] = r;
+            };
+            for (ptrdiff_t x = sensorX; x >= 0; x--) block(x, x == sensorX ? 0 : 1);
+            for (ptrdiff_t x = sensorX + 1; x < nx; x++) block(x, -1);
+        };
+        for (ptrdiff_t y = sensorY; y >= 0; y--) row(y, y == sensorY ? 0 : 1);
+        for (ptrdiff_t y = sensorY + 1; y < ny; y++) row(y, -1);
     }
 
     // The fan of rays at once (every ray starts at the sensor): a ray is proven clear, and not
@@ -246,6 +249,10 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     enum : uint8_t { kWalk, kClear, kNoRay };
     std::vector<uint8_t>& rayState = scratch.rayState;
     rayState.clear();
+    // Set when the test decided every ray and none is to be walked (rayState is then not
+    // read): the rays it proved clear.
+    bool noWalk = false;
+    size_t raysDecided = 0, raysClear = 0;
     constexpr double kMaxCoordinate_m = 1e5, kMaxHeight_m = 1e4, kHeightSlack_m = 1e-9;
     const double regionExtent_m = std::max(
         {std::abs(sensor_m.x()), std::abs(sensor_m.y()), std::abs(double(tableX0)) * block_m,
@@ -275,10 +282,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double length = std::sqrt(dx * dx + dy * dy);  // as the walk's
             if (length < cell) {
                 rayState[i] = kNoRay;
+                raysDecided++;
             } else if (!towardsSensor.empty() &&
                        !boundMayConflict(restBound(BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy)),
                                          std::min(tz, sensor_m.z()) - kSlack_m)) {
                 rayState[i] = kClear;  // the rectangle towards the sensor, as the walk's test
+                raysDecided++;
+                raysClear++;
             } else if (std::abs(tz) < kMaxHeight_m) {
                 fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(rays.size()));
                 lowestRay_m = std::min(lowestRay_m, tz);
@@ -358,13 +368,13 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
         const double longestRay_m =
             nRays > 0 ? *std::max_element(lengths.begin(), lengths.end()) : 0.0;
-        // The steepest fastSlopes of each group of kGroup rays in key order (a last, partial
-        // group is taken ray by ray).
+        // The steepest fastSlopes of each group of kGroup rays in key order (the last one
+        // possibly shorter).
         std::vector<double>& groupFastSlopes = scratch.groupFastSlopes;
-        groupFastSlopes.assign(nRays / kGroup, 0.0);
-        for (size_t j = 0; j + kGroup <= nRays; j += kGroup)
-            groupFastSlopes[j / kGroup] =
-                *std::max_element(fastSlopes.begin() + j, fastSlopes.begin() + j + kGroup);
+        groupFastSlopes.resize((nRays + kGroup - 1) / kGroup);
+        for (size_t j = 0; j < nRays; j += kGroup)
+            groupFastSlopes[j / kGroup] = *std::max_element(
+                fastSlopes.begin() + j, fastSlopes.begin() + std::min(j + kGroup, nRays));
         // The ray's lowest height [m] over its samples at distances [from, to] from the target
         // (clipped to the walk's [step, length)), or NaN if there is none.
         auto lowestBetween = [&](const FanRay& r, double from, double to) {
@@ -470,7 +480,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             const double reach = (0.5 * unit_m + kSlack_m) * r.sumAbsU;
 #ifdef __SSE2__
             static_assert(kUnits == 4, "one row of units is two pairs of doubles");
-            {
+            // Where one or two units are high, their own test below is cheaper than this one.
+            if (const uint32_t rest = high & (high - 1); (rest & (rest - 1)) != 0) {
                 // The units the line passes within reach of, all 16 at once (the same
                 // arithmetic as below, so the same ones): no branch per unit.
                 const __m128d reach2 = _mm_set1_pd(reach);
@@ -598,11 +609,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                 }
                 for (const auto& range : ranges)
                     for (size_t j = range[0]; j < range[1]; j++) {
-                        // A whole group of rays at once where none is steeper than maxSlope.
-                        if (j % kGroup == 0 && j + kGroup <= range[1] &&
-                            groupFastSlopes[j / kGroup] <= maxSlope) {
-                            j += kGroup - 1;
-                            continue;
+                        // The rest of j's group at once where none of the group is steeper
+                        // than maxSlope (at a range's ends, part of a group: a subset).
+                        if (j % kGroup == 0 || j == range[0]) {
+                            const size_t g = j / kGroup;
+                            if (groupFastSlopes[g] <= maxSlope) {
+                                j = std::min((g + 1) * kGroup, range[1]) - 1;
+                                continue;
+                            }
                         }
                         // On the line, a sample at distance d from the target lies length - d
                         // from the sensor: none in the block if length < nearStep_m.
@@ -622,7 +636,14 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                             r.clear = false;
                     }
             }
-        for (const FanRay& r : rays) rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
+        size_t fanClear = 0;
+        for (const FanRay& r : rays) {
+            rayState[r.updatedIndex] = r.clear ? kClear : kWalk;
+            fanClear += r.clear;
+        }
+        // The rays left out of the fan (heights beyond kMaxHeight_m) are walked.
+        noWalk = raysDecided + fanClear == updated.size();
+        if (noWalk) stats.raysCast += raysClear + fanClear;
     }
 
     // The sample distances along a ray, as the walk accumulates them (d += step, not k step,
@@ -635,7 +656,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     for (size_t i = 0; i < updated.size(); i++) {
         const BinGrid::UpdatedCell& u = updated[i];
         const double tz = u.maxHeight_m;
-        const float decrement = vis.certaintyDecrement * float(u.points);
+        // Computed where used: most updated cells edit nothing.
+        auto decrement = [&]() { return vis.certaintyDecrement * float(u.points); };
         // The certainty of the cell's surface (CellSurface) before its own edit (below); needed
         // only when a ray meets a conflicting bin. Rays never edit updated cells, so a late
         // look-up gives the same value unless the cell's own edit ran: then it is taken first.
@@ -656,7 +678,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
             target();
             grid.editBins(u.ix, u.iy, [&](Bin& b) {
                 if (!conflicts(b, tz)) return true;
-                b.certainty -= decrement;
+                b.certainty -= decrement();
                 stats.binsWeakened++;
                 if (b.certainty > 0) return true;
                 stats.binsRemoved++;
@@ -665,6 +687,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         }
 
         // Walk the line of sight from the updated cell back to the sensor.
+        if (noWalk) continue;                             // counted above
         if (!rayState.empty() && rayState[i] != kWalk) {  // decided by the fan test above
             stats.raysCast += rayState[i] == kClear;
             continue;
@@ -822,7 +845,7 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
                         stats.binsRemoved++;
                         return false;
                     }
-                    b.certainty -= decrement;
+                    b.certainty -= decrement();
                     stats.binsWeakened++;
                     if (b.certainty > 0) return true;
                     stats.binsRemoved++;
