@@ -12,6 +12,10 @@
  *   each scan in structure-of-arrays form, vectorised (omp simd; target_clones
  *   for AVX-512, AVX2 and baseline with runtime dispatch: one binary for all three). The survivors
  * are scattered in scan order or four ways interleaved (independent store-to-load chains);
+ * - BM_LeanKernelFullBinState: the same point stage with what the map keeps per bin updated per
+ *   point in fixed 64-byte slots (height sums, certainty, count, the plane moments by the
+ *   library's addPlanePoint, the least pose code, the cell's highest height): what the method's
+ *   per-bin state costs at best;
  * - BM_MapInsertSensorPoints: the map's insertion core (BinGrid::insertSensorPoints with a
  *   PosePropagator per scan): the full method (multi-bin choice, certainty, eq 13 and 14 gates,
  *   visibility index, exact 3x3 propagation);
@@ -29,11 +33,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <vector>
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/BinGrid.h"
+#include "multibin/map/BinUpdate.h"
 
 using namespace multibin;
 
@@ -153,11 +159,22 @@ struct LeanGrid {
 constexpr float kInvCell = float(1.0 / kCell_m), kInvBin = float(1.0 / kBinHeight_m);
 constexpr float kMaxVariance_m2 = float(kMaxUncertainty_m * kMaxUncertainty_m / 9.0);
 constexpr float kOrigin_m = float(kGridOrigin_m);
-/** One point of the point stage (inlined into both loops). */
+/** What the full-state kernel's scatter needs of a point besides slot and weights: its height,
+ * its offset from its cell's centre [m] and the code of its pose part of the height variance. */
+struct FullPointOutputs {
+    float* height_m;
+    float* dx_m;
+    float* dy_m;
+    uint8_t* poseCode;
+};
+
+/** One point of the point stage (inlined into the loops); `full`, if given, also gets what the
+ * full bin state needs. */
 __attribute__((always_inline)) inline void pointStage(const ScanConstants& k, const float* x,
                                                       const float* y, const float* z, int i,
                                                       int32_t* slot, float* weight,
-                                                      float* weightedZ) {
+                                                      float* weightedZ,
+                                                      const FullPointOutputs* full = nullptr) {
     const float px = x[i], py = y[i], pz = z[i];
     const float mx = k.r[0] * px + k.r[1] * py + k.r[2] * pz + k.t[0];
     const float my = k.r[3] * px + k.r[4] * py + k.r[5] * pz + k.t[1];
@@ -181,6 +198,12 @@ __attribute__((always_inline)) inline void pointStage(const ScanConstants& k, co
     slot[i] = ((iy * kGridCells + ix) * kBinsPerCell + (nb & (kBinsPerCell - 1)) + 1) * ok - 1;
     weight[i] = w;
     weightedZ[i] = w * mz;
+    if (full) {
+        full->height_m[i] = mz;
+        full->dx_m[i] = (fx - float(ix) - 0.5f) * float(kCell_m);
+        full->dy_m[i] = (fy - float(iy) - 0.5f) * float(kCell_m);
+        full->poseCode[i] = poseSigmaCode(quad);
+    }
 }
 
 __attribute__((target_clones("avx512f", "avx2", "default"))) void pointStageSimd(
@@ -189,6 +212,53 @@ __attribute__((target_clones("avx512f", "avx2", "default"))) void pointStageSimd
     float* __restrict weightedZ) {
 #pragma omp simd
     for (int i = 0; i < n; i++) pointStage(k, x, y, z, i, slot, weight, weightedZ);
+}
+
+/** The same with the full bin state's outputs. */
+__attribute__((target_clones("avx512f", "avx2", "default"))) void pointStageFullSimd(
+    const ScanConstants& k, const float* __restrict x, const float* __restrict y,
+    const float* __restrict z, int n, int32_t* __restrict slot, float* __restrict weight,
+    float* __restrict weightedZ, const FullPointOutputs& full) {
+    const FullPointOutputs out = full;  // a copy: no aliasing with the arrays
+#pragma omp simd
+    for (int i = 0; i < n; i++) pointStage(k, x, y, z, i, slot, weight, weightedZ, &out);
+}
+
+/** A bin slot with everything the map keeps per bin, in one cache line as the map's Bin: the
+ * height in information form, certainty, point count, the plane moments (the library's
+ * addPlanePoint) and the least pose code. */
+struct FullSlot {
+    float information = 0, weightedHeight = 0, certainty = 0;
+    uint32_t points = 0;
+    PlaneMoments plane;
+    uint8_t poseCode = 0;
+};
+static_assert(sizeof(FullSlot) <= 64, "one cache line, as the map's Bin");
+
+/** The full-state kernel's grid: 8 fixed slots per cell and, per cell, the highest height (the
+ * visibility index's bound). */
+struct FullGrid {
+    std::vector<FullSlot> slots{size_t(kGridCells) * kGridCells * kBinsPerCell};
+    std::vector<float> cellMax_m =
+        std::vector<float>(size_t(kGridCells) * kGridCells, -std::numeric_limits<float>::max());
+};
+
+/** One point into its slot, per point (no runs), in scan order. */
+void scatterFull(FullGrid& g, const int32_t* slot, const float* w, const float* wz,
+                 const float* height_m, const float* dx_m, const float* dy_m,
+                 const uint8_t* poseCode, int n) {
+    for (int i = 0; i < n; i++) {
+        if (slot[i] < 0) continue;
+        FullSlot& b = g.slots[size_t(slot[i])];
+        b.information += w[i];
+        b.weightedHeight += wz[i];
+        b.certainty += 1.f;
+        b.points++;
+        addPlanePoint(b.plane, dx_m[i], dy_m[i], height_m[i], w[i]);
+        b.poseCode = leastPoseSigmaCode(b.poseCode, poseCode[i]);
+        float& top = g.cellMax_m[size_t(slot[i]) / kBinsPerCell];
+        top = std::max(top, height_m[i]);
+    }
 }
 
 inline void scatterOne(LeanGrid& g, int32_t s, float w, float wz) {
@@ -227,6 +297,21 @@ struct Prepared {
 const Prepared& prepared() {
     static const Prepared p;
     return p;
+}
+
+void runFullStateKernel(FullGrid& g) {
+    const Prepared& p = prepared();
+    alignas(64) int32_t slot[kBeams];
+    alignas(64) float w[kBeams], wz[kBeams], h[kBeams], dx[kBeams], dy[kBeams];
+    alignas(64) uint8_t code[kBeams];
+    const FullPointOutputs full{h, dx, dy, code};
+    for (size_t k = 0; k < p.scans.size(); k++) {
+        const Scan& s = p.scans[k];
+        const int n = int(s.x.size());
+        pointStageFullSimd(p.constants[k], s.x.data(), s.y.data(), s.z.data(), n, slot, w, wz,
+                           full);
+        scatterFull(g, slot, w, wz, h, dx, dy, code, n);
+    }
 }
 
 template <bool kInterleaved>
@@ -295,6 +380,28 @@ std::string checkKernel() {
                                                     b.weightedHeight[i] / b.information[i])));
     }
     if (used == 0 || !(worstHeight_m < 1e-5)) return "the two scatter orders give other heights";
+    // The full-state kernel sums the same weights in the same order as the in-order scatter, so
+    // the same counts, information and heights, and its plane moments' weight is that information
+    // again; up to rounding, and for a few points a neighbouring slot: its point stage is another
+    // function, which GCC may contract into fused multiply-adds otherwise, so a point on a cell
+    // or bin edge may fall on the other side.
+    FullGrid f;
+    runFullStateKernel(f);
+    const auto near = [](float u, float v) {
+        return std::abs(u - v) <= 1e-5f * std::max(std::abs(u), std::abs(v));
+    };
+    size_t differing = 0;
+    for (size_t i = 0; i < a.information.size(); i++) {
+        const FullSlot& b = f.slots[i];
+        if (b.certainty == 0 && a.certainty[i] == 0) continue;
+        const double heightDifference_m =
+            b.weightedHeight / b.information - a.weightedHeight[i] / a.information[i];
+        differing += !(b.certainty == a.certainty[i] && near(b.information, a.information[i]) &&
+                       std::abs(heightDifference_m) < 1e-6 && near(b.plane.weight, b.information));
+    }
+    if (!(differing * 1000 <= used))
+        return "the full-state kernel's slots differ from the lean kernel's in " +
+               std::to_string(differing) + " of " + std::to_string(used);
     return {};
 }
 
@@ -321,6 +428,20 @@ static void BM_LeanKernelInterleavedScatter(benchmark::State& state) {
     setCounters(state);
 }
 BENCHMARK(BM_LeanKernelInterleavedScatter)->Unit(benchmark::kMillisecond);
+
+/** The lean kernel with the map's whole per-bin state (plane moments, certainty, count, pose
+ * code, the cell's highest height) updated per point in fixed 64-byte slots: what the method's
+ * state costs at best, against the map's core below. */
+static void BM_LeanKernelFullBinState(benchmark::State& state) {
+    if (const std::string e = checkKernel(); !e.empty()) {
+        state.SkipWithError(e.c_str());
+        return;
+    }
+    FullGrid g;
+    for (auto _ : state) runFullStateKernel(g);
+    setCounters(state);
+}
+BENCHMARK(BM_LeanKernelFullBinState)->Unit(benchmark::kMillisecond);
 
 /** Arg: the insertion core's threads (1: the single-core figure the ratio uses; 2: the
  * two-stage pipeline, reported apart). */
