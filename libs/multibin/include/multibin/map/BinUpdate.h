@@ -64,11 +64,13 @@ inline void addMeasurement(BinEstimate& bin, double height_m, double variance_m2
     util::addSaturating(bin.pointCount, 1u);
 }
 
-/** Whether `v` is a whole number below 2^24 in magnitude: every such number is a float, so sums
- * of them that stay below 2^24 are exact in float (addCertainty). */
+/** 2^24: every integer up to it is a float, so sums of whole numbers that stay below it are
+ * exact in float. */
+constexpr float kFloatExactIntegerLimit = 16777216.0f;
+
+/** Whether `v` is a whole number below kFloatExactIntegerLimit in magnitude (addCertainty). */
 inline bool isExactWholeFloat(float v) {
-    constexpr float kExact = 16777216.0f;  // 2^24
-    return std::abs(v) < kExact && float(static_cast<int32_t>(v)) == v;
+    return std::abs(v) < kFloatExactIntegerLimit && float(static_cast<int32_t>(v)) == v;
 }
 
 /** `certainty += increment`, `times` times over, in float: what a bin's certainty counter becomes
@@ -77,9 +79,9 @@ inline bool isExactWholeFloat(float v) {
  * the sequence's result bit for bit; otherwise the sequence is run. `wholeIncrement`:
  * isExactWholeFloat(increment), for callers that add the same increment many times. */
 inline void addCertainty(float& certainty, float increment, uint32_t times, bool wholeIncrement) {
-    constexpr double kExact = 16777216.0;  // 2^24
     const double total = double(certainty) + double(increment) * double(times);
-    if (wholeIncrement && isExactWholeFloat(certainty) && std::abs(total) <= kExact) {
+    if (wholeIncrement && isExactWholeFloat(certainty) &&
+        std::abs(total) <= double(kFloatExactIntegerLimit)) {
         certainty = static_cast<float>(total);
         return;
     }
