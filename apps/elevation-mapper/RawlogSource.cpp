@@ -91,6 +91,32 @@ mrpt::serialization::CSerializable::Ptr readBounded(const RawlogStreamGuard& gua
                        std::to_string(bytesLeft) + " bytes left");
 }
 
+/** What the next object (its header peeked, served again to the next read) is when it is not of
+ * a concrete class derived from `base`: "null", "of an unregistered class", "of the abstract
+ * class C" or "a C"; empty when it is one. `slot` names it for a header cut short. */
+std::string unlessDerivedFrom(RawlogStreamGuard& guard, const mrpt::rtti::TRuntimeClassId* base,
+                              const std::string& slot) {
+    const RawlogStreamGuard::Header h = guard.peekHeader();
+    if (!h.complete) throw std::runtime_error(slot + " is cut short");
+    if (h.className == "nullptr") return "null";
+    const auto* cls = mrpt::rtti::findRegisteredClass(h.className);
+    if (!cls) return "of an unregistered class";
+    if (!cls->ptrCreateObject) return std::string("of the abstract class ") + cls->className;
+    if (!cls->derivedFrom(base)) return std::string("a ") + cls->className;
+    return {};
+}
+
+/** The end-of-object flag of an object read here field by field (none in MRPT's framing before
+ * 0.5.5). */
+void readEndFlag(mrpt::serialization::CArchive& arch, const RawlogStreamGuard::Header& h,
+                 const std::string& object) {
+    if (h.oldFraming) return;
+    uint8_t endFlag = 0;
+    arch >> endFlag;
+    if (endFlag != 0x88)  // MRPT's SERIALIZATION_END_FLAG
+        throw std::runtime_error(object + "'s end-of-object flag is missing");
+}
+
 bool isActionCollection(const RawlogStreamGuard::Header& h) {
     return h.complete && h.className != "nullptr" &&
            mrpt::rtti::findRegisteredClass(h.className) == CLASS_ID(mrpt::obs::CActionCollection);
@@ -116,31 +142,52 @@ mrpt::serialization::CSerializable::Ptr readActionCollection(mrpt::serialization
                            " bytes left can hold");
     auto acts = mrpt::obs::CActionCollection::Create();
     for (uint32_t k = 0; k < n; k++) {
-        const RawlogStreamGuard::Header slot = guard.peekHeader();
-        if (!slot.complete)
-            throw std::runtime_error("action " + std::to_string(k) + " is cut short");
-        const bool null = slot.className == "nullptr";
-        const auto* cls = null ? nullptr : mrpt::rtti::findRegisteredClass(slot.className);
-        if (!cls || !cls->ptrCreateObject || !cls->derivedFrom(CLASS_ID(mrpt::obs::CAction)))
-            throw RefusedEntry(where + " (an action collection): action " + std::to_string(k) +
-                               (null   ? " is null"
-                                : !cls ? " is of an unregistered class"
-                                : !cls->ptrCreateObject
-                                    ? std::string(" is of the abstract class ") + cls->className
-                                    : std::string(" is a ") + cls->className) +
+        const std::string slot = "action " + std::to_string(k);
+        if (const std::string is = unlessDerivedFrom(guard, CLASS_ID(mrpt::obs::CAction), slot);
+            !is.empty())
+            throw RefusedEntry(where + " (an action collection): " + slot + " is " + is +
                                ", not an action");
         guard.allowNextAction();
         const auto action = std::dynamic_pointer_cast<mrpt::obs::CAction>(arch.ReadObject());
         if (!action) throw std::runtime_error("action " + std::to_string(k) + " is not an action");
         acts->insert(*action);
     }
-    if (!h.oldFraming) {
-        uint8_t endFlag = 0;
-        arch >> endFlag;
-        if (endFlag != 0x88)  // MRPT's SERIALIZATION_END_FLAG
-            throw std::runtime_error("the action collection's end-of-object flag is missing");
-    }
+    readEndFlag(arch, h, "the action collection");
     return acts;
+}
+
+/** A top-level simplemap of serialization version 0 (its header peeked as `h`), read here
+ * keyframe by keyframe as MRPT would: its 2D pose PDFs become 3D ones. MRPT 2.5 converts each
+ * pose it reads without checking it, so a null pose or an object of another class there is a
+ * SIGSEGV (doc/reliability.md, finding 17); here it is an error naming the keyframe. */
+mrpt::maps::CSimpleMap readSimplemapVersion0(mrpt::serialization::CArchive& arch,
+                                             RawlogStreamGuard& guard,
+                                             const RawlogStreamGuard::Header& h) {
+    guard.dropPeeked();
+    uint32_t n = 0;
+    arch >> n;
+    mrpt::maps::CSimpleMap sm;
+    for (uint32_t k = 0; k < n; k++) {
+        const std::string slot = "keyframe " + std::to_string(k);
+        if (const std::string is =
+                unlessDerivedFrom(guard, CLASS_ID(mrpt::poses::CPosePDF), slot + "'s pose");
+            !is.empty())
+            throw RefusedEntry(slot +
+                               " of a simplemap of serialization version 0 (2D poses) has a pose "
+                               "that is " +
+                               is + ", not a 2D pose PDF");
+        const auto pdf = std::dynamic_pointer_cast<mrpt::poses::CPosePDF>(arch.ReadObject());
+        if (!pdf) throw std::runtime_error("keyframe " + std::to_string(k) + " has no pose");
+        const auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(arch.ReadObject());
+        sm.insert(mrpt::poses::CPose3DPDF::Ptr(mrpt::poses::CPose3DPDF::createFrom2D(*pdf)), sf);
+    }
+    readEndFlag(arch, h, "the simplemap");
+    return sm;
+}
+
+bool isSimplemapVersion0(const RawlogStreamGuard::Header& h) {
+    return h.complete && h.version == 0 && h.className != "nullptr" &&
+           mrpt::rtti::findRegisteredClass(h.className) == CLASS_ID(mrpt::maps::CSimpleMap);
 }
 
 bool finitePose(const mrpt::poses::CPose3D& p) {
@@ -280,11 +327,19 @@ mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const 
         ReadBudget budget(ReadBudget::limitFor(sizeBound_bytes));
         try {
             auto arch = mrpt::serialization::archiveFrom(guard);
-            arch >> sm;
+            const RawlogStreamGuard::Header h = guard.peekHeader();
+            if (isSimplemapVersion0(h))
+                sm = readSimplemapVersion0(arch, guard, h);
+            else
+                arch >> sm;
+        } catch (const RefusedEntry&) {
+            throw;
         } catch (const std::exception&) {
             asked = ReadBudget::largestRefused();
             if (asked == 0 && guard.refusal().empty()) throw;
         }
+    } catch (const RefusedEntry& e) {
+        throw std::runtime_error(name + ": " + e.what());
     } catch (const std::exception& e) {
         throw std::runtime_error(name + " is truncated or corrupt: " + multibin::oneLineMessage(e));
     }

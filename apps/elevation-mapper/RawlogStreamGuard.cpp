@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #include "RawlogStreamGuard.h"
 
+#include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CAction.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
@@ -147,6 +148,10 @@ void RawlogStreamGuard::headerRead(const std::string& className, int version) {
         return;
     }
     if (!cls) return;  // null, or not registered (MRPT refuses it)
+    // MRPT converts the 2D poses of a version-0 simplemap without checking them (a null pose or
+    // another class is a SIGSEGV); RawlogSource reads a top-level one itself.
+    if (cls == CLASS_ID(mrpt::maps::CSimpleMap) && version == 0)
+        refuse("a simplemap of serialization version 0 (2D poses) inside another object");
     const bool action = cls->derivedFrom(CLASS_ID(mrpt::obs::CAction));
     if (!action && cls != CLASS_ID(mrpt::obs::CActionCollection)) return;
     if (!allowed || !action)

@@ -21,7 +21,9 @@
  *   the entries of a top-level action collection (allowNextAction());
  * - an object of an abstract class (MRPT reads it as null);
  * - a CActionRobotMovement2D whose pose change object (read for serialization versions 0 and 1,
- *   and for later ones when the estimation method is not odometry) is null or not a CPosePDF.
+ *   and for later ones when the estimation method is not odometry) is null or not a CPosePDF;
+ * - a CSimpleMap of serialization version 0 (2D poses, which MRPT converts unchecked) anywhere
+ *   but at the top of a simplemap file, which RawlogSource reads itself.
  * A refusal throws from Read(), before MRPT has the bytes; refusal() keeps its text (MRPT
  * replaces the text of errors inside nested objects by "EOF"). A false alarm needs a 1-byte
  * read followed by a read of exactly that many bytes that name an action class. */

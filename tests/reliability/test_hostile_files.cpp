@@ -110,6 +110,19 @@ void expectOneLineError(const RunResult& r, const fs::path& file, const std::str
 }
 
 void write(const fs::path& p, const Bytes& b) { std::ofstream(p, std::ios::binary) << b; }
+
+/** Each case (name, file bytes, what the error must say) written as DIR/name.KIND and given to
+ * the mapper as --KIND (rawlog or simplemap): a one-line error naming the file and saying that. */
+void expectEachRefused(const fs::path& dir, const std::string& kind,
+                       const std::vector<std::tuple<std::string, Bytes, std::string>>& cases) {
+    for (const auto& [name, bytes, what] : cases) {
+        SCOPED_TRACE(name);
+        const fs::path f = dir / (name + "." + kind);
+        write(f, bytes);
+        expectOneLineError(runMapper("--" + kind, f, dir), f, what);
+    }
+}
+
 }  // namespace
 
 // A sensory frame whose observation slot holds a null object, or an object of another class
@@ -210,12 +223,7 @@ TEST(HostileFiles, AnActionOrPoseChangeThatIsNullOrOfAnotherClassIsAnErrorNotACr
         {"slot_abstract",
          inCollection(Bytes(1, char(0x80 | 18)) + "mrpt::obs::CAction" + Bytes(1, 0) + endFlag),
          "action 0 is of the abstract class mrpt::obs::CAction"}};
-    for (const auto& [name, bytes, what] : cases) {
-        SCOPED_TRACE(name);
-        const fs::path f = dir / (name + ".rawlog");
-        write(f, bytes);
-        expectOneLineError(runMapper("--rawlog", f, dir), f, what);
-    }
+    expectEachRefused(dir, "rawlog", cases);
     // An action where an observation belongs (MRPT reads any class there, then casts).
     const auto obs = scan(50);
     const Bytes obsBytes = bytesOf(mrpt::obs::CObservation::Ptr(obs));
@@ -241,6 +249,46 @@ TEST(HostileFiles, AnActionOrPoseChangeThatIsNullOrOfAnotherClassIsAnErrorNotACr
         const RunResult ok = runMapper("--rawlog", f, dir);
         EXPECT_EQ(ok.exitCode, 0) << name << ": " << ok.stderrText;
     }
+}
+
+// A simplemap of serialization version 0 stores 2D pose PDFs, which MRPT 2.5 converts to 3D
+// without checking what it read: a null pose or an object of another class there was a SIGSEGV
+// inside MRPT (finding 17, found by fuzz_rawlog_read in CI). The mapper reads such a file
+// itself, keyframe by keyframe, and refuses one nested anywhere else.
+TEST(HostileFiles, AVersion0SimplemapWhosePoseIsNotA2DPdfIsAnErrorNotACrash) {
+    const fs::path dir = scratchDir("hostile_simplemap_v0");
+    const std::string cls = "mrpt::maps::CSimpleMap";
+    const Bytes one("\x01\0\0\0", 4);    // one keyframe
+    const Bytes endFlag(1, char(0x88));  // MRPT's end-of-object flag
+    auto v0 = [&](const Bytes& pose) {
+        return Bytes(1, char(0x80 | cls.size())) + cls + Bytes(1, 0) + one + pose +
+               sensoryFrameWith(scan(50)) + endFlag;
+    };
+    const Bytes pose3d =
+        bytesOf(mrpt::poses::CPose3DPDF::Ptr(mrpt::poses::CPose3DPDFGaussian::Create(posePdf())));
+    const std::vector<std::tuple<std::string, Bytes, std::string>> cases = {
+        {"null", v0(nullObject()),
+         "keyframe 0 of a simplemap of serialization version 0 (2D poses) has a pose that is "
+         "null, not a 2D pose PDF"},
+        {"pose3d", v0(pose3d),
+         "a pose that is a mrpt::poses::CPose3DPDFGaussian, not a 2D pose PDF"},
+        {"not_a_pdf", v0(poseObject()),
+         "a pose that is a mrpt::poses::CPose3D, not a 2D pose PDF"}};
+    expectEachRefused(dir, "simplemap", cases);
+    // Nested in a rawlog (MRPT reads any class where an observation belongs, then casts).
+    const auto obs = scan(50);
+    const fs::path nested = dir / "nested.rawlog";
+    write(nested, sensoryFrameWith(scan(50)) + spliced(sensoryFrameWith(obs),
+                                                       bytesOf(mrpt::obs::CObservation::Ptr(obs)),
+                                                       v0(nullObject())));
+    expectOneLineError(runMapper("--rawlog", nested, dir), nested,
+                       "a simplemap of serialization version 0 (2D poses) inside another object");
+    // Control: a version-0 simplemap with a 2D pose PDF is read, its pose made 3D, and mapped.
+    const fs::path good = dir / "good.simplemap";
+    write(good, v0(bytesOf(mrpt::poses::CPosePDF::Ptr(
+                    mrpt::poses::CPosePDFGaussian::Create(mrpt::poses::CPose2D(0.1, 0, 0))))));
+    const RunResult ok = runMapper("--simplemap", good, dir);
+    EXPECT_EQ(ok.exitCode, 0) << ok.stderrText;
 }
 
 // A fixed window that cannot hold the data is an error naming the window, never a silent empty
