@@ -117,9 +117,10 @@ void readEndFlag(mrpt::serialization::CArchive& arch, const RawlogStreamGuard::H
         throw std::runtime_error(object + "'s end-of-object flag is missing");
 }
 
-bool isActionCollection(const RawlogStreamGuard::Header& h) {
+/** Whether a peeked header announces an object of exactly the class `cls`. */
+bool isOfClass(const RawlogStreamGuard::Header& h, const mrpt::rtti::TRuntimeClassId* cls) {
     return h.complete && h.className != "nullptr" &&
-           mrpt::rtti::findRegisteredClass(h.className) == CLASS_ID(mrpt::obs::CActionCollection);
+           mrpt::rtti::findRegisteredClass(h.className) == cls;
 }
 
 /** A top-level action collection (its header peeked as `h`), read here action by action: MRPT
@@ -149,7 +150,7 @@ mrpt::serialization::CSerializable::Ptr readActionCollection(mrpt::serialization
                                ", not an action");
         guard.allowNextAction();
         const auto action = std::dynamic_pointer_cast<mrpt::obs::CAction>(arch.ReadObject());
-        if (!action) throw std::runtime_error("action " + std::to_string(k) + " is not an action");
+        if (!action) throw std::runtime_error(slot + " is not an action");
         acts->insert(*action);
     }
     readEndFlag(arch, h, "the action collection");
@@ -177,17 +178,12 @@ mrpt::maps::CSimpleMap readSimplemapVersion0(mrpt::serialization::CArchive& arch
                                "that is " +
                                is + ", not a 2D pose PDF");
         const auto pdf = std::dynamic_pointer_cast<mrpt::poses::CPosePDF>(arch.ReadObject());
-        if (!pdf) throw std::runtime_error("keyframe " + std::to_string(k) + " has no pose");
+        if (!pdf) throw std::runtime_error(slot + " has no pose");
         const auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(arch.ReadObject());
         sm.insert(mrpt::poses::CPose3DPDF::Ptr(mrpt::poses::CPose3DPDF::createFrom2D(*pdf)), sf);
     }
     readEndFlag(arch, h, "the simplemap");
     return sm;
-}
-
-bool isSimplemapVersion0(const RawlogStreamGuard::Header& h) {
-    return h.complete && h.version == 0 && h.className != "nullptr" &&
-           mrpt::rtti::findRegisteredClass(h.className) == CLASS_ID(mrpt::maps::CSimpleMap);
 }
 
 bool finitePose(const mrpt::poses::CPose3D& p) {
@@ -243,7 +239,7 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
             const RawlogStreamGuard::Header h = guard.peekHeader();
             if (h.bytes == 0) break;  // clean end, between two entries
             obj = readBounded(guard, left, entryName(), [&] {
-                return isActionCollection(h)
+                return isOfClass(h, CLASS_ID(mrpt::obs::CActionCollection))
                            ? readActionCollection(arch, guard, h, left, entryName())
                            : arch.ReadObject();
             });
@@ -328,7 +324,7 @@ mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const 
         try {
             auto arch = mrpt::serialization::archiveFrom(guard);
             const RawlogStreamGuard::Header h = guard.peekHeader();
-            if (isSimplemapVersion0(h))
+            if (isOfClass(h, CLASS_ID(mrpt::maps::CSimpleMap)) && h.version == 0)
                 sm = readSimplemapVersion0(arch, guard, h);
             else
                 arch >> sm;
