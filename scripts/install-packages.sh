@@ -3,10 +3,11 @@
 # not installed yet (sudo when not root). Sourced by setup.sh and sanitize.sh.
 
 # What any build of the project needs (compilers and tools, MRPT, Eigen, OpenCV, GoogleTest,
-# Google Benchmark, nlohmann-json, zlib).
+# Google Benchmark, nlohmann-json, zlib; pybind11, numpy and pytest for the Python module).
 multibin_build_packages=(g++ cmake ninja-build pkg-config libmrpt-dev mrpt-apps mrpt-common
                          libeigen3-dev libopencv-dev libgtest-dev libbenchmark-dev
-                         nlohmann-json3-dev zlib1g-dev)
+                         nlohmann-json3-dev zlib1g-dev
+                         pybind11-dev python3-dev python3-numpy python3-pytest)
 install_missing_packages() {
   local missing=() p sudo_cmd=""
   for p in "$@"; do

@@ -1,0 +1,93 @@
+/* Part of the multibin elevation-mapping library: a C++ helper of the Python module's tests
+ * and benchmark. It loads a serialized map as any C++ program would (MRPT archive) and answers
+ * the module's height query (HeightQuery.h) at given points:
+ *
+ *   multibin_query_table MAP XY_IN TABLE_OUT   x, y float64 pairs in; x, y, height, sigma,
+ *                                              source float64 rows out (NaN where unknown)
+ *   multibin_query_table --time N MAP XY_IN    the query loop over the points N times; prints the
+ *                                              fastest run's seconds */
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "HeightQuery.h"
+
+using mrpt::maps::CMultiBinElevationMap;
+
+namespace {
+std::vector<double> readDoubles(const std::string& path) {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in) throw std::runtime_error("cannot read '" + path + "'");
+    std::vector<double> v(size_t(in.tellg()) / sizeof(double));
+    in.seekg(0);
+    in.read(reinterpret_cast<char*>(v.data()), std::streamsize(v.size() * sizeof(double)));
+    return v;
+}
+
+void loadMap(const std::string& path, CMultiBinElevationMap& map) {
+    mrpt::io::CFileGZInputStream in(path);
+    auto arch = mrpt::serialization::archiveFrom(in);
+    arch.ReadObject(&map);
+}
+
+/** The points' x and y (split from the interleaved pairs). */
+void split(const std::vector<double>& xy, std::vector<double>& x, std::vector<double>& y) {
+    x.resize(xy.size() / 2);
+    y.resize(xy.size() / 2);
+    for (size_t i = 0; i < x.size(); i++) {
+        x[i] = xy[2 * i];
+        y[i] = xy[2 * i + 1];
+    }
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        const std::vector<std::string> a(argv + 1, argv + argc);
+        const bool timing = a.size() == 4 && a[0] == "--time";
+        if (!timing && a.size() != 3) {
+            std::cerr << "usage: multibin_query_table MAP XY_IN TABLE_OUT | --time N MAP XY_IN\n";
+            return 2;
+        }
+        CMultiBinElevationMap map;
+        loadMap(timing ? a[2] : a[0], map);
+        std::vector<double> x, y;
+        split(readDoubles(timing ? a[3] : a[1]), x, y);
+        const size_t n = x.size();
+        std::vector<double> h(n), s(n);
+        std::vector<uint8_t> src(n);
+        if (timing) {
+            double best_s = 1e300;
+            for (int run = 0; run < std::stoi(a[1]); run++) {
+                const auto t0 = std::chrono::steady_clock::now();
+                multibin::python::queryHeights(map, x.data(), y.data(), n, h.data(), s.data(),
+                                               src.data());
+                best_s = std::min(
+                    best_s,
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+            }
+            std::printf("%.9f\n", best_s);
+            return 0;
+        }
+        multibin::python::queryHeights(map, x.data(), y.data(), n, h.data(), s.data(), src.data());
+        std::ofstream out(a[2], std::ios::binary);
+        for (size_t i = 0; i < n; i++) {
+            const double row[5] = {x[i], y[i], h[i], s[i], double(src[i])};
+            out.write(reinterpret_cast<const char*>(row), sizeof row);
+        }
+        if (!out) throw std::runtime_error("cannot write '" + a[2] + "'");
+        return 0;
+    } catch (const std::exception& e) {
+        std::cerr << "multibin_query_table: " << e.what() << "\n";
+        return 1;
+    }
+}
