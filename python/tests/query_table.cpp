@@ -2,8 +2,9 @@
  * and benchmark. It loads a serialized map as any C++ program would (MRPT archive) and answers
  * the module's height query (HeightQuery.h) at given points:
  *
- *   multibin_query_table MAP XY_IN TABLE_OUT   x, y float64 pairs in; x, y, height, sigma,
- *                                              source float64 rows out (NaN where unknown)
+ *   multibin_query_table [--fill] MAP XY_IN TABLE_OUT
+ *       x, y float64 pairs in; x, y, height, sigma, source float64 rows out (NaN where unknown);
+ *       with --fill the gaps are filled first (a loaded map holds no fill: it is lazy)
  *   multibin_query_table --time N MAP XY_IN    the query loop over the points N times; prints the
  *                                              fastest run's seconds */
 #include <mrpt/io/CFileGZInputStream.h>
@@ -52,14 +53,18 @@ void split(const std::vector<double>& xy, std::vector<double>& x, std::vector<do
 
 int main(int argc, char** argv) {
     try {
-        const std::vector<std::string> a(argv + 1, argv + argc);
+        std::vector<std::string> a(argv + 1, argv + argc);
+        const bool fill = !a.empty() && a[0] == "--fill";
+        if (fill) a.erase(a.begin());
         const bool timing = a.size() == 4 && a[0] == "--time";
         if (!timing && a.size() != 3) {
-            std::cerr << "usage: multibin_query_table MAP XY_IN TABLE_OUT | --time N MAP XY_IN\n";
+            std::cerr << "usage: multibin_query_table [--fill] MAP XY_IN TABLE_OUT | [--fill] "
+                         "--time N MAP XY_IN\n";
             return 2;
         }
         CMultiBinElevationMap map;
         loadMap(timing ? a[2] : a[0], map);
+        if (fill) map.dem_update_map();
         std::vector<double> x, y;
         split(readDoubles(timing ? a[3] : a[1]), x, y);
         const size_t n = x.size();
