@@ -70,6 +70,15 @@ def main():
                 m.height(xi, yi)
 
         loop_s = blockwise(args.loop_runs, x, y, python_loop)
+        # The same by what the map answers: the query's own cost differs by source.
+        _, _, src = m.height(x, y)
+        by_source = {}
+        for name, sel in [("unknown", src == multibin.SOURCE_UNKNOWN),
+                          ("measured", src == multibin.SOURCE_MEASURED),
+                          ("filled", src >= multibin.SOURCE_FILLED_MEDIAN)]:
+            xs, ys = x[sel][:BLOCK], y[sel][:BLOCK]
+            by_source[name] = (len(xs), blockwise(args.runs, xs, ys, m.height),
+                               blockwise(args.loop_runs, xs, ys, python_loop))
         cpp_s = float(subprocess.run(
             [str(helper), "--fill", "--time", str(args.runs), str(tmp / "map.bin"),
              str(tmp / "xy.bin")], check=True, capture_output=True, text=True).stdout)
@@ -82,6 +91,10 @@ def main():
         print(f"  {name:30s} {t * 1e3:8.1f} ms  ({t / args.points * 1e9:5.0f} ns/point)")
     print(f"  Python loop / vectorised: {loop_s / vectorised_s:.1f} x (target >= 5)")
     print(f"  vectorised / C++ loop:    {vectorised_s / cpp_s:.2f} x (target <= 1.5)")
+    print("By source (up to one block of the points the map answers so):")
+    for name, (n, vec_s, py_s) in by_source.items():
+        print(f"  {name:9s} {n:6d} points: vectorised {vec_s / n * 1e9:5.0f} ns/point, Python "
+              f"loop {py_s / n * 1e9:5.0f} ns/point, {py_s / vec_s:.1f} x")
 
 
 if __name__ == "__main__":

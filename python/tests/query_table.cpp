@@ -88,12 +88,10 @@ int main(int argc, char** argv) {
                 const size_t m = std::min(kTimedBlock, n - b);
                 double best_s = 1e300;
                 for (int run = 0; run < std::stoi(a[1]); run++) {
-                    const auto t0 = std::chrono::steady_clock::now();
+                    const double t0_s = threadCpu_s();
                     multibin::python::queryHeights(map, x.data() + b, y.data() + b, m, h.data() + b,
                                                    s.data() + b, src.data() + b);
-                    best_s = std::min(
-                        best_s, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
-                                    .count());
+                    best_s = std::min(best_s, threadCpu_s() - t0_s);
                 }
                 total_s += best_s;
             }
