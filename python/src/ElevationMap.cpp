@@ -234,6 +234,10 @@ py::dict ElevationMap::insertSensorPoints(const py::handle& points, const py::ha
     pdf.mean = pose6(fn + ": robot_pose", robotPose);
     pdf.cov = poseCovariance(fn + ": robot_pose_cov", robotPoseCov);
     fixOriginNear(pdf.mean.x(), pdf.mean.y());
+    if (m_map->isDualGrid()) {  // both grids follow the robot, as for an observation
+        py::gil_scoped_release nogil;
+        m_map->recenter(pdf.mean.x(), pdf.mean.y());
+    }
     const mrpt::math::TPoint2D o = m_map->mapOrigin();
     pdf.mean.x(pdf.mean.x() - o.x);  // the library's geometry is relative to the origin
     pdf.mean.y(pdf.mean.y() - o.y);

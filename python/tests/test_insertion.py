@@ -179,3 +179,15 @@ def test_insert_sensor_points_refuses_bad_poses(sensor_pose, robot_pose, robot_p
     with pytest.raises(ValueError, match="insert_sensor_points: " + message):
         m.insert_sensor_points(P, C, sensor_pose, robot_pose, robot_pose_cov)
     assert m.insert_stats["accepted"] == 0
+
+
+def test_a_dual_grid_follows_the_robot_of_insert_sensor_points():
+    """The local grid (2 m) is centred on the robot pose before the points go in: points 5 m
+    away from the first pose are kept in the local grid's precise cells."""
+    m = multibin.ElevationMap(dual_grid=True)
+    pts, cov = plane_points(3000, size_m=0.5, height_m=-0.3, sigma_m=0.002)
+    pose = np.array([5.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    stats = m.insert_sensor_points(pts, cov, np.zeros(6), pose, np.zeros((6, 6)))
+    assert stats["accepted"] == 3000
+    h, _, src = m.height([5.25], [0.25])
+    assert src[0] == multibin.SOURCE_MEASURED and abs(h[0] + 0.3) < 1e-3
