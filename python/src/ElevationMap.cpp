@@ -276,10 +276,19 @@ py::dict ElevationMap::layers() const {
     EsriAsciiGrid height, sigma, certainty, source;
     {
         py::gil_scoped_release nogil;
-        height = m_map->toRaster(Layer::Height);
-        sigma = m_map->toRaster(Layer::Sigma);
-        certainty = m_map->toRaster(Layer::Certainty);
-        source = m_map->toRaster(Layer::Source);
+        // Each raster takes the map's lock on its own: a writer between them may grow the
+        // window. Read again until the four share one lattice (a grown window is rare).
+        auto sameLattice = [](const EsriAsciiGrid& a, const EsriAsciiGrid& b) {
+            return a.rows() == b.rows() && a.cols() == b.cols() && a.xllcenter_m == b.xllcenter_m &&
+                   a.yllcenter_m == b.yllcenter_m;
+        };
+        do {
+            height = m_map->toRaster(Layer::Height);
+            sigma = m_map->toRaster(Layer::Sigma);
+            certainty = m_map->toRaster(Layer::Certainty);
+            source = m_map->toRaster(Layer::Source);
+        } while (!(sameLattice(height, sigma) && sameLattice(height, certainty) &&
+                   sameLattice(height, source)));
     }
     py::array_t<uint8_t> src({source.rows(), source.cols()});
     auto v = src.mutable_unchecked<2>();
