@@ -3,11 +3,10 @@
 # not installed yet (sudo when not root). Sourced by setup.sh and sanitize.sh.
 
 # What any build of the project needs (compilers and tools, MRPT, Eigen, OpenCV, GoogleTest,
-# Google Benchmark, nlohmann-json, zlib; pybind11, numpy and pytest for the Python module).
+# Google Benchmark, nlohmann-json, zlib).
 multibin_build_packages=(g++ cmake ninja-build pkg-config libmrpt-dev mrpt-apps mrpt-common
                          libeigen3-dev libopencv-dev libgtest-dev libbenchmark-dev
-                         nlohmann-json3-dev zlib1g-dev
-                         pybind11-dev python3-dev python3-numpy python3-pytest)
+                         nlohmann-json3-dev zlib1g-dev)
 install_missing_packages() {
   local missing=() p sudo_cmd=""
   for p in "$@"; do
@@ -20,3 +19,6 @@ install_missing_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends \
     "${missing[@]}" >/dev/null
 }
+# The Python module (python/, doc/python.md): pybind11 and the headers to build it, numpy and
+# pytest for its tests. Part of every build: scripts/setup.sh requires the module.
+multibin_build_packages+=(pybind11-dev python3-dev python3-numpy python3-pytest)
