@@ -21,3 +21,6 @@ install_missing_packages() {
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends \
     "${missing[@]}" >/dev/null
 }
+# The Python module (python/, doc/python.md): pybind11 and the headers to build it, numpy and
+# pytest for its tests. Part of every build: scripts/setup.sh requires the module.
+multibin_build_packages+=(pybind11-dev python3-dev python3-numpy python3-pytest)

@@ -9,5 +9,6 @@ source "$root/scripts/install-packages.sh"
 # The build, plus matplotlib for elevation-mapper's figures.
 install_missing_packages "${multibin_build_packages[@]}" python3-matplotlib
 
-cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S "$root" -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DMULTIBIN_REQUIRE_PYTHON=ON >/dev/null  # the packages above hold all it needs
 cmake --build "$build_dir" -j "$(nproc)"

@@ -26,11 +26,14 @@ public:
     /** One line saying why no point was fused (call when the map fused none). */
     std::string whyNothingFused(const multibin::InsertStats& totals) const;
 
-private:
+    /** What report() prints for one class (the Python module returns them as a dict). */
     struct Counts {
         size_t used = 0, rejected = 0, byLabel = 0, nothing = 0, poses = 0;
         size_t pointsFused = 0, pointsRejected = 0;
     };
+    const std::map<std::string, Counts>& byClass() const { return m_byClass; }
+
+private:
     std::map<std::string, Counts> m_byClass;
     size_t m_accepted0 = 0, m_rejected0 = 0, m_byLabel0 = 0;
 };

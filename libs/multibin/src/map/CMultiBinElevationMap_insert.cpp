@@ -348,6 +348,13 @@ multibin::InsertStats CMultiBinElevationMap::insertPoints(
         sensorOrigin_m);
 }
 
+void CMultiBinElevationMap::growToCoverPoints(const PointsWithCov& mapPoints,
+                                              const Eigen::Vector3d& sensor_m) {
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
+    validateOptions(*this);
+    growToCover(mapPoints, sensor_m);
+}
+
 multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     multibin::BinGrid& grid, const FuseIntoGrid& fuse,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m, bool cameraFrame) {

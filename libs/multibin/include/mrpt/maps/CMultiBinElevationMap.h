@@ -230,6 +230,12 @@ public:
         double continuityBound_m = std::numeric_limits<double>::infinity(),
         const std::optional<Eigen::Vector3d>& sensorOrigin_m = std::nullopt,
         const multibin::PoseVariances* pose = nullptr);
+    /** Grows the window as an observation's insertion does (TCreationOptions::grow,
+     * max_size_m) to cover those of `mapPoints` within max_size_m / 2 of `sensor_m` that pass
+     * the eq 13 gate; both relative to mapOrigin(). For callers of insertPoints(), which does not
+     * grow (the Python module's insert_points). */
+    void growToCoverPoints(const multibin::PointsWithCov& mapPoints,
+                           const Eigen::Vector3d& sensor_m);
 
     /** @name Queries @{ */
     const multibin::BinGrid& grid() const;
