@@ -19,12 +19,13 @@ namespace multibin {
 class PosePropagator;
 struct PoseVariances;
 
-/** The 2.5D grid of multi-bin cells: the storage (BinStore: cells, bins, the moving window), the
- * update rule applied to points (the gates of eqs 13-14 and the Kalman update of eq 15 from
- * BinUpdate.h) and the visibility index kept in step with both (VisibilityIndex: update cycles,
- * block height bounds), as OctoMap's OccupancyOcTreeBase adds its update rule to the storage of
- * OcTreeBaseImpl. Memory: 16 B per cell of the window (4 B store, 12 B index), 12 B per block of
- * 256 cells and 64 B per bin (Bin.h). */
+/** The 2.5D grid of multi-bin cells: the storage (a BinStore member: cells, bins, the moving
+ * window), the update rule applied to points (the gates of eqs 13-14 from BinUpdate.h, each
+ * bin's update through BinAccumulator.h) and the visibility index kept in step with both
+ * (VisibilityIndex: update cycles, block height bounds), as OctoMap's OccupancyOcTreeBase adds its
+ * update rule to the storage of OcTreeBaseImpl. The insertion on two cores runs through
+ * src/map/InsertionPipeline.h. Memory: 16 B per cell of the window (4 B store, 12 B index), 12 B
+ * per block of 256 cells and 64 B per bin (Bin.h). */
 class BinGrid {
 public:
     using BinId = BinStore::BinId;
