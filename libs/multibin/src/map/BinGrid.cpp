@@ -2,23 +2,15 @@
 #include "multibin/map/BinGrid.h"
 
 #include <algorithm>
-#include <array>
-#include <atomic>
 #include <cmath>
-#include <exception>
-#include <memory>
 #include <stdexcept>
-#include <thread>
-
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#endif
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/BinAccumulator.h"
 #include "multibin/util/Counters.h"
 #include "multibin/util/VectorClones.h"
 
-#include "../util/HelperThread.h"
+#include "InsertionPipeline.h"
 
 namespace multibin {
 
@@ -29,20 +21,20 @@ InsertStats& InsertStats::operator+=(const InsertStats& o) {
                             &InsertStats::tooUncertain, &InsertStats::continuityRejected);
 }
 
-BinGrid::BinGrid(double cellSize_m) : BinStore(cellSize_m) { m_index.reset(window()); }
+BinGrid::BinGrid(double cellSize_m) : m_store(cellSize_m) { m_index.reset(window()); }
 
 void BinGrid::reset(double cellSize_m, const CellWindow& window) {
-    BinStore::reset(cellSize_m, window);
+    m_store.reset(cellSize_m, window);
     m_index.reset(window);
 }
 
 void BinGrid::growToInclude(const CellWindow& w) {
-    if (BinStore::growToInclude(w)) m_index.regrow(store());
+    if (m_store.growToInclude(w)) m_index.regrow(m_store);
 }
 
 void BinGrid::appendBin(int ix, int iy, const BinEstimate& bin) {
-    BinStore::appendBin(ix, iy, bin);
-    m_index.noteHeight(slot(ix, iy), ix, iy, bin.height_m);
+    m_store.appendBin(ix, iy, bin);
+    m_index.noteHeight(m_store.slot(ix, iy), ix, iy, bin.height_m);
 }
 
 void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateParams& params) {
@@ -51,17 +43,16 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
     int16_t n;
     if (!binIndexOf(other.height_m, params.binHeight_m, n)) return;
     bool added;
-    const size_t s = slot(ix, iy);
-    Bin& bin = BinStore::bin(findOrAddBin(s, n, added));
+    const size_t s = m_store.slot(ix, iy);
+    Bin& bin = m_store.bin(m_store.findOrAddBin(s, n, added));
     if (added) {
         static_cast<BinEstimate&>(bin) = other;
         bin.index = n;
     } else {
-        fuse(bin.height_m, bin.variance_m2, other.height_m, other.variance_m2);
-        mergePlaneMoments(bin.plane, other.plane);
-        lowerPoseSigmaCodes(bin, other.poseHeightSigmaCode, other.poseHorizontalSigmaCode);
-        bin.certainty += other.certainty;
-        util::addSaturating(bin.pointCount, other.pointCount);
+        BinAccumulator<HeightFusion::kSequential> update;
+        update.open(bin, cellCenter_m(ix), cellCenter_m(iy));
+        update.merge(other);
+        update.close(bin, params, false);
     }
     m_index.noteHeight(s, ix, iy, bin.height_m);
 }
@@ -90,24 +81,28 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
         stats.outsideBinRange++;
         return false;
     }
-    return fuseMeasurement(slot(ix, iy), ix, iy, n, height_m, variance_m2, params,
-                           continuityBound_m, stats, std::nanf(""), std::nanf(""), 0, 0);
+    return fuseMeasurement(m_store.slot(ix, iy), ix, iy, n, height_m, variance_m2,
+                           1.0 / variance_m2, params, continuityBound_m, stats, std::nanf(""),
+                           std::nanf(""), 0, 0);
 }
 
 bool BinGrid::fuseMeasurement(size_t s, int ix, int iy, int16_t n, double height_m,
-                              double variance_m2, const BinUpdateParams& params,
+                              double variance_m2, double weight, const BinUpdateParams& params,
                               double continuityBound_m, InsertStats& stats, float x_m, float y_m,
                               uint8_t poseHeightCode, uint8_t poseHorizontalCode) {
-    Bin& bin = BinStore::bin(findOrAddBin(s, n));
-    if (!passesEq14(bin, height_m, continuityBound_m)) {
+    Bin& bin = m_store.bin(m_store.findOrAddBin(s, n));
+    BinAccumulator<HeightFusion::kSequential> update;
+    update.open(bin, cellCenter_m(ix), cellCenter_m(iy));
+    if (!update.passesEq14(height_m, continuityBound_m)) {
         stats.continuityRejected++;
         return false;
     }
-    addMeasurement(bin, height_m, variance_m2, params);
-    if (!std::isnan(x_m))  // a height without a place (insertHeight) says nothing of the slope
-        addPlanePoint(bin.plane, float(x_m - cellCenter_m(ix)), float(y_m - cellCenter_m(iy)),
-                      float(height_m), float(1.0 / variance_m2));
-    lowerPoseSigmaCodes(bin, poseHeightCode, poseHorizontalCode);
+    if (std::isnan(x_m))  // a height without a place (insertHeight) says nothing of the slope
+        update.addHeight(height_m, variance_m2, weight, params);
+    else
+        update.addPoint(x_m, y_m, height_m, variance_m2, weight, params);
+    update.lowerPoseCodes(poseHeightCode, poseHorizontalCode);
+    update.close(bin, params, false);
     stats.accepted++;
     m_index.noteUpdate(s, ix, iy, height_m, 1);
     return true;
@@ -232,29 +227,42 @@ struct ClassifiedStage {
     size_t count = 0;
 };
 
-/** Blocks in flight between the two stages of the pipeline: 8 x 14 kB, inside the L2 cache. */
-constexpr size_t kPipelineRing = 8;
-/** The pipeline pays from about this many blocks on (handing a task to the helper thread costs
- * about as much as a few blocks' work): a 30 000-return lidar revolution, a stereo or depth frame,
- * not a 683-beam laser scan. */
-constexpr size_t kPipelineMinBlocks = 16;
-
-inline void pauseCore() {
-#if defined(__x86_64__) || defined(__i386__)
-    _mm_pause();  // a spin-wait hint: frees the core's resources for its other hyperthread
-#endif
+/** Calls fuse(i) for each accepted point i of a classified block, in order, and counts the others
+ * in `rejected` by reason; returns the accepted count. */
+template <class Fuse>
+__attribute__((always_inline)) inline size_t forAccepted(const ClassifiedStage& stage,
+                                                         size_t (&rejected)[kStatusCount],
+                                                         Fuse&& fuse) {
+    const PointBlock& pts = stage.points;
+    const ClassifiedBlock& cb = stage.classes;
+    size_t accepted = stage.count;
+    for (size_t i = 0; i < stage.count; i++) {
+        if (cb.status[i] != kAccept) {  // rare: counted per reason after the loop
+            uint8_t status = cb.status[i];
+            if (status == kCheckSingular) {  // zero or singular: an exact pose, fused as it is
+                const SymmetricCov3 c{pts.v[3][i], pts.v[4][i], pts.v[5][i],
+                                      pts.v[6][i], pts.v[7][i], pts.v[8][i]};
+                status =
+                    isSingularCovariance(c) ? cb.statusAfterCovariance[i] : uint8_t(kBadCovariance);
+            }
+            if (status != kAccept) {
+                rejected[status]++;
+                accepted--;
+                continue;
+            }
+        }
+        fuse(i);
+    }
+    return accepted;
 }
 
-/** Waits for `ready()` (the helper thread, for a free slot of the ring): spins briefly (the other
- * stage is usually a block away), then yields the core. */
-template <class Ready>
-void waitUntil(Ready&& ready) {
-    for (int spins = 0; !ready(); spins++) {
-        if (spins < 1024)
-            pauseCore();
-        else
-            std::this_thread::yield();
-    }
+/** Adds the rejections forAccepted counted to `stats`. */
+void addRejections(InsertStats& stats, const size_t (&rejected)[kStatusCount]) {
+    stats.notFinite += rejected[kNotFinite];
+    stats.badCovariance += rejected[kBadCovariance];
+    stats.outsideMap += rejected[kOutsideMap];
+    stats.tooUncertain += rejected[kTooUncertain];
+    stats.outsideBinRange += rejected[kOutsideBinRange];
 }
 
 }  // namespace
@@ -295,75 +303,6 @@ InsertStats BinGrid::insertSensorPoints(const PosePropagator& propagator,
         params, continuityBound_m);
 }
 
-template <typename Classify, typename Update>
-bool BinGrid::insertPipelined(size_t blocks, Classify& classify, Update& updateBins) {
-    // Two stages on two cores: the helper thread propagates and classifies blocks ahead while
-    // this thread updates the bins in point order, so the bins are those of one thread, bit for
-    // bit; only this thread touches the grid. This thread does not wait for the helper: a block
-    // the helper has not delivered when its turn comes (the helper not awake yet, or its core
-    // taken by another process) is classified here, and the helper moves past it.
-    std::unique_ptr<ClassifiedStage[]> ring(new ClassifiedStage[kPipelineRing]);
-    std::atomic<size_t> slotHolds[kPipelineRing];  // 1 + the block a slot holds; 0: none yet
-    for (std::atomic<size_t>& h : slotHolds) h.store(0, std::memory_order_relaxed);
-    std::atomic<size_t> nextForHelper{0}, consumed{0};
-    std::atomic<bool> done{false};
-    auto produce = [&]() {
-        try {
-            for (;;) {
-                const size_t j = nextForHelper.fetch_add(1, std::memory_order_relaxed);
-                if (j >= blocks) return;
-                // Slot j % ring is free once block j - ring has been consumed.
-                waitUntil([&] {
-                    return j < consumed.load(std::memory_order_acquire) + kPipelineRing ||
-                           done.load(std::memory_order_relaxed);
-                });
-                if (done.load(std::memory_order_relaxed)) return;
-                if (j < consumed.load(std::memory_order_acquire)) continue;  // done here
-                classify(j, ring[j % kPipelineRing]);
-                slotHolds[j % kPipelineRing].store(j + 1, std::memory_order_release);
-            }
-        } catch (...) {
-            // Nothing is lost: this thread classifies every block the helper does not deliver.
-        }
-    };
-    HelperThread& helper = HelperThread::shared();
-    if (!helper.tryStart(produce)) return false;  // busy with another map: one core
-    auto stopHelper = [&] {
-        done.store(true, std::memory_order_relaxed);
-        helper.wait();  // at most the block it is classifying
-    };
-    ClassifiedStage own;  // a block classified on this thread
-    try {
-        for (size_t j = 0; j < blocks; j++) {
-            const std::atomic<size_t>& holds = slotHolds[j % kPipelineRing];
-            bool ready = holds.load(std::memory_order_acquire) == j + 1;
-            // Wait briefly for a block the helper has claimed (about one block's work).
-            for (int spin = 0;
-                 !ready && spin < 64 && nextForHelper.load(std::memory_order_relaxed) > j; spin++) {
-                pauseCore();
-                ready = holds.load(std::memory_order_acquire) == j + 1;
-            }
-            if (ready) {
-                updateBins(ring[j % kPipelineRing]);
-            } else {
-                // Keep the helper off block j if it has not claimed it yet.
-                size_t next = nextForHelper.load(std::memory_order_relaxed);
-                while (next <= j && !nextForHelper.compare_exchange_weak(
-                                        next, j + 1, std::memory_order_relaxed)) {
-                }
-                classify(j, own);
-                updateBins(own);
-            }
-            consumed.store(j + 1, std::memory_order_release);
-        }
-    } catch (...) {
-        stopHelper();
-        throw;
-    }
-    stopHelper();
-    return true;
-}
-
 template <typename BlockSource>
 InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
                                   const BinUpdateParams& params, double continuityBound_m) {
@@ -374,70 +313,27 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
     // (HeightInformation): the same estimate as the sequential filter up to rounding, without a
     // division chained through every point.
     const bool perPoint = continuityBound_m < std::numeric_limits<double>::infinity();
-    const CellWindow w = window();
-    const ClassifyGeometry geometry{inverseCellSize(), w,      originSlotX(),
-                                    originSlotY(),     params, kMinFusedVariance_m2};
+    const ClassifyGeometry geometry{m_store.inverseCellSize(), window(), m_store.originSlotX(),
+                                    m_store.originSlotY(),     params,   kMinFusedVariance_m2};
 
-    // The open run: consecutive accepted points in one bin. Its plane moments are a copy, written
-    // back when the run closes, so the per-point update stays in registers.
+    // The open run: consecutive accepted points in one bin. Its update (BinAccumulator) stays in
+    // registers and is written back when the run closes.
     struct Run {
         BinId bin = kNoBin;
         size_t slot = 0;
         int16_t n = 0;
         int ix = 0, iy = 0;
-        uint32_t points = 0;
-        HeightInformation sum;
-        PlaneMoments plane;
-        double cellX_m = 0, cellY_m = 0;  // the cell's centre [m]
-        double maxHeight_m = 0;
-        // Its first point's pose parts' codes: the run's points are neighbours of one frame,
-        // whose pose parts differ by far less than the codes' steps (BinUpdate.h).
-        uint8_t poseHeightCode = 0, poseHorizontalCode = 0;
-        bool frozen = false;  // the bin has zero variance: its height cannot move
+        BinAccumulator<HeightFusion::kInformation> update;
     } run;
     const bool wholeIncrement = isExactWholeFloat(params.certaintyIncrement);
     auto closeRun = [&]() {
         if (run.bin == kNoBin) return;
-        Bin& bin = BinStore::bin(run.bin);
-        if (!run.frozen) {
-            bin.height_m = static_cast<float>(run.sum.height_m());
-            bin.variance_m2 = static_cast<float>(run.sum.variance_m2());
-        }
-        bin.plane = run.plane;
-        addCertainty(bin.certainty, params.certaintyIncrement, run.points, wholeIncrement);
-        lowerPoseSigmaCodes(bin, run.poseHeightCode, run.poseHorizontalCode);
-        util::addSaturating(bin.pointCount, run.points);
-        m_index.noteUpdate(run.slot, run.ix, run.iy, run.maxHeight_m, run.points);
+        run.update.close(m_store.bin(run.bin), params, wholeIncrement);
+        m_index.noteUpdate(run.slot, run.ix, run.iy, run.update.maxHeight_m(), run.update.points());
         run.bin = kNoBin;
     };
 
     size_t rejected[kStatusCount] = {};
-    // Calls fuse(i) for each accepted point i of a block, in order, and counts the others by
-    // reason; returns the accepted count.
-    auto forAccepted = [&](const ClassifiedStage& stage, auto&& fuse)
-        __attribute__((always_inline)) {
-        const PointBlock& pts = stage.points;
-        const ClassifiedBlock& cb = stage.classes;
-        size_t accepted = stage.count;
-        for (size_t i = 0; i < stage.count; i++) {
-            if (cb.status[i] != kAccept) {  // rare: counted per reason after the loop
-                uint8_t status = cb.status[i];
-                if (status == kCheckSingular) {  // zero or singular: an exact pose, fused as it is
-                    const SymmetricCov3 c{pts.v[3][i], pts.v[4][i], pts.v[5][i],
-                                          pts.v[6][i], pts.v[7][i], pts.v[8][i]};
-                    status = isSingularCovariance(c) ? cb.statusAfterCovariance[i]
-                                                     : uint8_t(kBadCovariance);
-                }
-                if (status != kAccept) {
-                    rejected[status]++;
-                    accepted--;
-                    continue;
-                }
-            }
-            fuse(i);
-        }
-        return accepted;
-    };
     // Pass 2, in point order: the bin updates of one classified block, point by point for a
     // laser (eq 14) and by runs otherwise, each its own loop.
     // Inlined into both loops below: called through a function, the run and the counters live
@@ -447,47 +343,35 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         const ClassifiedBlock& cb = stage.classes;
         if (perPoint) {  // fuseMeasurement counts what it accepts or refuses (eq 14)
             forAccepted(
-                stage, [&](size_t i) __attribute__((always_inline)) {
+                stage, rejected, [&](size_t i) __attribute__((always_inline)) {
                     fuseMeasurement(cb.slot[i], cb.ix[i], cb.iy[i], static_cast<int16_t>(cb.bin[i]),
                                     pts.v[2][i],
-                                    std::max<double>(pts.v[8][i], kMinFusedVariance_m2), params,
-                                    continuityBound_m, stats, pts.v[0][i], pts.v[1][i],
-                                    cb.poseCode[0][i], cb.poseCode[1][i]);
+                                    std::max<double>(pts.v[8][i], kMinFusedVariance_m2),
+                                    cb.weight[i], params, continuityBound_m, stats, pts.v[0][i],
+                                    pts.v[1][i], cb.poseCode[0][i], cb.poseCode[1][i]);
                 });
             return;
         }
         stats.accepted += forAccepted(
-            stage, [&](size_t i) __attribute__((always_inline)) {
-                const float x = pts.v[0][i], y = pts.v[1][i];
-                const double h = pts.v[2][i];
-                const double weight = cb.weight[i];
+            stage, rejected, [&](size_t i) __attribute__((always_inline)) {
                 const size_t s = size_t(cb.slot[i]);
                 const int16_t n = static_cast<int16_t>(cb.bin[i]);
                 if (run.bin == kNoBin || run.slot != s || run.n != n) {
                     closeRun();
-                    run.bin = findOrAddBin(s, n);
+                    run.bin = m_store.findOrAddBin(s, n);
                     run.slot = s;
                     run.n = n;
                     run.ix = cb.ix[i];
                     run.iy = cb.iy[i];
-                    run.points = 0;
-                    run.maxHeight_m = h;
-                    run.poseHeightCode = cb.poseCode[0][i];
-                    run.poseHorizontalCode = cb.poseCode[1][i];
-                    const Bin& bin = BinStore::bin(run.bin);
-                    run.plane = bin.plane;
-                    run.cellX_m = cellCenter_m(run.ix);
-                    run.cellY_m = cellCenter_m(run.iy);
-                    run.frozen = bin.pointCount > 0 && !(bin.variance_m2 > 0);
-                    run.sum = HeightInformation{};
-                    if (bin.pointCount > 0 && !run.frozen)
-                        run.sum.add(bin.height_m, bin.variance_m2);
+                    run.update.open(m_store.bin(run.bin), cellCenter_m(run.ix),
+                                    cellCenter_m(run.iy));
+                    // The first point's pose codes: the run's points are neighbours of one frame,
+                    // whose pose parts differ by far less than the codes' steps (BinUpdate.h).
+                    run.update.lowerPoseCodes(cb.poseCode[0][i], cb.poseCode[1][i]);
                 }
-                run.sum.addWeighted(h, weight);
-                addPlanePoint(run.plane, float(x - run.cellX_m), float(y - run.cellY_m), float(h),
-                              float(weight));
-                run.maxHeight_m = std::max(run.maxHeight_m, h);
-                run.points++;
+                run.update.addPoint(pts.v[0][i], pts.v[1][i], pts.v[2][i],
+                                    std::max<double>(pts.v[8][i], kMinFusedVariance_m2),
+                                    cb.weight[i], params);
             });
     };
     // Pass 1 of block j: the points (propagated, for sensor points) and their classes.
@@ -498,8 +382,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         fillBlock(begin, stage.count, stage.points);
         classifyBlock(geometry, stage.points, stage.count, stage.classes);
     };
-    if (!(m_insertionThreads >= 2 && blocks >= kPipelineMinBlocks &&
-          insertPipelined(blocks, classify, updateBins))) {
+    if (!(m_insertionThreads >= 2 && blocks >= pipeline::kMinBlocks &&
+          pipeline::run<ClassifiedStage>(blocks, classify, updateBins))) {
         ClassifiedStage stage;
         for (size_t j = 0; j < blocks; j++) {
             classify(j, stage);
@@ -507,11 +391,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         }
     }
     closeRun();
-    stats.notFinite += rejected[kNotFinite];
-    stats.badCovariance += rejected[kBadCovariance];
-    stats.outsideMap += rejected[kOutsideMap];
-    stats.tooUncertain += rejected[kTooUncertain];
-    stats.outsideBinRange += rejected[kOutsideBinRange];
+    addRejections(stats, rejected);
     return stats;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "multibin/geometry/Lattice.h"
@@ -18,37 +19,48 @@ namespace multibin {
 class PosePropagator;
 struct PoseVariances;
 
-/** The 2.5D grid of multi-bin cells: the storage (BinStore: cells, bins, the moving window), the
- * update rule applied to points (the gates of eqs 13-14 and the Kalman update of eq 15 from
- * BinUpdate.h) and the visibility index kept in step with both (VisibilityIndex: update cycles,
- * block height bounds), as OctoMap's OccupancyOcTreeBase adds its update rule to the storage of
- * OcTreeBaseImpl. Memory: 16 B per cell of the window (4 B store, 12 B index), 12 B per block of
- * 256 cells and 64 B per bin (Bin.h). */
-class BinGrid : private BinStore {
+/** The 2.5D grid of multi-bin cells: the storage (a BinStore member: cells, bins, the moving
+ * window), the update rule applied to points (the gates of eqs 13-14 from BinUpdate.h, each
+ * bin's update through BinAccumulator.h) and the visibility index kept in step with both
+ * (VisibilityIndex: update cycles, block height bounds), as OctoMap's OccupancyOcTreeBase adds its
+ * update rule to the storage of OcTreeBaseImpl. The insertion on two cores runs through
+ * src/map/InsertionPipeline.h. Memory: 16 B per cell of the window (4 B store, 12 B index), 12 B
+ * per block of 256 cells and 64 B per bin (Bin.h). */
+class BinGrid {
 public:
-    using BinStore::BinId;
-    using BinStore::kNoBin;
+    using BinId = BinStore::BinId;
+    static constexpr BinId kNoBin = BinStore::kNoBin;
     using UpdatedCell = VisibilityIndex::UpdatedCell;
     static constexpr int kBlockShift = VisibilityIndex::kBlockShift;
     static constexpr int kBlockCells = VisibilityIndex::kBlockCells;
 
     explicit BinGrid(double cellSize_m = 0.02);
 
-    /** @name Geometry and storage (BinStore)
+    /** @name Geometry and storage (BinStore's, forwarded)
      * @{ */
-    using BinStore::binCount;
-    using BinStore::binIndexOf;
-    using BinStore::cellCenter_m;
-    using BinStore::cellIndex;
-    using BinStore::cellSize_m;
-    using BinStore::clearCell;  // the block bounds stay conservative
-    using BinStore::editBins;   // likewise
-    using BinStore::empty;
-    using BinStore::floorToInt;
-    using BinStore::forEachBin;
-    using BinStore::lattice;
-    using BinStore::window;
-    const BinStore& store() const { return *this; }
+    const BinStore& store() const { return m_store; }
+    size_t binCount() const { return m_store.binCount(); }
+    static bool binIndexOf(double height_m, double binHeight_m, int16_t& n) {
+        return BinStore::binIndexOf(height_m, binHeight_m, n);
+    }
+    double cellCenter_m(int index) const { return m_store.cellCenter_m(index); }
+    int cellIndex(double coord_m) const { return m_store.cellIndex(coord_m); }
+    double cellSize_m() const { return m_store.cellSize_m(); }
+    /** Removes every bin of one cell; the block bounds stay conservative. */
+    void clearCell(int ix, int iy) { m_store.clearCell(ix, iy); }
+    /** BinStore::editBins; the block bounds stay conservative. */
+    template <typename F>
+    size_t editBins(int ix, int iy, F&& f) {
+        return m_store.editBins(ix, iy, std::forward<F>(f));
+    }
+    bool empty() const { return m_store.empty(); }
+    static int floorToInt(double v) { return BinStore::floorToInt(v); }
+    template <typename F>
+    void forEachBin(int ix, int iy, F&& f) const {
+        m_store.forEachBin(ix, iy, std::forward<F>(f));
+    }
+    Lattice lattice() const { return m_store.lattice(); }
+    const CellWindow& window() const { return m_store.window(); }
     /** @} */
 
     /** Drops all bins and sets an empty window; the cell size may change. */
@@ -60,7 +72,7 @@ public:
      * Cost: proportional to the cells that enter. */
     template <typename OnLeave>
     void moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
-        BinStore::moveWindowTo(ix0, iy0, onLeave, [this](size_t s) { m_index.forgetSlot(s); });
+        m_store.moveWindowTo(ix0, iy0, onLeave, [this](size_t s) { m_index.forgetSlot(s); });
         m_index.moveWindow(window());
     }
     void moveWindowTo(int ix0, int iy0) {
@@ -121,11 +133,11 @@ public:
     void beginCycle() { m_index.beginCycle(); }
     const std::vector<UpdatedCell>& updatedCells() const { return m_index.updatedCells(); }
     bool updatedThisCycle(int ix, int iy) const {
-        return window().contains(ix, iy) && m_index.updatedThisCycle(slot(ix, iy));
+        return window().contains(ix, iy) && m_index.updatedThisCycle(m_store.slot(ix, iy));
     }
     /** See VisibilityIndex::cellMaxHeight_m; -infinity outside the window. */
     float cellMaxHeight_m(int ix, int iy) const {
-        return window().contains(ix, iy) ? m_index.cellMaxHeight_m(slot(ix, iy))
+        return window().contains(ix, iy) ? m_index.cellMaxHeight_m(m_store.slot(ix, iy))
                                          : -std::numeric_limits<float>::infinity();
     }
     /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
@@ -137,7 +149,7 @@ public:
 
     /** Memory held by the grid [bytes]: the store and the visibility index. Independent of the
      * vertical extent. */
-    size_t memoryBytes() const { return BinStore::memoryBytes() + m_index.memoryBytes(); }
+    size_t memoryBytes() const { return m_store.memoryBytes() + m_index.memoryBytes(); }
 
     /** Standard deviation of a bin's estimate (binSigma_m) [m]. */
     static double sigma_m(const BinEstimate& b, const BinUpdateParams& p) {
@@ -150,19 +162,16 @@ private:
     template <typename BlockSource>
     InsertStats insertBlocks(size_t count, BlockSource&& fillBlock, const BinUpdateParams& params,
                              double continuityBound_m);
-    /** insertBlocks' two passes on two threads: `classify(j, stage)` fills and classifies
-     * block j on the helper thread, `updateBins(stage)` runs here in block order. False, with
-     * nothing done, if the helper thread is busy. */
-    template <typename Classify, typename Update>
-    bool insertPipelined(size_t blocks, Classify& classify, Update& updateBins);
-    /** Gates 13 and bin range passed: eq 14 and the per-point Kalman update (eq 15). */
+    /** Gates 13 and bin range passed: eq 14 and the per-point update (eq 15, BinAccumulator) of
+     * bin n of cell (ix, iy) at `slot`; `weight` = 1 / variance_m2. */
     bool fuseMeasurement(size_t slot, int ix, int iy, int16_t n, double height_m,
-                         double variance_m2, const BinUpdateParams& params,
+                         double variance_m2, double weight, const BinUpdateParams& params,
                          double continuityBound_m, InsertStats& stats, float x_m,
                          float y_m,  //!< its place feeds the plane moments; NaN: no place
                          uint8_t poseHeightCode,  //!< poseSigmaCode of its pose parts; 0: none
                          uint8_t poseHorizontalCode);
 
+    BinStore m_store;
     VisibilityIndex m_index;
     int m_insertionThreads = 1;
 };
