@@ -79,8 +79,8 @@ struct PathShape {
     }
 };
 
-std::vector<Frame> walkPath(const Terrain& ground, const PathShape& p, uint64_t poseSeed) {
-    TrajectoryOptions o;
+std::vector<Frame> walkPath(const Terrain& ground, const PathShape& p, TrajectoryOptions o,
+                            uint64_t poseSeed) {
     std::vector<Frame> frames;
     for (int k = 0;; ++k) {
         const double t = k / o.laserRate_hz, s = p.s0 + p.speed * t;
@@ -244,6 +244,13 @@ std::string RandomScene::describe() const {
 
 RandomScene makeRandomScene(const RandomSceneOptions& opts) {
     if (opts.boards.empty()) throw std::invalid_argument("random scene: no boards given");
+    ScenarioConfig cfg;  // the sensors' and poses' errors
+    if (opts.noise == "independent")
+        applyIndependentNoise(cfg);
+    else if (opts.noise == "exact")
+        applyExactMeasurements(cfg);
+    else if (opts.noise != "matched")
+        throw std::invalid_argument("random scene: noise must be matched, independent or exact");
     RandomScene sc;
     sc.seed = opts.seed;
     Rng rng(hash64(opts.seed ^ 0x52414e44u));  // geometry only; sensor noise has its own seeds
@@ -295,13 +302,11 @@ RandomScene makeRandomScene(const RandomSceneOptions& opts) {
         ScenePass pass;
         pass.path = kind;
         pass.placement = plan[p];
-        pass.frames = walkPath(sc.ground, shape, hash64(opts.seed * 31 + p));
+        pass.frames = walkPath(sc.ground, shape, cfg.trajectory, hash64(opts.seed * 31 + p));
         sc.passes.push_back(std::move(pass));
     }
     const double mountHeight = uniform(rng, 0.2, 0.5), pitchDeg = uniform(rng, 30, 60);
     sc.darkPatches = uniformInt(rng, 0, 8);
-    ScenarioConfig cfg;  // the sensors' errors: matched, or those of independent-evaluation.md
-    if (opts.independentNoise) applyIndependentNoise(cfg);
     sc.laser = cfg.laser;
     sc.laser.pose = mrpt::poses::CPose3D(0, 0, mountHeight, 0, pitchDeg * M_PI / 180, 0);
     return sc;

@@ -64,7 +64,9 @@ struct RandomSceneOptions {
     std::vector<multibin::EsriAsciiGrid> boards;  //!< pool the tiles are drawn from
     std::vector<std::string> boardNames;          //!< names for describe(), same order
     uint64_t seed = 1;
-    bool independentNoise = false;  //!< the errors of applyIndependentNoise(), else matched
+    /** Sensor and pose errors: "matched" (the library's models), "independent"
+     * (applyIndependentNoise) or "exact" (applyExactMeasurements: no error at all). */
+    std::string noise = "matched";
 };
 
 /** Draws a scene: 2 or 3 x 2 tiles of the pool's boards (each rotated by k x 90 deg and maybe

@@ -138,7 +138,7 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomScene
 }
 
 void scoreStaticAndFilled(const Regions& reg, Maps& with, Maps& without, RandomSceneScores& s) {
-    Rms withObj, noObj, filled;
+    Rms withObj, noObj, filled, mrptMean;
     for (int r = 0; r < reg.gt.rows(); ++r)
         for (int k = 0; k < reg.gt.cols(); ++k) {
             const double truth = reg.gt.heights_m(r, k);
@@ -148,13 +148,14 @@ void scoreStaticAndFilled(const Regions& reg, Maps& with, Maps& without, RandomS
             double z1, s1, z0, s0;
             const auto src1 = with.map.cellElevation(x, y, z1, s1, true);
             const auto src0 = without.map.cellElevation(x, y, z0, s0, false);
+            const auto* c = with.mrptMean->cellByPos(x, y);
+            const bool mrptGap = !c || c->w == 0;
             if (src1 == multibin::HeightSource::Measured &&
                 src0 == multibin::HeightSource::Measured) {
                 withObj.add(z1 - truth);
                 noObj.add(z0 - truth);
+                if (!mrptGap) mrptMean.add(c->h - truth);
             }
-            const auto* c = with.mrptMean->cellByPos(x, y);
-            const bool mrptGap = !c || c->w == 0;
             if (mrptGap && src1 != multibin::HeightSource::Measured &&
                 src1 != multibin::HeightSource::Unknown)
                 filled.add(z1 - truth);
@@ -162,6 +163,7 @@ void scoreStaticAndFilled(const Regions& reg, Maps& with, Maps& without, RandomS
     s.staticCells = withObj.n;
     s.staticRmse_m = withObj.value();
     s.staticRmseNoObject_m = noObj.value();
+    s.staticMrptRmse_m = mrptMean.value();
     s.filledCells = filled.n;
     s.filledRmse_m = filled.value();
 }

@@ -21,6 +21,7 @@ struct RandomSceneScores {
     /** Static terrain (every measured cell away from the object's placements), the map with the
      * object and the same scene mapped with the object never there, on the cells both measured. */
     double staticRmse_m = kNaN, staticRmseNoObject_m = kNaN;
+    double staticMrptRmse_m = kNaN;  //!< MRPT's mean on those cells (where it has data) [m]
     size_t staticCells = 0;
     /** Filled cells where MRPT's grid has no data: RMSE of the map's filled heights [m]. */
     double filledRmse_m = kNaN;

@@ -32,7 +32,7 @@ const RandomSceneOptions& scoringPool() {
 RandomScene scene(uint64_t seed, bool independent = false) {
     RandomSceneOptions o = scoringPool();
     o.seed = seed;
-    o.independentNoise = independent;
+    o.noise = independent ? "independent" : "matched";
     return makeRandomScene(o);
 }
 
