@@ -174,7 +174,7 @@ void scoreQueries(const RandomScene& sc, const Regions& reg, Maps& m, RandomScen
     std::uniform_real_distribution<double> ux(0.0, g.tilesX() * g.tileSide_m());
     std::uniform_real_distribution<double> uy(-0.5 * g.tilesY() * g.tileSide_m(),
                                               0.5 * g.tilesY() * g.tileSide_m());
-    Rms map, mrptMean;
+    Rms map, mrptMean, floor;
     for (int i = 0; i < 4000; ++i) {
         const double x = ux(rng), y = uy(rng);
         if (reg.inAnyAt(x, y)) continue;
@@ -182,12 +182,18 @@ void scoreQueries(const RandomScene& sc, const Regions& reg, Maps& m, RandomScen
         const auto* c = m.mrptMean->cellByPos(x, y);
         if (!m.map.heightAt(x, y, h, sigma) || !c || c->w == 0) continue;
         const double truth = g.height(x, y);
+        const int k = int(std::lround((x - reg.gt.xllcenter_m) / reg.gt.cellsize_m));
+        const int r = int(std::lround((y - reg.gt.yllcenter_m) / reg.gt.cellsize_m));
+        const double cellMean = reg.gt.heights_m(r, k);  // inside: inAnyAt() checked the range
+        if (!std::isfinite(cellMean)) continue;
         map.add(h - truth);
         mrptMean.add(c->h - truth);
+        floor.add(cellMean - truth);
     }
     s.queryPoints = map.n;
     s.queryRmse_m = map.value();
     s.queryMrptRmse_m = mrptMean.value();
+    s.queryFloorRmse_m = floor.value();
 }
 
 }  // namespace

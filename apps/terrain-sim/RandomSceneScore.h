@@ -29,6 +29,8 @@ struct RandomSceneScores {
     /** Random query points on the boards (away from the object): heightAt() and MRPT's cell at
      * the same points, both against the true surface there [m]. */
     double queryRmse_m = kNaN, queryMrptRmse_m = kNaN;
+    /** The floor of any one-height-per-cell map there: the true mean of the point's cell [m]. */
+    double queryFloorRmse_m = kNaN;
     size_t queryPoints = 0;
 };
 
