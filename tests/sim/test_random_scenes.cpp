@@ -149,14 +149,14 @@ const std::vector<ScoredScene>& ciScenes() {
 // What today's map holds on every CI scene (regression bounds, not issue 38's targets): the
 // vacated footprint is re-observed and the map beats MRPT's mean there; the static terrain is
 // within 5 % of the same scene mapped without the object; at random points the map is within
-// 1.2 x MRPT's mean (measured 0.96-1.12 on these scoring boards, doc/random-scenes.md).
+// 1.2 x MRPT's mean (measured 0.95-1.05 on these scenes, doc/random-scenes.md).
 TEST(RandomScenes, TodaysBoundsOnAHandfulOfScoringScenes) {
     for (const ScoredScene& s : ciScenes()) {
         SCOPED_TRACE(s.scene.describe());
         const RandomSceneScores& r = s.scores;
         ASSERT_GT(r.objectCells, 20u);
         EXPECT_LE(r.objectUnknown, r.objectCells / 10);
-        EXPECT_LT(r.objectRmse_m, 0.6 * r.objectMrptRmse_m);
+        EXPECT_LT(r.objectRmse_m, 0.8 * r.objectMrptRmse_m);
         EXPECT_LE(r.staticRmse_m, 1.05 * r.staticRmseNoObject_m);
         EXPECT_GT(r.staticCells, 3000u);
         EXPECT_LT(r.queryRmse_m, 1.2 * r.queryMrptRmse_m);
