@@ -147,27 +147,21 @@ SceneObject drawObject(Rng& rng, const Terrain& g, double x, double y) {
     o.x_m = x;
     o.y_m = y;
     o.yaw_rad = uniform(rng, 0, M_PI);
-    double height = 0;
-    switch (o.kind) {
-        case ObjectKind::Box:
-            o.halfX_m = uniform(rng, 0.04, 0.15);
-            o.halfY_m = uniform(rng, 0.04, 0.15);
-            height = uniform(rng, 0.08, 0.25);
-            break;
-        case ObjectKind::Post:
-            o.halfX_m = o.halfY_m = uniform(rng, 0.02, 0.04);
-            height = uniform(rng, 0.3, 0.6);
-            break;
-        case ObjectKind::Step:
-            o.halfX_m = uniform(rng, 0.15, 0.25);
-            o.halfY_m = uniform(rng, 0.1, 0.2);
-            height = uniform(rng, 0.05, 0.12);
-            break;
-        case ObjectKind::Column:
-            o.halfX_m = o.halfY_m = uniform(rng, 0.12, 0.2);
-            height = uniform(rng, 1.0, 1.8);
-            break;
-    }
+    // Per kind: half side x, half side y (square: = x), height, each drawn in [lo, hi] [m].
+    struct Sizes {
+        double x0, x1, y0, y1, h0, h1;
+        bool square;
+    };
+    static const Sizes kSizes[] = {
+        {0.04, 0.15, 0.04, 0.15, 0.08, 0.25, false},  // box
+        {0.02, 0.04, 0, 0, 0.3, 0.6, true},           // post
+        {0.15, 0.25, 0.1, 0.2, 0.05, 0.12, false},    // step
+        {0.12, 0.2, 0, 0, 1.0, 1.8, true},            // column: a standing person
+    };
+    const Sizes& z = kSizes[int(o.kind)];
+    o.halfX_m = uniform(rng, z.x0, z.x1);
+    o.halfY_m = z.square ? o.halfX_m : uniform(rng, z.y0, z.y1);
+    const double height = uniform(rng, z.h0, z.h1);
     o.top_m = maxGroundUnder(g, o) + height;
     return o;
 }
