@@ -7,6 +7,7 @@
 #include <mrpt/maps/CHeightGridMap2D.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
+#include <multibin/map/BinGrid.h>
 
 #include <cmath>
 #include <memory>
@@ -108,6 +109,28 @@ struct Rms {
     double value() const { return n ? std::sqrt(sum / n) : RandomSceneScores::kNaN; }
 };
 
+/** What cell (x, y) of the map holds, against the truth there (RandomSceneScores::CellKind). */
+RandomSceneScores::CellKind cellKind(const CMultiBinElevationMap& map, double x, double y,
+                                     double truth_m) {
+    constexpr double kAtGround_m = 0.03;
+    const multibin::BinGrid& grid = map.grid();
+    const auto origin = map.mapOrigin();
+    const int ix = grid.cellIndex(x - origin.x), iy = grid.cellIndex(y - origin.y);
+    if (!grid.window().contains(ix, iy)) return RandomSceneScores::NoBin;
+    int bins = 0;
+    bool ground = false;
+    grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+        bins++;
+        ground = ground || std::abs(b.height_m - truth_m) < kAtGround_m;
+    });
+    const multibin::Bin* win = grid.winningBin(ix, iy);
+    if (bins == 0) return RandomSceneScores::NoBin;
+    if (!ground) return RandomSceneScores::OnlyStale;
+    return win && std::abs(win->height_m - truth_m) >= kAtGround_m
+               ? RandomSceneScores::StaleWinsBesideGround
+               : RandomSceneScores::GroundWins;
+}
+
 void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomSceneScores& s) {
     const int last = sc.passes.back().placement;
     Rms dem, mrptMean;
@@ -128,6 +151,9 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomScene
             }
             dem.add(z - truth);
             worst = std::max(worst, std::abs(z - truth));
+            const auto kind = cellKind(m.map, x, y, truth);
+            s.objectSquaredError_m2[kind] += (z - truth) * (z - truth);
+            s.objectCellsOfKind[kind]++;
             const auto* c = m.mrptMean->cellByPos(x, y);
             if (c && c->w > 0) mrptMean.add(c->h - truth);
         }

@@ -18,6 +18,11 @@ struct RandomSceneScores {
     double objectRmse_m = kNaN, objectMrptRmse_m = kNaN;
     size_t objectCells = 0, objectUnknown = 0;
     double objectWorstError_m = kNaN;  //!< largest |DEM - ground| over those cells [m]
+    /** What those cells hold at the end (a bin "at the ground" lies within 30 mm of the truth),
+     * and the squared error [m^2] summed over each kind: why the object's place is wrong. */
+    enum CellKind { StaleWinsBesideGround, OnlyStale, NoBin, GroundWins, kCellKinds };
+    double objectSquaredError_m2[kCellKinds] = {0, 0, 0, 0};
+    size_t objectCellsOfKind[kCellKinds] = {0, 0, 0, 0};
     /** Static terrain (every measured cell away from the object's placements), the map with the
      * object and the same scene mapped with the object never there, on the cells both measured. */
     double staticRmse_m = kNaN, staticRmseNoObject_m = kNaN;
