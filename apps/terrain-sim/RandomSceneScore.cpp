@@ -224,8 +224,13 @@ void scoreQueries(const RandomScene& sc, const Regions& reg, Maps& m, RandomScen
 
 }  // namespace
 
-RandomSceneScores scoreRandomScene(const RandomScene& sc) {
+RandomSceneScores scoreRandomScene(const RandomScene& sc,
+                                   const std::function<void(CMultiBinElevationMap&)>& configure) {
     Maps with, without;
+    if (configure) {
+        configure(with.map);
+        configure(without.map);
+    }
     mapPasses(sc, true, with);
     mapPasses(sc, false, without);
     const multibin::EsriAsciiGrid gt = sc.ground.groundTruth(with.map.dem_get_resolution());

@@ -6,7 +6,12 @@
 #include "RandomScene.h"
 
 #include <cstddef>
+#include <functional>
 #include <limits>
+
+namespace mrpt::maps {
+class CMultiBinElevationMap;
+}
 
 namespace terrain_sim {
 
@@ -39,9 +44,12 @@ struct RandomSceneScores {
     size_t queryPoints = 0;
 };
 
-/** Maps every pass of the scene (laser, 10 Hz, the pass's pose PDFs) into a default
- * CMultiBinElevationMap and a CHeightGridMap2D (mean) fed the same points, and once more with the
- * object never there, then scores both against the scene's ground. */
-RandomSceneScores scoreRandomScene(const RandomScene& scene);
+/** Maps every pass of the scene (laser, 10 Hz, the pass's pose PDFs) into a
+ * CMultiBinElevationMap (default options, then `configure` if given, e.g. options from an ini)
+ * and a CHeightGridMap2D (mean) fed the same points, and once more with the object never there,
+ * then scores both against the scene's ground. */
+RandomSceneScores scoreRandomScene(
+    const RandomScene& scene,
+    const std::function<void(mrpt::maps::CMultiBinElevationMap&)>& configure = {});
 
 }  // namespace terrain_sim

@@ -4,6 +4,10 @@
 #include "RandomScene.h"
 #include "RandomSceneScore.h"
 
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/system/filesystem.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,10 +20,12 @@ using namespace terrain_sim;
 
 namespace {
 
+#define kInsertSection "[MappingApplication_multiBinElevationMap_00_insertOpts]"
 const char* kUsage =
     "usage: random-scenes [--boards tuning|scoring] [--seeds FIRST-LAST] "
-    "[--noise matched|independent|exact] [--board-dir DIR]\n"
-    "  tuning boards B, X1, W; scoring boards AC, CC, CD (doc/independent-evaluation.md)\n";
+    "[--noise matched|independent|exact] [--board-dir DIR] [--ini FILE]\n"
+    "  tuning boards B, X1, W; scoring boards AC, CC, CD (doc/independent-evaluation.md)\n"
+    "  --ini: map options from FILE's section " kInsertSection " over the defaults\n";
 
 struct Quantity {
     const char* name;
@@ -44,7 +50,7 @@ void record(Quantity& q, double value, bool fails, uint64_t seed) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string boards = "scoring", noise = "matched", dir = "rawlogs/terrain/littledog";
+    std::string boards = "scoring", noise = "matched", dir = "rawlogs/terrain/littledog", ini;
     uint64_t first = 1000, last = 1049;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -55,6 +61,8 @@ int main(int argc, char** argv) {
             noise = argv[++i];
         else if (a == "--board-dir" && v)
             dir = argv[++i];
+        else if (a == "--ini" && v)
+            ini = argv[++i];
         else if (a == "--seeds" && v && std::sscanf(argv[++i], "%lu-%lu", &first, &last) == 2) {
         } else {
             std::fprintf(stderr, "random-scenes: error: bad argument '%s'\n%s", a.c_str(), kUsage);
@@ -77,6 +85,18 @@ int main(int argc, char** argv) {
         return 1;
     }
     opts.noise = noise;
+    std::function<void(mrpt::maps::CMultiBinElevationMap&)> configure;
+    if (!ini.empty()) {
+        if (!mrpt::system::fileExists(ini)) {
+            std::fprintf(stderr, "random-scenes: error: cannot read --ini '%s'\n", ini.c_str());
+            return 1;
+        }
+        configure = [ini](mrpt::maps::CMultiBinElevationMap& map) {
+            const mrpt::config::CConfigFile file(ini);
+            std::string section = kInsertSection;
+            map.insertionOptions.loadFromConfigFile(file, section.substr(1, section.size() - 2));
+        };
+    }
     Quantity object{"moved object RMSE, footprint + 1 cell [mm]", "<= 15 mm in 90 %", {}, {}};
     Quantity mrptObject{"  MRPT's mean there [mm]", "-", {}, {}};
     // "No worse than without the object": the two runs draw the same noise streams, but a beam
@@ -89,8 +109,9 @@ int main(int argc, char** argv) {
     // Over the scenes failing the moved-object bound: what the cells there hold (CellKind).
     double failingSq[RandomSceneScores::kCellKinds] = {0, 0, 0, 0};
     size_t failingCells[RandomSceneScores::kCellKinds] = {0, 0, 0, 0};
-    std::printf("# random-scenes --boards %s --noise %s --seeds %lu-%lu\n", boards.c_str(),
-                noise.c_str(), (unsigned long)first, (unsigned long)last);
+    std::printf("# random-scenes --boards %s --noise %s --seeds %lu-%lu%s%s\n", boards.c_str(),
+                noise.c_str(), (unsigned long)first, (unsigned long)last,
+                ini.empty() ? "" : " --ini ", ini.c_str());
     std::printf(
         "# seed object_mm mrpt_mm unknown static_mm static_noobj_mm static_mrpt_mm filled_mm "
         "filled_n "
@@ -98,7 +119,7 @@ int main(int argc, char** argv) {
     for (uint64_t seed = first; seed <= last; ++seed) {
         opts.seed = seed;
         const RandomScene sc = makeRandomScene(opts);
-        const RandomSceneScores s = scoreRandomScene(sc);
+        const RandomSceneScores s = scoreRandomScene(sc, configure);
         std::printf("%lu %.1f %.1f %zu %.2f %.2f %.2f %.1f %zu %.2f %.2f %.2f | %s\n",
                     (unsigned long)seed, 1e3 * s.objectRmse_m, 1e3 * s.objectMrptRmse_m,
                     s.objectUnknown, 1e3 * s.staticRmse_m, 1e3 * s.staticRmseNoObject_m,
