@@ -127,6 +127,15 @@ Terrain Terrain::fromSamples(const Eigen::MatrixXf& heights_m, double x0_m, doub
     return t;
 }
 
+Terrain Terrain::withSamples(const Eigen::MatrixXf& heights_m) const {
+    if (heights_m.rows() != h_.rows() || heights_m.cols() != h_.cols() || !heights_m.allFinite())
+        throw std::invalid_argument("terrain: replacement samples must be finite, same shape");
+    Terrain t = *this;
+    t.h_ = heights_m;
+    t.buildBlocks();
+    return t;
+}
+
 void Terrain::buildBlocks() {
     zMin_ = std::min(0.0, double(h_.minCoeff()));
     zMax_ = std::max(0.0, double(h_.maxCoeff()));

@@ -32,6 +32,10 @@ public:
     static Terrain fromSamples(const Eigen::MatrixXf& heights_m, double x0_m, double y0_m,
                                double cell_m);
 
+    /** The same terrain (lattice, tiles, surfaces) with other samples, e.g. an object drawn in
+     * (random scenes). `heights_m` must have the lattice's shape. */
+    Terrain withSamples(const Eigen::MatrixXf& heights_m) const;
+
     /** Bilinear height [m] at (x, y) [m]; 0 outside the sample lattice. */
     double height(double x_m, double y_m) const;
     /** Unit surface normal (map frame) from central differences of height(). */

@@ -27,11 +27,8 @@ PoseErrorModel walkErrorModel() {
     return m;
 }
 
-namespace {
-
-/** Draws the pose errors along the frames and fills the estimates. */
-void applyErrors(std::vector<Frame>& frames, const PoseErrorModel& model,
-                 const TrajectoryOptions& o, std::mt19937_64& rng) {
+void applyPoseErrors(std::vector<Frame>& frames, const PoseErrorModel& model,
+                     const TrajectoryOptions& o, std::mt19937_64& rng) {
     const double rate_hz = o.laserRate_hz;
     std::normal_distribution<double> gauss(0.0, 1.0);
     const int period = model.correctionPeriod_s > 0
@@ -52,6 +49,8 @@ void applyErrors(std::vector<Frame>& frames, const PoseErrorModel& model,
     }
 }
 
+namespace {
+
 int stereoEvery(const TrajectoryOptions& o) {
     if (!(o.laserRate_hz > 0) || !(o.stereoRate_hz > 0))
         throw std::invalid_argument("trajectory: rates must be positive");
@@ -59,6 +58,33 @@ int stereoEvery(const TrajectoryOptions& o) {
 }
 
 }  // namespace
+
+mrpt::poses::CPose3D hexapodPose(const Terrain& terrain, double x, double y, double yaw,
+                                 double ph) {
+    // Foot positions of the hexapod in the body frame [m]: front, middle, rear pairs.
+    const double feet[6][2] = {{0.18, 0.16},  {0.0, 0.2},  {-0.18, 0.16},
+                               {0.18, -0.16}, {0.0, -0.2}, {-0.18, -0.16}};
+    auto footHeight = [&](double fx, double fy) {  // mean over the foot's 4 cm contact patch
+        double s = 0;
+        for (int i = -1; i <= 1; ++i)
+            for (int j = -1; j <= 1; ++j) s += terrain.height(fx + 0.02 * i, fy + 0.02 * j);
+        return s / 9;
+    };
+    double hf[6], mean = 0;
+    for (int i = 0; i < 6; ++i) {
+        const double fx = x + feet[i][0] * std::cos(yaw) - feet[i][1] * std::sin(yaw);
+        const double fy = y + feet[i][0] * std::sin(yaw) + feet[i][1] * std::cos(yaw);
+        hf[i] = footHeight(fx, fy);
+        mean += hf[i] / 6;
+    }
+    const double front = 0.5 * (hf[0] + hf[3]), rear = 0.5 * (hf[2] + hf[5]);
+    const double leftH = (hf[0] + hf[1] + hf[2]) / 3, rightH = (hf[3] + hf[4] + hf[5]) / 3;
+    // MRPT: positive pitch is nose down, positive roll lifts the left side.
+    const double pitch = -std::atan2(front - rear, 0.36) + 0.005 * std::sin(2 * ph);
+    const double roll = std::atan2(leftH - rightH, 0.347) + 0.008 * std::sin(ph);
+    const double z = mean + 0.004 * std::abs(std::sin(ph));
+    return mrpt::poses::CPose3D(x, y, z, yaw, pitch, roll);
+}
 
 std::vector<Frame> mockupTrajectory(const Terrain& terrain, const TrajectoryOptions& o,
                                     std::mt19937_64& rng) {
@@ -75,7 +101,7 @@ std::vector<Frame> mockupTrajectory(const Terrain& terrain, const TrajectoryOpti
         f.stereo = k % every == 0;
         frames.push_back(f);
     }
-    applyErrors(frames, mockupErrorModel(), o, rng);
+    applyPoseErrors(frames, mockupErrorModel(), o, rng);
     return frames;
 }
 
@@ -84,15 +110,6 @@ std::vector<Frame> walkTrajectory(const Terrain& terrain, const TrajectoryOption
     if (!(o.walkSpeed_mps > 0)) throw std::invalid_argument("walk: speed must be positive");
     const double endX = terrain.tilesX() * terrain.tileSide_m() + o.endMargin_m;
     const int every = stereoEvery(o);
-    // Foot positions of the hexapod in the body frame [m]: front, middle, rear pairs.
-    const double feet[6][2] = {{0.18, 0.16},  {0.0, 0.2},  {-0.18, 0.16},
-                               {0.18, -0.16}, {0.0, -0.2}, {-0.18, -0.16}};
-    auto footHeight = [&](double x, double y) {  // mean over the foot's 4 cm contact patch
-        double s = 0;
-        for (int i = -1; i <= 1; ++i)
-            for (int j = -1; j <= 1; ++j) s += terrain.height(x + 0.02 * i, y + 0.02 * j);
-        return s / 9;
-    };
     std::vector<Frame> frames;
     for (int k = 0;; ++k) {
         const double t = k / o.laserRate_hz;
@@ -100,26 +117,13 @@ std::vector<Frame> walkTrajectory(const Terrain& terrain, const TrajectoryOption
         if (x > endX + 1e-9 || (o.maxFrames > 0 && k >= o.maxFrames)) break;
         const double ph = 2 * M_PI * t / o.gaitPeriod_s;
         const double y = 0.006 * std::sin(ph), yaw = 0.01 * std::sin(ph);
-        double hf[6], mean = 0;
-        for (int i = 0; i < 6; ++i) {
-            const double fx = x + feet[i][0] * std::cos(yaw) - feet[i][1] * std::sin(yaw);
-            const double fy = y + feet[i][0] * std::sin(yaw) + feet[i][1] * std::cos(yaw);
-            hf[i] = footHeight(fx, fy);
-            mean += hf[i] / 6;
-        }
-        const double front = 0.5 * (hf[0] + hf[3]), rear = 0.5 * (hf[2] + hf[5]);
-        const double leftH = (hf[0] + hf[1] + hf[2]) / 3, rightH = (hf[3] + hf[4] + hf[5]) / 3;
-        // MRPT: positive pitch is nose down, positive roll lifts the left side.
-        const double pitch = -std::atan2(front - rear, 0.36) + 0.005 * std::sin(2 * ph);
-        const double roll = std::atan2(leftH - rightH, 0.347) + 0.008 * std::sin(ph);
-        const double z = mean + 0.004 * std::abs(std::sin(ph));
         Frame f;
         f.t_s = t;
-        f.truth = mrpt::poses::CPose3D(x, y, z, yaw, pitch, roll);
+        f.truth = hexapodPose(terrain, x, y, yaw, ph);
         f.stereo = k % every == 0;
         frames.push_back(f);
     }
-    applyErrors(frames, walkErrorModel(), o, rng);
+    applyPoseErrors(frames, walkErrorModel(), o, rng);
     return frames;
 }
 

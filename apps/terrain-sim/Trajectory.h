@@ -55,6 +55,17 @@ PoseErrorModel mockupErrorModel();
 /** A visual tracker's drifting pose error between corrections (walk). */
 PoseErrorModel walkErrorModel();
 
+/** Draws the model's pose errors along the frames (scaled by opts.poseErrorScale) and fills
+ * each frame's estimate (truth + error) and covariance. */
+void applyPoseErrors(std::vector<Frame>& frames, const PoseErrorModel& model,
+                     const TrajectoryOptions& opts, std::mt19937_64& rng);
+
+/** The hexapod's body pose standing at (x, y) [m] with heading yaw [rad] at gait phase ph
+ * [rad]: height, pitch and roll follow the terrain under its six feet, with the gait's bob and
+ * rocking on top (the walk's body model). */
+mrpt::poses::CPose3D hexapodPose(const Terrain& terrain, double x_m, double y_m, double yaw_rad,
+                                 double ph_rad);
+
 std::vector<Frame> mockupTrajectory(const Terrain& terrain, const TrajectoryOptions& opts,
                                     std::mt19937_64& rng);
 /** A hexapod walk along y = 0 in +x: body height, pitch and roll follow the terrain under the

@@ -1,0 +1,245 @@
+/* Part of the multibin elevation-mapping library: terrain-sim. */
+#include "RandomSceneScore.h"
+
+#include "Scenario.h"
+#include "SurfaceTexture.h"
+
+#include <mrpt/maps/CHeightGridMap2D.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <multibin/map/BinGrid.h>
+
+#include <cmath>
+#include <memory>
+
+namespace terrain_sim {
+namespace {
+
+using mrpt::maps::CHeightGridMap2D;
+using mrpt::maps::CMultiBinElevationMap;
+
+struct Maps {
+    CMultiBinElevationMap map;  // default options
+    std::unique_ptr<CHeightGridMap2D> mrptMean;
+};
+
+/** Every pass's laser scans into the map and, as points, into MRPT's mean height grid. The noise
+ * streams depend on the seed and the pass only, so the runs with and without the object draw
+ * alike. */
+void mapPasses(const RandomScene& sc, bool withObject, Maps& m) {
+    const Terrain& g = sc.ground;
+    const double cell = m.map.dem_get_resolution();
+    m.mrptMean = std::make_unique<CHeightGridMap2D>(CHeightGridMap2D::mrSimpleAverage,
+                                                    g.x0_m() - 2.0, g.xMax_m() + 2.0,
+                                                    g.y0_m() - 2.0, g.yMax_m() + 2.0, cell);
+    for (size_t p = 0; p < sc.passes.size(); ++p) {
+        const Terrain seen = withObject ? sc.seenIn(p) : g;
+        const SurfaceTexture texture(seen, sc.seed, sc.darkPatches);
+        const LaserSim laser(sc.laser, seen, texture, sc.seed);
+        std::mt19937_64 rng(hash64(sc.seed * 1000003 + p));
+        for (const Frame& f : sc.passes[p].frames) {
+            const auto scan = laser.scan(f.truth, syntheticStamp(f.t_s + 100.0 * p), rng);
+            m.map.insertObservation(*scan, f.estimate);
+            mrpt::maps::CSimplePointsMap points;
+            points.insertionOptions.minDistBetweenLaserPoints = 0;
+            points.loadFromRangeScan(*scan, f.estimate.mean);
+            const mrpt::maps::CHeightGridMap2D_Base::TPointInsertParams ip;
+            for (size_t k = 0; k < points.size(); k++) {
+                float x, y, z;
+                points.getPoint(k, x, y, z);
+                m.mrptMean->insertIndividualPoint(x, y, z, ip);
+            }
+        }
+    }
+    m.map.dem_update_map();
+}
+
+/** Cells of the truth raster, marked per placement: the footprint (any part of the cell on it)
+ * grown by one cell. */
+struct Regions {
+    const multibin::EsriAsciiGrid& gt;
+    std::vector<Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic>> grown;
+
+    Regions(const multibin::EsriAsciiGrid& truth, const std::vector<SceneObject>& objects)
+        : gt(truth) {
+        const double c = gt.cellsize_m;
+        for (const SceneObject& o : objects) {
+            Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic> on(gt.rows(), gt.cols());
+            on.setConstant(false);
+            for (int r = 0; r < gt.rows(); ++r)
+                for (int k = 0; k < gt.cols(); ++k) {
+                    const double x = gt.xllcenter_m + k * c, y = gt.yllcenter_m + r * c;
+                    if (std::hypot(x - o.x_m, y - o.y_m) > o.boundingRadius_m() + c) continue;
+                    for (int a = 0; a < 4 && !on(r, k); ++a)  // 4 x 4 points per cell
+                        for (int b = 0; b < 4 && !on(r, k); ++b)
+                            on(r, k) = o.covers(x + c * (a - 1.5) / 4, y + c * (b - 1.5) / 4);
+                }
+            auto grownOn = on;
+            for (int r = 0; r < gt.rows(); ++r)
+                for (int k = 0; k < gt.cols(); ++k)
+                    for (int dr = -1; dr <= 1; ++dr)
+                        for (int dk = -1; dk <= 1; ++dk) {
+                            const int rr = r + dr, kk = k + dk;
+                            if (rr >= 0 && kk >= 0 && rr < gt.rows() && kk < gt.cols() &&
+                                on(rr, kk))
+                                grownOn(r, k) = true;
+                        }
+            grown.push_back(grownOn);
+        }
+    }
+    bool inAny(int r, int k) const {
+        for (const auto& g : grown)
+            if (g(r, k)) return true;
+        return false;
+    }
+    bool inAnyAt(double x, double y) const {
+        const int k = int(std::lround((x - gt.xllcenter_m) / gt.cellsize_m));
+        const int r = int(std::lround((y - gt.yllcenter_m) / gt.cellsize_m));
+        return r < 0 || k < 0 || r >= gt.rows() || k >= gt.cols() || inAny(r, k);
+    }
+};
+
+struct Rms {
+    double sum = 0;
+    size_t n = 0;
+    void add(double e) {
+        sum += e * e;
+        ++n;
+    }
+    double value() const { return n ? std::sqrt(sum / n) : RandomSceneScores::kNaN; }
+};
+
+/** What cell (x, y) of the map holds, against the truth there (RandomSceneScores::CellKind). */
+RandomSceneScores::CellKind cellKind(const CMultiBinElevationMap& map, double x, double y,
+                                     double truth_m) {
+    constexpr double kAtGround_m = 0.03;
+    const multibin::BinGrid& grid = map.grid();
+    const auto origin = map.mapOrigin();
+    const int ix = grid.cellIndex(x - origin.x), iy = grid.cellIndex(y - origin.y);
+    if (!grid.window().contains(ix, iy)) return RandomSceneScores::NoBin;
+    int bins = 0;
+    bool ground = false;
+    grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+        bins++;
+        ground = ground || std::abs(b.height_m - truth_m) < kAtGround_m;
+    });
+    const multibin::Bin* win = grid.winningBin(ix, iy);
+    if (bins == 0) return RandomSceneScores::NoBin;
+    if (!ground) return RandomSceneScores::OnlyStale;
+    return win && std::abs(win->height_m - truth_m) >= kAtGround_m
+               ? RandomSceneScores::StaleWinsBesideGround
+               : RandomSceneScores::GroundWins;
+}
+
+void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomSceneScores& s) {
+    const int last = sc.passes.back().placement;
+    Rms dem, mrptMean;
+    double worst = 0;
+    for (int r = 0; r < reg.gt.rows(); ++r)
+        for (int k = 0; k < reg.gt.cols(); ++k) {
+            bool vacated = false;
+            for (int v : sc.vacatedPlacements()) vacated = vacated || reg.grown[v](r, k);
+            if (!vacated || (last >= 0 && reg.grown[last](r, k))) continue;
+            const double x = reg.gt.xllcenter_m + k * reg.gt.cellsize_m;
+            const double y = reg.gt.yllcenter_m + r * reg.gt.cellsize_m;
+            const double truth = reg.gt.heights_m(r, k);
+            double z;
+            if (!std::isfinite(truth)) continue;
+            if (!m.map.dem_get_z(x, y, z)) {
+                s.objectUnknown++;
+                continue;
+            }
+            dem.add(z - truth);
+            worst = std::max(worst, std::abs(z - truth));
+            const auto kind = cellKind(m.map, x, y, truth);
+            s.objectSquaredError_m2[kind] += (z - truth) * (z - truth);
+            s.objectCellsOfKind[kind]++;
+            const auto* c = m.mrptMean->cellByPos(x, y);
+            if (c && c->w > 0) mrptMean.add(c->h - truth);
+        }
+    s.objectCells = dem.n;
+    s.objectRmse_m = dem.value();
+    s.objectMrptRmse_m = mrptMean.value();
+    s.objectWorstError_m = dem.n ? worst : RandomSceneScores::kNaN;
+}
+
+void scoreStaticAndFilled(const Regions& reg, Maps& with, Maps& without, RandomSceneScores& s) {
+    Rms withObj, noObj, filled, mrptMean;
+    for (int r = 0; r < reg.gt.rows(); ++r)
+        for (int k = 0; k < reg.gt.cols(); ++k) {
+            const double truth = reg.gt.heights_m(r, k);
+            if (!std::isfinite(truth) || reg.inAny(r, k)) continue;
+            const double x = reg.gt.xllcenter_m + k * reg.gt.cellsize_m;
+            const double y = reg.gt.yllcenter_m + r * reg.gt.cellsize_m;
+            double z1, s1, z0, s0;
+            const auto src1 = with.map.cellElevation(x, y, z1, s1, true);
+            const auto src0 = without.map.cellElevation(x, y, z0, s0, false);
+            const auto* c = with.mrptMean->cellByPos(x, y);
+            const bool mrptGap = !c || c->w == 0;
+            if (src1 == multibin::HeightSource::Measured &&
+                src0 == multibin::HeightSource::Measured) {
+                withObj.add(z1 - truth);
+                noObj.add(z0 - truth);
+                if (!mrptGap) mrptMean.add(c->h - truth);
+            }
+            if (mrptGap && src1 != multibin::HeightSource::Measured &&
+                src1 != multibin::HeightSource::Unknown)
+                filled.add(z1 - truth);
+        }
+    s.staticCells = withObj.n;
+    s.staticRmse_m = withObj.value();
+    s.staticRmseNoObject_m = noObj.value();
+    s.staticMrptRmse_m = mrptMean.value();
+    s.filledCells = filled.n;
+    s.filledRmse_m = filled.value();
+}
+
+void scoreQueries(const RandomScene& sc, const Regions& reg, Maps& m, RandomSceneScores& s) {
+    const Terrain& g = sc.ground;
+    std::mt19937_64 rng(hash64(sc.seed ^ 0x51554552u));
+    std::uniform_real_distribution<double> ux(0.0, g.tilesX() * g.tileSide_m());
+    std::uniform_real_distribution<double> uy(-0.5 * g.tilesY() * g.tileSide_m(),
+                                              0.5 * g.tilesY() * g.tileSide_m());
+    Rms map, mrptMean, floor;
+    for (int i = 0; i < 4000; ++i) {
+        const double x = ux(rng), y = uy(rng);
+        if (reg.inAnyAt(x, y)) continue;
+        double h, sigma;
+        const auto* c = m.mrptMean->cellByPos(x, y);
+        if (!m.map.heightAt(x, y, h, sigma) || !c || c->w == 0) continue;
+        const double truth = g.height(x, y);
+        const int k = int(std::lround((x - reg.gt.xllcenter_m) / reg.gt.cellsize_m));
+        const int r = int(std::lround((y - reg.gt.yllcenter_m) / reg.gt.cellsize_m));
+        const double cellMean = reg.gt.heights_m(r, k);  // inside: inAnyAt() checked the range
+        if (!std::isfinite(cellMean)) continue;
+        map.add(h - truth);
+        mrptMean.add(c->h - truth);
+        floor.add(cellMean - truth);
+    }
+    s.queryPoints = map.n;
+    s.queryRmse_m = map.value();
+    s.queryMrptRmse_m = mrptMean.value();
+    s.queryFloorRmse_m = floor.value();
+}
+
+}  // namespace
+
+RandomSceneScores scoreRandomScene(const RandomScene& sc,
+                                   const std::function<void(CMultiBinElevationMap&)>& configure) {
+    Maps with, without;
+    if (configure) {
+        configure(with.map);
+        configure(without.map);
+    }
+    mapPasses(sc, true, with);
+    mapPasses(sc, false, without);
+    const multibin::EsriAsciiGrid gt = sc.ground.groundTruth(with.map.dem_get_resolution());
+    const Regions reg(gt, sc.placements);
+    RandomSceneScores s;
+    scoreObject(sc, reg, with, s);
+    scoreStaticAndFilled(reg, with, without, s);
+    scoreQueries(sc, reg, with, s);
+    return s;
+}
+
+}  // namespace terrain_sim
