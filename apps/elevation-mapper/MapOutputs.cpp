@@ -8,6 +8,8 @@
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -130,6 +132,12 @@ void OutputFolder::create() const {
     if (ec)
         throw std::runtime_error("cannot create the output folder '" + m_dir.string() +
                                  "': " + ec.message());
+    // Another user could plant files or symlinks in a folder of theirs (or a shared one).
+    struct stat st {};
+    if (::stat(m_dir.c_str(), &st) != 0 || st.st_uid != ::geteuid())
+        throw std::runtime_error("the output folder '" + m_dir.string() +
+                                 "' does not belong to the user running elevation-mapper: choose "
+                                 "a folder of your own with --out");
 }
 
 void OutputFolder::checkNotAnInput(const std::string& name) const {
@@ -172,6 +180,12 @@ void OutputFolder::writeWith(const std::string& name,
     checkNotAnInput(name);
     create();
     multibin::writeFileAtomically((m_dir / name).string(), writer);
+}
+
+void OutputFolder::moveIn(const std::string& name, const std::string& file) const {
+    checkNotAnInput(name);
+    create();
+    multibin::moveIntoPlace(file, (m_dir / name).string());
 }
 
 MapLayers MapLayers::of(const CMultiBinElevationMap& map) {

@@ -30,6 +30,7 @@
 #include <unistd.h>
 
 #include "EvaluationRun.h"
+#include "Figures.h"
 #include "MapOutputs.h"
 #include "ObservationTally.h"
 #include "ProgressBar.h"
@@ -37,6 +38,7 @@
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
+#include "multibin/io/OutputFile.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
@@ -163,38 +165,6 @@ std::string windowText(const CMultiBinElevationMap& map) {
     std::snprintf(buf, sizeof buf, "x %.6g..%.6g m, y %.6g..%.6g m", map.getXMin(), map.getXMax(),
                   map.getYMin(), map.getYMax());
     return buf;
-}
-
-/** The matplotlib script that draws the figures: beside the sources, or installed. */
-std::string plotScript() {
-    for (const fs::path& p :
-         {fs::path(MULTIBIN_SOURCE_DIR) / "apps/elevation-mapper/plot_report.py",
-          fs::path(MULTIBIN_DATA_DIR) / "plot_report.py"})
-        if (fs::exists(p)) return p.string();
-    return {};
-}
-
-/** Draws the figures with Debian's python3-matplotlib into `out`, the layer panels from the
- * rasters in `rasterDir`; a missing plotter is a warning, not an error (every number is in
- * report.json and the rasters). */
-void drawFigures(const fs::path& out, const fs::path& rasterDir) {
-    const std::string script = plotScript();
-    const std::string python = "/usr/bin/python3";
-    if (script.empty() || !fs::exists(python)) {
-        std::cerr << "elevation-mapper: warning: figures not drawn (needs " << python
-                  << " with python3-matplotlib and plot_report.py)\n";
-        return;
-    }
-    const std::string cmd =
-        python + " '" + script + "' '" + out.string() + "' '" + rasterDir.string() + "' >/dev/null";
-    std::cout.flush();
-    int rc = 0;
-    ProgressBar::runWithProgress("figures", [&] { rc = std::system(cmd.c_str()); });
-    if (rc != 0)
-        std::cerr << "elevation-mapper: warning: figures not drawn: '" << cmd << "' failed\n";
-    else
-        std::cout << "figures: " << (out / "fig_pi.png").string() << ", fig_profile.png, "
-                  << "layers.png\n";
 }
 
 /** Four comma-separated numbers given to `flag` (e.g. "--profile"), or none for empty text. */
@@ -364,19 +334,7 @@ int run(const Arguments& args) {
     std::cout << "}\n";
     if (evaluation) {
         std::cout << "\nEvaluation against " << args.groundTruth << " (report.json):\n" << table;
-        if (args.plots) {
-            if (selection.asc) {
-                drawFigures(folder.dir(), folder.dir());
-            } else {  // the layer panels read the ESRI ASCII rasters: a scratch copy
-                const fs::path scratch = fs::temp_directory_path() /
-                                         ("elevation-mapper-layers-" + std::to_string(::getpid()));
-                const OutputFolder scratchFolder(scratch, {});
-                layers.saveAsc(scratchFolder);
-                drawFigures(folder.dir(), scratch);
-                std::error_code ec;
-                fs::remove_all(scratch, ec);
-            }
-        }
+        if (args.plots) drawFigures(folder, selection.asc ? nullptr : &layers);
     }
     return 0;
 }
@@ -384,6 +342,7 @@ int run(const Arguments& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    multibin::removePartialFilesOnSignals();  // a killed run leaves no partial file
     try {
         const Arguments args = parseArguments(argc, argv);
         if (args.usedDefaults)
