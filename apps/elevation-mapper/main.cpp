@@ -167,6 +167,19 @@ std::string windowText(const CMultiBinElevationMap& map) {
     return buf;
 }
 
+/** Keeps only the multi-bin elevation maps of `inits`; returns how many others there were. The
+ * mapper writes no other map, and another type in the same ini (an occupancy grid of any size)
+ * would be built and fed for nothing. */
+size_t keepOnlyElevationMaps(mrpt::maps::TSetOfMetricMapInitializers& inits) {
+    mrpt::maps::TSetOfMetricMapInitializers kept;
+    for (const auto& init : inits)
+        if (init->getMetricMapClassType()->derivedFrom(CLASS_ID(CMultiBinElevationMap)))
+            kept.push_back(init);
+    const size_t others = inits.size() - kept.size();
+    inits = kept;
+    return others;
+}
+
 /** Four comma-separated numbers given to `flag` (e.g. "--profile"), or none for empty text. */
 std::vector<double> parseFourNumbers(const std::string& flag, const std::string& text,
                                      const std::string& meaning) {
@@ -215,6 +228,9 @@ int run(const Arguments& args) {
     mrpt::config::CConfigFile ini(args.config);
     mrpt::maps::TSetOfMetricMapInitializers inits;
     inits.loadFromConfigFile(ini, args.section);
+    if (const size_t others = keepOnlyElevationMaps(inits))
+        std::cout << "note: " << others << " other map(s) of [" << args.section
+                  << "] not built: elevation-mapper builds and writes only multiBinElevationMap\n";
     mrpt::maps::CMultiMetricMap maps(inits);
     const auto elevation = maps.mapByClass<CMultiBinElevationMap>();
     if (!elevation)

@@ -86,6 +86,8 @@ void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::st
     const auto at = prefix.rfind(tag);
     if (at == std::string::npos) return;  // not created through a CMultiMetricMap ini
     const std::string parent = prefix.substr(0, at);
+    // The parent section too holds each key once (the map count given twice is an error).
+    multibin::StrictConfigSection{source, parent};
     const std::string countKey = "multiBinElevationMap_count";
     const std::string countText = source.read_string(parent, countKey, "0");
     char* end = nullptr;
