@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "EvaluationRun.h"
@@ -201,7 +202,24 @@ std::vector<double> parseFourNumbers(const std::string& flag, const std::string&
 const std::vector<std::string> kEvaluationFiles{"report.json", "profile.csv",     "eval_*",
                                                 "fig_pi.png",  "fig_profile.png", "layers.png"};
 
-int run(const Arguments& args) {
+/** Refuses an input that is not a regular file (a device, a FIFO, a socket): MRPT reads one
+ * forever, blocks on it or fails without a message. `what`: "rawlog", "config", ... */
+void checkRegularFile(const std::string& what, const std::string& path) {
+    struct stat st {};
+    if (path.empty() || ::stat(path.c_str(), &st) != 0 || S_ISDIR(st.st_mode) ||
+        S_ISREG(st.st_mode))
+        return;  // absent and folders: their own messages where the input is read
+    throw std::runtime_error(what + " '" + path +
+                             "' is not a regular file (a device, a FIFO or a socket)");
+}
+
+/** Maps and writes; `stage` says what is being done, for errors that do not say it. */
+int run(const Arguments& args, std::string& stage) {
+    for (const auto& [what, path] : {std::pair{"config", args.config},
+                                     {"rawlog", args.rawlog},
+                                     {"simplemap", args.simplemap},
+                                     {"ground truth", args.groundTruth}})
+        checkRegularFile(what, path);
     OutputSelection selection = OutputSelection::parse(args.outputs);
     double exportCell_m = 0;  // --export-resolution: 0 = none
     if (!args.exportResolution.empty() &&
@@ -225,6 +243,7 @@ int run(const Arguments& args) {
         throw std::runtime_error("config '" + args.config + "' not found");
     if (fs::is_directory(args.config))
         throw std::runtime_error("config '" + args.config + "' is a directory, not a file");
+    stage = "reading config '" + args.config + "'";
     mrpt::config::CConfigFile ini(args.config);
     mrpt::maps::TSetOfMetricMapInitializers inits;
     inits.loadFromConfigFile(ini, args.section);
@@ -272,6 +291,7 @@ int run(const Arguments& args) {
         tally.after(obs, inserted, *elevation);
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
+    stage = "mapping " + inputName;
     ProgressBar bar("mapping");
     if (!args.rawlog.empty()) {
         RawlogSource::forEachInRawlog(
@@ -314,6 +334,7 @@ int run(const Arguments& args) {
         std::cout << "note: " << fused.outsideMap << " points fell outside the fixed window ("
                   << windowText(*elevation) << ")\n";
 
+    stage = "filling the map of " + inputName;
     elevation->flushLocalToGlobal();  // dual grid: the global grid holds the whole run
     const auto fill0 = Clock::now();
     ProgressBar::runWithProgress("filling", [&] { elevation->dem_update_map(); });  // once
@@ -323,12 +344,15 @@ int run(const Arguments& args) {
     if (evaluation) table = evaluation->finish(folder, insert_s, fill_s);
     MapLayers layers;
     ProgressBar::runWithProgress("layers", [&] { layers = MapLayers::of(*elevation); });
-    std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
-    if (exportCell_m > 0) {
-        SupersampledLayers fine;
+    // Everything that can fail on the request is computed before the first output is written.
+    SupersampledLayers fine;
+    if (exportCell_m > 0)
         ProgressBar::runWithProgress("supersampled", [&] {
             fine = SupersampledLayers::of(*elevation, layers, exportCell_m);
         });
+    stage = "writing the outputs into '" + folder.dir().string() + "'";
+    std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
+    if (exportCell_m > 0) {
         fine.saveAsc(folder);
         written.insert(written.end(), std::begin(SupersampledLayers::kFiles),
                        std::end(SupersampledLayers::kFiles));
@@ -359,15 +383,16 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
     multibin::removePartialFilesOnSignals();  // a killed run leaves no partial file
+    std::string stage = "reading the arguments";
     try {
         const Arguments args = parseArguments(argc, argv);
         if (args.usedDefaults)
             std::cout << "No arguments: mapping the shipped mock-up scenario\n  --config "
                       << args.config << "\n  --rawlog " << args.rawlog << "\n  --ground-truth "
                       << args.groundTruth << "\n  --out " << args.out << "\n";
-        return run(args);
+        return run(args, stage);
     } catch (const std::exception& e) {
-        std::cerr << "elevation-mapper: error: " << multibin::oneLineMessage(e) << "\n";
+        std::cerr << "elevation-mapper: error: " << multibin::userMessage(e, stage) << "\n";
         return 1;
     }
 }
