@@ -486,16 +486,20 @@ std::string CMultiBinElevationMap::asString() const {
 }
 
 double CMultiBinElevationMap::getXMin() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.x() + m_impl->grid.window().ix0 * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getXMax() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.x() +
            (m_impl->grid.window().ix0 + m_impl->grid.window().nx) * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getYMin() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.y() + m_impl->grid.window().iy0 * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getYMax() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.y() +
            (m_impl->grid.window().iy0 + m_impl->grid.window().ny) * m_impl->grid.cellSize_m();
 }
