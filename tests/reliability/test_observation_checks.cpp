@@ -84,19 +84,6 @@ mrpt::obs::CObservationRotatingScan::Ptr rotatingScan() {
     return obs;
 }
 
-/** A rectified 32 x 24 px stereo pair with a 0.09 m baseline, no disparity image. */
-mrpt::obs::CObservationStereoImages::Ptr stereoPair() {
-    auto obs = mrpt::obs::CObservationStereoImages::Create();
-    obs->sensorLabel = "STEREO";
-    for (auto* cam : {&obs->leftCamera, &obs->rightCamera}) {
-        cam->ncols = 32;
-        cam->nrows = 24;
-        cam->setIntrinsicParamsFromValues(300, 300, 16, 12);
-    }
-    obs->rightCameraPose = mrpt::math::TPose3DQuat(0.09, 0, 0, 1, 0, 0, 0);
-    return obs;
-}
-
 }  // namespace
 
 // A scaled or zero rotation in a sensor pose was read as it was.
@@ -189,11 +176,11 @@ TEST(ObservationChecks, AScanApertureOutOfRangeIsAnErrorInTheLidarPath) {
 
 // A negative focal length and an absurd baseline in a stereo pair.
 TEST(ObservationChecks, StereoFocalLengthsAndBaselinesOutOfTheirRangeAreErrors) {
-    auto focal = stereoPair();
+    auto focal = stereoPair(32, 24);
     focal->leftCamera.setIntrinsicParamsFromValues(-300, 300, 16, 12);
     expectRefused([&](Map& m) { m.insertObservation(*focal, posePdf()); },
                   {"CObservationStereoImages 'STEREO'", "leftCamera.fx", "negative"});
-    auto baseline = stereoPair();
+    auto baseline = stereoPair(32, 24);
     baseline->rightCameraPose = mrpt::math::TPose3DQuat(1e6, 0, 0, 1, 0, 0, 0);
     expectRefused([&](Map& m) { m.insertObservation(*baseline, posePdf()); },
                   {"CObservationStereoImages 'STEREO'", "baseline"});
