@@ -9,6 +9,8 @@
 
 #include <fcntl.h>
 
+#include <csignal>
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "multibin/io/OutputFile.h"
 #include "reliability_helpers.h"
 
 #ifdef ELEVATION_MAPPER_EXE
@@ -209,4 +212,26 @@ TEST(HostilePaths, AnOutputFolderOfAnotherUserIsRefused) {
     EXPECT_TRUE(fs::is_empty(out));
 }
 
+// A run killed while writing left its partial file (600 MB for a fine export): the handlers of
+// removePartialFilesOnSignals() remove what is being written, then the signal ends the process.
+TEST(HostilePaths, AWriteEndedBySigtermOrSigintLeavesNoPartialFile) {
+    for (const int sig : {SIGTERM, SIGINT, SIGHUP}) {
+        SCOPED_TRACE(sig);
+        const fs::path dir = scratchDir("paths_killed_" + std::to_string(sig));
+        const pid_t pid = ::fork();
+        if (pid == 0) {
+            multibin::removePartialFilesOnSignals();
+            multibin::writeFileAtomically((dir / "big.asc").string(), [&](const std::string& p) {
+                std::ofstream(p) << std::string(1 << 20, 'x');  // half written ...
+                ::raise(sig);                                   // ... when the signal comes
+                return true;
+            });
+            ::_exit(0);
+        }
+        int status = 0;
+        ::waitpid(pid, &status, 0);
+        EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "status " << status;
+        EXPECT_TRUE(fs::is_empty(dir)) << fs::begin(fs::directory_iterator(dir))->path();
+    }
+}
 #endif
