@@ -129,3 +129,32 @@ TEST(Messages, ALabelInAnErrorCannotForgeALineOrEscapeTheTerminal) {
     EXPECT_EQ(p.err.find('\x1b'), std::string::npos) << p.err;
 }
 #endif
+
+#ifdef ELEVATION_MAPPER_EXE
+// Requests that took minutes (issue 37, kind 8): a profile line to a far point was sampled every
+// half cell along its whole length; an export resolution near the old cap (1e8 samples) took
+// minutes and wrote gigabytes, and failed after the other outputs were written. Both are
+// refused within seconds, before any output.
+TEST(Messages, SlowRequestsAreRefusedBeforeAnyOutput) {
+    const fs::path dir = scratchDir("messages_slow");
+    const fs::path src = MULTIBIN_SOURCE_DIR;
+    const std::string common = " --config " + (src / "ini" / "mockup.ini").string() + " --rawlog " +
+                               (src / "rawlogs" / "mockup.rawlog").string() + " --no-plots --out " +
+                               (dir / "out").string();
+    for (const auto& [extra, what] :
+         {std::pair{std::string(" --ground-truth ") + (src / "rawlogs" / "mockup_gt.asc").string() +
+                        " --profile 0,0,1e9,0",
+                    std::string("--profile")},
+          {std::string(" --export-resolution 0.0004"), std::string("--export-resolution")}}) {
+        SCOPED_TRACE(extra);
+        fs::remove_all(dir / "out");
+        const std::string cmd = "timeout 60 " + std::string(ELEVATION_MAPPER_EXE) + common + extra +
+                                " > /dev/null 2> " + (dir / "stderr.txt").string();
+        const int status = std::system(cmd.c_str());
+        const std::string err = readAll(dir / "stderr.txt");
+        EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status << " " << err;
+        EXPECT_NE(err.find(what), std::string::npos) << err;
+        EXPECT_FALSE(fs::exists(dir / "out" / "elevation_map.bin")) << "an output was written";
+    }
+}
+#endif
