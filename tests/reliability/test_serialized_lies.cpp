@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <string>
 #include <vector>
@@ -89,8 +90,17 @@ std::vector<uint8_t> serialized(const LyingMap& m) {
     return out;
 }
 
-/** Loading `m` throws a message containing `what`; the map read into is unchanged. */
+/** Loading `m` throws a message containing `what`; the map read into is unchanged. With
+ * MULTIBIN_LIES_CORPUS set to a folder, each input is also written there (the seeds of
+ * tests/fuzz/corpus/map_deserialize/lies-*). */
 void expectRefused(const LyingMap& m, const std::string& what) {
+    if (const char* corpus = std::getenv("MULTIBIN_LIES_CORPUS")) {
+        static int n = 0;
+        const auto bytes = serialized(m);
+        std::ofstream(std::filesystem::path(corpus) / ("lies-" + std::to_string(n++)),
+                      std::ios::binary)
+            .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    }
     Map map = mapWithOtherData();
     const auto before = serialize(map);
     try {
