@@ -92,6 +92,19 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
                    m_lattice.area_m()[1], m_lattice.area_m()[2], m_lattice.area_m()[3],
                    m_lattice.cellSize_m) {
     m_laserOnly.insertionOptions = evaluated.insertionOptions;
+    // The profile is sampled every half cell: a line beyond the evaluated area would be sampled
+    // (billions of times, for a far end point) where there is nothing to draw.
+    const auto area = m_lattice.area_m();
+    for (size_t k = 0; k + 1 < options.profile_m.size(); k += 2) {
+        const double x = options.profile_m[k], y = options.profile_m[k + 1];
+        if (!(x >= area[0] && x <= area[1] && y >= area[2] && y <= area[3])) {
+            std::ostringstream os;
+            os << "--profile: the point (" << x << ", " << y
+               << ") m lies outside the evaluated area x " << area[0] << ".." << area[1] << " m, y "
+               << area[2] << ".." << area[3] << " m";
+            throw std::invalid_argument(os.str());
+        }
+    }
     if (options.withMrf) {
         // A centred crop: MRPT's GMRF solve grows as about n^2.6 in cells.
         const int side = std::min({options.mrfMaxCells, m_lattice.window.nx, m_lattice.window.ny});

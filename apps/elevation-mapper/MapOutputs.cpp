@@ -8,6 +8,8 @@
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -130,6 +132,12 @@ void OutputFolder::create() const {
     if (ec)
         throw std::runtime_error("cannot create the output folder '" + m_dir.string() +
                                  "': " + ec.message());
+    // Another user could plant files or symlinks in a folder of theirs (or a shared one).
+    struct stat st {};
+    if (::stat(m_dir.c_str(), &st) != 0 || st.st_uid != ::geteuid())
+        throw std::runtime_error("the output folder '" + m_dir.string() +
+                                 "' does not belong to the user running elevation-mapper: choose "
+                                 "a folder of your own with --out");
 }
 
 void OutputFolder::checkNotAnInput(const std::string& name) const {
@@ -174,6 +182,12 @@ void OutputFolder::writeWith(const std::string& name,
     multibin::writeFileAtomically((m_dir / name).string(), writer);
 }
 
+void OutputFolder::moveIn(const std::string& name, const std::string& file) const {
+    checkNotAnInput(name);
+    create();
+    multibin::moveIntoPlace(file, (m_dir / name).string());
+}
+
 MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
     using L = CMultiBinElevationMap::RasterLayer;
     MapLayers m;
@@ -205,10 +219,14 @@ SupersampledLayers SupersampledLayers::of(const CMultiBinElevationMap& map, cons
     const double y0 = box.yllcenter_m - 0.5 * box.cellsize_m;
     const int cols = int(std::ceil(box.cols() * box.cellsize_m / cell_m - 1e-9));
     const int rows = int(std::ceil(box.rows() * box.cellsize_m / cell_m - 1e-9));
-    if (double(cols) * double(rows) > 1e8)
+    // Each sample is a surface query and about 20 bytes in each of two text files: 2e7 samples
+    // take seconds and 400 MB; more would take minutes and gigabytes.
+    constexpr double kMaxSamples = 2e7;
+    if (!(double(cols) * double(rows) <= kMaxSamples))
         throw std::invalid_argument("--export-resolution " + std::to_string(cell_m) +
                                     " m: " + std::to_string(cols) + " x " + std::to_string(rows) +
-                                    " samples, over 1e8");
+                                    " samples over the rasters' area, more than 2e7; choose a "
+                                    "coarser resolution");
     for (multibin::EsriAsciiGrid* g : {&out.height, &out.sigma}) {
         g->heights_m.setConstant(rows, cols, NAN);
         g->xllcenter_m = x0 + 0.5 * cell_m;

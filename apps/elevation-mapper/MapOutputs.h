@@ -34,8 +34,9 @@ struct OutputSelection {
 };
 
 /** The run's output folder. Every file is checked against the run's inputs (an input is never
- * overwritten) and written whole through a temporary file and a rename (a full disk leaves no
- * truncated file); every error names its file. */
+ * overwritten) and written whole through a temporary file created exclusively and a rename (a
+ * full disk leaves no truncated file, a symlink planted in the folder is never followed); the
+ * folder must belong to the user running the program. Every error names its file. */
 class OutputFolder {
 public:
     /** inputs: (what, path), e.g. ("--ground-truth", "gt.asc"). The folder is created when the
@@ -51,6 +52,8 @@ public:
     /** For writers that take a path: writer(temporaryPath) returns false or throws on failure. */
     void writeWith(const std::string& name,
                    const std::function<bool(const std::string& path)>& writer) const;
+    /** Moves `file` (written by another program into a private folder) into place as `name`. */
+    void moveIn(const std::string& name, const std::string& file) const;
 
 private:
     void create() const;

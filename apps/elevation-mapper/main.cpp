@@ -27,9 +27,11 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "EvaluationRun.h"
+#include "Figures.h"
 #include "MapOutputs.h"
 #include "ObservationTally.h"
 #include "ProgressBar.h"
@@ -37,6 +39,7 @@
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
+#include "multibin/io/OutputFile.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
@@ -165,36 +168,17 @@ std::string windowText(const CMultiBinElevationMap& map) {
     return buf;
 }
 
-/** The matplotlib script that draws the figures: beside the sources, or installed. */
-std::string plotScript() {
-    for (const fs::path& p :
-         {fs::path(MULTIBIN_SOURCE_DIR) / "apps/elevation-mapper/plot_report.py",
-          fs::path(MULTIBIN_DATA_DIR) / "plot_report.py"})
-        if (fs::exists(p)) return p.string();
-    return {};
-}
-
-/** Draws the figures with Debian's python3-matplotlib into `out`, the layer panels from the
- * rasters in `rasterDir`; a missing plotter is a warning, not an error (every number is in
- * report.json and the rasters). */
-void drawFigures(const fs::path& out, const fs::path& rasterDir) {
-    const std::string script = plotScript();
-    const std::string python = "/usr/bin/python3";
-    if (script.empty() || !fs::exists(python)) {
-        std::cerr << "elevation-mapper: warning: figures not drawn (needs " << python
-                  << " with python3-matplotlib and plot_report.py)\n";
-        return;
-    }
-    const std::string cmd =
-        python + " '" + script + "' '" + out.string() + "' '" + rasterDir.string() + "' >/dev/null";
-    std::cout.flush();
-    int rc = 0;
-    ProgressBar::runWithProgress("figures", [&] { rc = std::system(cmd.c_str()); });
-    if (rc != 0)
-        std::cerr << "elevation-mapper: warning: figures not drawn: '" << cmd << "' failed\n";
-    else
-        std::cout << "figures: " << (out / "fig_pi.png").string() << ", fig_profile.png, "
-                  << "layers.png\n";
+/** Keeps only the multi-bin elevation maps of `inits`; returns how many others there were. The
+ * mapper writes no other map, and another type in the same ini (an occupancy grid of any size)
+ * would be built and fed for nothing. */
+size_t keepOnlyElevationMaps(mrpt::maps::TSetOfMetricMapInitializers& inits) {
+    mrpt::maps::TSetOfMetricMapInitializers kept;
+    for (const auto& init : inits)
+        if (init->getMetricMapClassType()->derivedFrom(CLASS_ID(CMultiBinElevationMap)))
+            kept.push_back(init);
+    const size_t others = inits.size() - kept.size();
+    inits = kept;
+    return others;
 }
 
 /** Four comma-separated numbers given to `flag` (e.g. "--profile"), or none for empty text. */
@@ -218,7 +202,24 @@ std::vector<double> parseFourNumbers(const std::string& flag, const std::string&
 const std::vector<std::string> kEvaluationFiles{"report.json", "profile.csv",     "eval_*",
                                                 "fig_pi.png",  "fig_profile.png", "layers.png"};
 
-int run(const Arguments& args) {
+/** Refuses an input that is not a regular file (a device, a FIFO, a socket): MRPT reads one
+ * forever, blocks on it or fails without a message. `what`: "rawlog", "config", ... */
+void checkRegularFile(const std::string& what, const std::string& path) {
+    struct stat st {};
+    if (path.empty() || ::stat(path.c_str(), &st) != 0 || S_ISDIR(st.st_mode) ||
+        S_ISREG(st.st_mode))
+        return;  // absent and folders: their own messages where the input is read
+    throw std::runtime_error(what + " '" + path +
+                             "' is not a regular file (a device, a FIFO or a socket)");
+}
+
+/** Maps and writes; `stage` says what is being done, for errors that do not say it. */
+int run(const Arguments& args, std::string& stage) {
+    for (const auto& [what, path] : {std::pair{"config", args.config},
+                                     {"rawlog", args.rawlog},
+                                     {"simplemap", args.simplemap},
+                                     {"ground truth", args.groundTruth}})
+        checkRegularFile(what, path);
     OutputSelection selection = OutputSelection::parse(args.outputs);
     double exportCell_m = 0;  // --export-resolution: 0 = none
     if (!args.exportResolution.empty() &&
@@ -242,9 +243,13 @@ int run(const Arguments& args) {
         throw std::runtime_error("config '" + args.config + "' not found");
     if (fs::is_directory(args.config))
         throw std::runtime_error("config '" + args.config + "' is a directory, not a file");
+    stage = "reading config '" + args.config + "'";
     mrpt::config::CConfigFile ini(args.config);
     mrpt::maps::TSetOfMetricMapInitializers inits;
     inits.loadFromConfigFile(ini, args.section);
+    if (const size_t others = keepOnlyElevationMaps(inits))
+        std::cout << "note: " << others << " other map(s) of [" << args.section
+                  << "] not built: elevation-mapper builds and writes only multiBinElevationMap\n";
     mrpt::maps::CMultiMetricMap maps(inits);
     const auto elevation = maps.mapByClass<CMultiBinElevationMap>();
     if (!elevation)
@@ -286,6 +291,7 @@ int run(const Arguments& args) {
         tally.after(obs, inserted, *elevation);
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
+    stage = "mapping " + inputName;
     ProgressBar bar("mapping");
     if (!args.rawlog.empty()) {
         RawlogSource::forEachInRawlog(
@@ -328,6 +334,7 @@ int run(const Arguments& args) {
         std::cout << "note: " << fused.outsideMap << " points fell outside the fixed window ("
                   << windowText(*elevation) << ")\n";
 
+    stage = "filling the map of " + inputName;
     elevation->flushLocalToGlobal();  // dual grid: the global grid holds the whole run
     const auto fill0 = Clock::now();
     ProgressBar::runWithProgress("filling", [&] { elevation->dem_update_map(); });  // once
@@ -337,12 +344,15 @@ int run(const Arguments& args) {
     if (evaluation) table = evaluation->finish(folder, insert_s, fill_s);
     MapLayers layers;
     ProgressBar::runWithProgress("layers", [&] { layers = MapLayers::of(*elevation); });
-    std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
-    if (exportCell_m > 0) {
-        SupersampledLayers fine;
+    // Everything that can fail on the request is computed before the first output is written.
+    SupersampledLayers fine;
+    if (exportCell_m > 0)
         ProgressBar::runWithProgress("supersampled", [&] {
             fine = SupersampledLayers::of(*elevation, layers, exportCell_m);
         });
+    stage = "writing the outputs into '" + folder.dir().string() + "'";
+    std::vector<std::string> written = writeMapOutputs(*elevation, layers, selection, folder);
+    if (exportCell_m > 0) {
         fine.saveAsc(folder);
         written.insert(written.end(), std::begin(SupersampledLayers::kFiles),
                        std::end(SupersampledLayers::kFiles));
@@ -364,19 +374,7 @@ int run(const Arguments& args) {
     std::cout << "}\n";
     if (evaluation) {
         std::cout << "\nEvaluation against " << args.groundTruth << " (report.json):\n" << table;
-        if (args.plots) {
-            if (selection.asc) {
-                drawFigures(folder.dir(), folder.dir());
-            } else {  // the layer panels read the ESRI ASCII rasters: a scratch copy
-                const fs::path scratch = fs::temp_directory_path() /
-                                         ("elevation-mapper-layers-" + std::to_string(::getpid()));
-                const OutputFolder scratchFolder(scratch, {});
-                layers.saveAsc(scratchFolder);
-                drawFigures(folder.dir(), scratch);
-                std::error_code ec;
-                fs::remove_all(scratch, ec);
-            }
-        }
+        if (args.plots) drawFigures(folder, selection.asc ? nullptr : &layers);
     }
     return 0;
 }
@@ -384,15 +382,17 @@ int run(const Arguments& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    multibin::removePartialFilesOnSignals();  // a killed run leaves no partial file
+    std::string stage = "reading the arguments";
     try {
         const Arguments args = parseArguments(argc, argv);
         if (args.usedDefaults)
             std::cout << "No arguments: mapping the shipped mock-up scenario\n  --config "
                       << args.config << "\n  --rawlog " << args.rawlog << "\n  --ground-truth "
                       << args.groundTruth << "\n  --out " << args.out << "\n";
-        return run(args);
+        return run(args, stage);
     } catch (const std::exception& e) {
-        std::cerr << "elevation-mapper: error: " << multibin::oneLineMessage(e) << "\n";
+        std::cerr << "elevation-mapper: error: " << multibin::userMessage(e, stage) << "\n";
         return 1;
     }
 }

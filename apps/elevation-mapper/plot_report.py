@@ -1,13 +1,13 @@
 #!/usr/bin/python3
 """Draws elevation-mapper's evaluation figures with matplotlib (Debian: python3-matplotlib).
 
-Usage: plot_report.py DIR [RASTER_DIR]
+Usage: plot_report.py DIR [RASTER_DIR [FIGURE_DIR]]
 
 Reads DIR/report.json, DIR/profile.csv and the rasters elevation_*.asc that elevation-mapper
-wrote (in RASTER_DIR, default DIR), and writes:
-  DIR/fig_pi.png       the paper's Fig. 8: Performance Index (eq 17) per method, bars
-  DIR/fig_profile.png  the paper's Fig. 3: a height profile with the +-3 sigma band and the truth
-  DIR/layers.png       height, sigma, certainty and filled cells of the map, with colour bars
+wrote (in RASTER_DIR, default DIR), and writes into FIGURE_DIR (default DIR):
+  fig_pi.png       the paper's Fig. 8: Performance Index (eq 17) per method, bars
+  fig_profile.png  the paper's Fig. 3: a height profile with the +-3 sigma band and the truth
+  layers.png       height, sigma, certainty and filled cells of the map, with colour bars
 """
 import csv
 import json
@@ -139,16 +139,17 @@ def plot_layers(directory, out):
 
 
 def main():
-    if len(sys.argv) not in (2, 3):
+    if len(sys.argv) not in (2, 3, 4):
         sys.exit(__doc__)
     d = sys.argv[1]
-    rasters = sys.argv[2] if len(sys.argv) == 3 else d
+    rasters = sys.argv[2] if len(sys.argv) >= 3 else d
+    figures = sys.argv[3] if len(sys.argv) == 4 else d
     with open(os.path.join(d, "report.json")) as f:
         report = json.load(f)
-    plot_pi(report, os.path.join(d, "fig_pi.png"))
-    plot_profile(os.path.join(d, "profile.csv"), os.path.join(d, "fig_profile.png"))
-    plot_layers(rasters, os.path.join(d, "layers.png"))
-    print(f"figures: {d}/fig_pi.png, {d}/fig_profile.png, {d}/layers.png")
+    plot_pi(report, os.path.join(figures, "fig_pi.png"))
+    plot_profile(os.path.join(d, "profile.csv"), os.path.join(figures, "fig_profile.png"))
+    plot_layers(rasters, os.path.join(figures, "layers.png"))
+    print(f"figures: {figures}/fig_pi.png, {figures}/fig_profile.png, {figures}/layers.png")
 
 
 if __name__ == "__main__":

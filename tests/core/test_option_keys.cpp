@@ -161,12 +161,12 @@ TEST(OptionKeys, ValuesSetInCodeAreCheckedByTheKeysRules) {
 
 // The rules' texts, which are the error messages.
 TEST(OptionKeys, RuleTextsSayTheRule) {
-    EXPECT_EQ(multibin::positive("m").text(), "must be positive and finite (m)");
-    EXPECT_EQ(multibin::atLeast(1).text(), "must be >= 1 and finite");
+    EXPECT_EQ(multibin::positive("m").text(), "must be positive and finite (m), at most 1e+10 m");
+    EXPECT_EQ(multibin::atLeast(1).text(), "must be >= 1 and finite, at most 1e+09");
     EXPECT_EQ(multibin::between(0, 1).text(), "must be from 0 to 1");
     EXPECT_EQ(multibin::oddBetween(3, 15, "cells").text(),
               "must be an odd number from 3 to 15 (cells)");
-    EXPECT_EQ(multibin::finite("m").text(), "must be finite (m)");
+    EXPECT_EQ(multibin::finite("m").text(), "must be finite (m), within +-1e+10 m");
     EXPECT_FALSE(multibin::oddBetween(3, 15).holds(4));
     EXPECT_TRUE(multibin::oddBetween(3, 15).holds(15));
     EXPECT_FALSE(multibin::positive().holds(0));

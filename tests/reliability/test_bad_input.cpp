@@ -95,28 +95,6 @@ bool floorHeightAt(const Map& map, double xRobot_m, double y_m, double& h_m) {
            map.getHeight(xRobot_m + 0.2601, y_m, h_m, s);
 }
 
-/** A rectified 32 x 24 px stereo pair (fx = 300 px, 0.09 m baseline) with a disparity image of
- * w x h px, all 40 px. */
-mrpt::obs::CObservationStereoImages::Ptr stereoPair(int w, int h) {
-    auto obs = mrpt::obs::CObservationStereoImages::Create();
-    obs->sensorLabel = "STEREO";
-    for (auto* cam : {&obs->leftCamera, &obs->rightCamera}) {
-        cam->ncols = 32;
-        cam->nrows = 24;
-        cam->setIntrinsicParamsFromValues(300, 300, 16, 12);
-    }
-    obs->rightCameraPose = mrpt::math::TPose3DQuat(0.09, 0, 0, 1, 0, 0, 0);
-    // Camera looking down at the floor from 0.5 m (MRPT camera frame: +z forward).
-    obs->cameraPose =
-        mrpt::poses::CPose3DQuat(mrpt::poses::CPose3D(0, 0, 0.5, -M_PI / 2, 0, -M_PI)).asTPose();
-    multibin::sensors::DisparityImage d(w, h);
-    for (float& v : d.disparity_px) v = 40.f;  // 0.675 m away
-    obs->imageDisparity = multibin::sensors::encodeDisparityImage(d);
-    obs->hasImageDisparity = true;
-    obs->hasImageRight = false;
-    return obs;
-}
-
 mrpt::maps::CMultiMetricMap mapsFromIni(const std::string& iniText) {
     mrpt::config::CConfigFileMemory ini(iniText);
     mrpt::maps::TSetOfMetricMapInitializers inits;

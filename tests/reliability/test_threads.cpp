@@ -39,6 +39,9 @@ void read(const Map& map, const std::atomic<bool>& done, std::atomic<int>& start
             if (map.dem_get_z(x, 0.3, z) && !std::isfinite(z)) bad++;
             queries += 3;
         }
+        // The extent getters read the window growth moves (a race before they took the lock).
+        if (!(map.getXMax() >= map.getXMin()) || !(map.getYMax() >= map.getYMin())) bad++;
+        queries += 4;
         const auto raster = map.toRaster(Map::RasterLayer::Height);
         if (raster.rows() < 0) bad++;
         mrpt::io::CMemoryStream mem;

@@ -23,10 +23,14 @@ std::string trim(const std::string& s) {
     if (b == std::string::npos) return {};
     const auto e = s.find_last_not_of(" \t\r\n");
     std::string out = s.substr(b, e - b + 1);
-    // Strip a trailing comment ("value  // note" or "value # note").
-    for (const char* mark : {"//", "#", ";"}) {
-        const auto c = out.find(mark);
-        if (c != std::string::npos) out = out.substr(0, c);
+    // Strip a trailing comment ("value  // note" or "value # note"): a mark that starts the value
+    // or follows a blank, so that a label holding one ("cam#2") is kept whole.
+    for (size_t at = 0; at < out.size(); at++) {
+        const bool mark = out[at] == '#' || out[at] == ';' || out.compare(at, 2, "//") == 0;
+        if (mark && (at == 0 || out[at - 1] == ' ' || out[at - 1] == '\t')) {
+            out.resize(at);
+            break;
+        }
     }
     const auto e2 = out.find_last_not_of(" \t");
     return e2 == std::string::npos ? std::string() : out.substr(0, e2 + 1);
@@ -64,8 +68,9 @@ std::string iniText(const mrpt::config::CConfigFileBase& source, const std::stri
     return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
 }
 
-/** The first key given more than once in `section` of ini `text` ("" if none). MRPT's reader
- * keeps the last value without a word. */
+/** The first key given more than once in `section` of ini `text` ("" if none), compared as MRPT
+ * compares them, ignoring case (also across headers of the section in different case): MRPT's
+ * reader keeps the last value without a word. */
 std::string duplicatedKey(const std::string& text, const std::string& section) {
     std::set<std::string> seen;
     bool inSection = false;
@@ -78,13 +83,14 @@ std::string duplicatedKey(const std::string& text, const std::string& section) {
         if (line.empty()) continue;
         if (line.front() == '[') {
             const auto close = line.find(']');
-            inSection = close != std::string::npos && trim(line.substr(1, close - 1)) == section;
+            inSection = close != std::string::npos &&
+                        lower(trim(line.substr(1, close - 1))) == lower(section);
             continue;
         }
         const auto eq = line.find('=');
         if (!inSection || eq == std::string::npos) continue;
         const std::string key = trim(line.substr(0, eq));
-        if (!seen.insert(key).second) return key;
+        if (!seen.insert(lower(key)).second) return key;
     }
     return {};
 }
@@ -209,7 +215,13 @@ void StrictConfigSection::read(const std::string& key, std::vector<double>& valu
 
 void StrictConfigSection::read(const std::string& key, std::vector<std::string>& value) {
     const std::string* s = raw(key);
-    if (s) value = splitList(*s);
+    if (!s) return;
+    std::vector<std::string> items = splitList(*s);
+    // A list names each thing once: a repeated item would silently keep one of its meanings.
+    std::set<std::string> seen;
+    for (const std::string& item : items)
+        if (!seen.insert(item).second) fail(key, "'" + item + "' is listed twice");
+    value = std::move(items);
 }
 
 void StrictConfigSection::readInRange(const std::string& key, double& value, double lo, double hi) {

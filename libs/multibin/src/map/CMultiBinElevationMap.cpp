@@ -86,6 +86,8 @@ void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::st
     const auto at = prefix.rfind(tag);
     if (at == std::string::npos) return;  // not created through a CMultiMetricMap ini
     const std::string parent = prefix.substr(0, at);
+    // The parent section too holds each key once (the map count given twice is an error).
+    multibin::StrictConfigSection{source, parent};
     const std::string countKey = "multiBinElevationMap_count";
     const std::string countText = source.read_string(parent, countKey, "0");
     char* end = nullptr;
@@ -484,16 +486,20 @@ std::string CMultiBinElevationMap::asString() const {
 }
 
 double CMultiBinElevationMap::getXMin() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.x() + m_impl->grid.window().ix0 * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getXMax() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.x() +
            (m_impl->grid.window().ix0 + m_impl->grid.window().nx) * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getYMin() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.y() + m_impl->grid.window().iy0 * m_impl->grid.cellSize_m();
 }
 double CMultiBinElevationMap::getYMax() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     return m_impl->origin_m.y() +
            (m_impl->grid.window().iy0 + m_impl->grid.window().ny) * m_impl->grid.cellSize_m();
 }

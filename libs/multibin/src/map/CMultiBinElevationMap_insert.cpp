@@ -3,6 +3,7 @@
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/system/datetime.h>
 #include "CMultiBinElevationMap_impl.h"
+#include "multibin/sensors/ObservationChecks.h"
 #include "multibin/util/Counters.h"
 
 #include <algorithm>
@@ -146,6 +147,7 @@ void CMultiBinElevationMap::forEachObservationWithPosePdf(
         const auto& [posePdf, sf] = simplemap.get(i);
         const std::string where = "CMultiBinElevationMap: simplemap keyframe " + std::to_string(i);
         if (!posePdf) throw std::invalid_argument(where + " has no pose (null)");
+        multibin::sensors::checkPosePdf(*posePdf, where + "'s pose");
         if (!sf) throw std::invalid_argument(where + " has no sensory frame (null)");
         for (const auto& obs : *sf)
             if (!obs) throw std::invalid_argument(where + " holds a null observation");

@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -67,34 +69,94 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
     throw std::runtime_error("CMultiBinElevationMap: corrupt serialized map (" + what + ")");
 }
 
-/** Reads a grid whose window may have at most maxSideCells cells per side (the stored options'
- * own limit), checked before anything is allocated; its bins carry plane moments if
- * `withPlane` (version 3; before, a loaded bin has none) and pose sigma codes if `withPose`
- * (version 4; before, not known). */
-void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double cellSize_m,
-              double maxSideCells, bool withPlane, bool withPose) {
-    int32_t ix0, iy0, nx, ny;
-    in >> ix0 >> iy0 >> nx >> ny;
-    if (nx < 0 || ny < 0 || double(nx) > maxSideCells || double(ny) > maxSideCells)
-        corrupt("window of " + std::to_string(nx) + " x " + std::to_string(ny) +
+/** What a stored grid holds, read and checked before the grid allocates its window. */
+struct StoredGrid {
+    multibin::CellWindow window;
+    struct Cell {
+        int32_t ix, iy;
+        size_t firstBin;
+        uint16_t bins;
+    };
+    std::vector<Cell> cells;
+    std::vector<multibin::Bin> bins;
+};
+
+/** Cells a stored window may span whatever it holds (16 bytes each in BinStore: 256 MB), and
+ * per non-empty cell beyond that: a map of real data is never sparser (a 1 km walk along the
+ * diagonal of a 2 cm window leaves one cell in 100 non-empty), a lying 1 kB file is. */
+constexpr uint64_t kWindowCellsFree = uint64_t(1) << 24;
+constexpr uint64_t kWindowCellsPerNonEmptyCell = 1024;
+
+/** Checks a stored window: sides within the stored options' limit (maxSideCells), every cell
+ * index within what BinStore can index (its clamp of coordinates), so that ix0 + nx cannot
+ * overflow. */
+void checkWindow(const multibin::CellWindow& w, double maxSideCells) {
+    if (w.nx < 0 || w.ny < 0 || double(w.nx) > maxSideCells || double(w.ny) > maxSideCells)
+        corrupt("window of " + std::to_string(w.nx) + " x " + std::to_string(w.ny) +
                 " cells, beyond the stored options' limit of " +
                 std::to_string(int64_t(maxSideCells)) + " per side");
-    grid.reset(cellSize_m, multibin::CellWindow{ix0, iy0, nx, ny});
+    const double maxIndex =
+        multibin::BinStore::clampedCellCoordinate(std::numeric_limits<double>::infinity());
+    for (const int64_t i :
+         {int64_t(w.ix0), int64_t(w.iy0), int64_t(w.ix0) + w.nx, int64_t(w.iy0) + w.ny})
+        if (double(std::abs(i)) > maxIndex)
+            corrupt("window from cell (" + std::to_string(w.ix0) + ", " + std::to_string(w.iy0) +
+                    ") over " + std::to_string(w.nx) + " x " + std::to_string(w.ny) +
+                    " cells, beyond the cell indices the grid supports (+-" +
+                    std::to_string(int64_t(maxIndex)) + ")");
+}
+
+/** Checks a stored bin for sense: finite, non-negative variance and certainty, its height inside
+ * its own vertical bin [index, index + 1) * binHeight_m, give or take float rounding (a point
+ * just below a bin's top, stored as float, may round onto it). */
+void checkBin(const multibin::Bin& b, int ix, int iy, double binHeight_m) {
+    const std::string where = "bin " + std::to_string(b.index) + " of cell (" + std::to_string(ix) +
+                              ", " + std::to_string(iy) + ")";
+    if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) || !std::isfinite(b.variance_m2) ||
+        !(b.certainty >= 0) || !std::isfinite(b.certainty))
+        corrupt("invalid " + where);
+    const double bottom_m = b.index * binHeight_m, top_m = (b.index + 1) * binHeight_m;
+    const double rounding_m = 1e-3 * binHeight_m + 1e-6 * std::abs(double(b.height_m));
+    if (!(b.height_m >= bottom_m - rounding_m && b.height_m <= top_m + rounding_m)) {
+        char text[160];
+        std::snprintf(text, sizeof text, " holds the height %.9g m, outside its bin [%.9g, %.9g) m",
+                      b.height_m, bottom_m, top_m);
+        corrupt(where + text);
+    }
+}
+
+/** Reads a grid (see readGrid) into memory that grows only with the bytes read. */
+StoredGrid readStoredGrid(mrpt::serialization::CArchive& in, double maxSideCells,
+                          double binHeight_m, bool withPlane, bool withPose) {
+    StoredGrid g;
+    multibin::CellWindow& w = g.window;
+    int32_t ix0, iy0, nx, ny;
+    in >> ix0 >> iy0 >> nx >> ny;
+    w = multibin::CellWindow{ix0, iy0, nx, ny};
+    checkWindow(w, maxSideCells);
     uint64_t nonEmpty;
     in >> nonEmpty;
-    if (nonEmpty > uint64_t(nx) * uint64_t(ny))
+    if (nonEmpty > w.cellCount())
         corrupt(std::to_string(nonEmpty) + " cells in a window of " +
-                std::to_string(uint64_t(nx) * uint64_t(ny)));
+                std::to_string(w.cellCount()));
+    std::vector<uint8_t> seen(size_t(1) << 16);  // the bin indices of the cell being read
     for (uint64_t c = 0; c < nonEmpty; c++) {
-        int32_t ix, iy;
-        uint16_t n;
-        in >> ix >> iy >> n;
-        if (!grid.window().contains(ix, iy)) corrupt("cell outside the window");
-        for (uint16_t k = 0; k < n; k++) {
+        StoredGrid::Cell cell{0, 0, g.bins.size(), 0};
+        in >> cell.ix >> cell.iy >> cell.bins;
+        if (!w.contains(cell.ix, cell.iy)) corrupt("cell outside the window");
+        // Written row by row, each cell once: a cell out of that order is a duplicate or a lie.
+        if (!g.cells.empty() && std::make_pair(cell.iy, cell.ix) <=
+                                    std::make_pair(g.cells.back().iy, g.cells.back().ix))
+            corrupt("cell (" + std::to_string(cell.ix) + ", " + std::to_string(cell.iy) +
+                    ") listed twice or out of order");
+        if (cell.bins == 0) corrupt("a non-empty cell with no bins");
+        for (uint16_t k = 0; k < cell.bins; k++) {
             multibin::Bin b;
             in >> b.height_m >> b.variance_m2 >> b.certainty >> b.pointCount >> b.index;
-            if (!std::isfinite(b.height_m) || !(b.variance_m2 >= 0) || !(b.certainty >= 0))
-                corrupt("invalid bin");
+            checkBin(b, cell.ix, cell.iy, binHeight_m);
+            if (seen[size_t(b.index - std::numeric_limits<int16_t>::min())]++)
+                corrupt("bin " + std::to_string(b.index) + " of cell (" + std::to_string(cell.ix) +
+                        ", " + std::to_string(cell.iy) + ") stored twice");
             if (withPlane) {
                 bool finite = true;
                 forEachMoment(b.plane, [&](float& v) {
@@ -107,9 +169,31 @@ void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double
                     corrupt("invalid plane moments");
             }
             if (withPose) in >> b.poseHeightSigmaCode >> b.poseHorizontalSigmaCode;
-            grid.appendBin(ix, iy, b);
+            g.bins.push_back(b);
         }
+        for (size_t k = cell.firstBin; k < g.bins.size(); k++)
+            seen[size_t(g.bins[k].index - std::numeric_limits<int16_t>::min())] = 0;
+        g.cells.push_back(cell);
     }
+    const uint64_t allowed =
+        std::max(kWindowCellsFree, kWindowCellsPerNonEmptyCell * g.cells.size());
+    if (w.cellCount() > allowed)
+        corrupt("window of " + std::to_string(w.nx) + " x " + std::to_string(w.ny) + " cells for " +
+                std::to_string(g.cells.size()) + " non-empty cells: more than " +
+                std::to_string(allowed) + " cells, sparser than any map of data");
+    return g;
+}
+
+/** Reads a grid whose window may have at most maxSideCells cells per side (the stored options'
+ * own limit); its bins carry plane moments if `withPlane` (version 3; before, a loaded bin has
+ * none) and pose sigma codes if `withPose` (version 4; before, not known). Everything is read and
+ * checked for sense before the grid allocates its window. */
+void readGrid(mrpt::serialization::CArchive& in, multibin::BinGrid& grid, double cellSize_m,
+              double maxSideCells, double binHeight_m, bool withPlane, bool withPose) {
+    const StoredGrid g = readStoredGrid(in, maxSideCells, binHeight_m, withPlane, withPose);
+    grid.reset(cellSize_m, g.window);
+    for (const StoredGrid::Cell& c : g.cells)
+        for (size_t k = 0; k < c.bins; k++) grid.appendBin(c.ix, c.iy, g.bins[c.firstBin + k]);
 }
 /** What a serialized map holds, read completely (and checked) before the map is touched. */
 struct StoredMap {
@@ -145,11 +229,12 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
     const double singleSide_m = std::max({c.max_size_m, c.max_x - c.min_x, c.max_y - c.min_y});
     if (c.dual_grid) {
         readGrid(in, grid, c.global_resolution_m, c.global_size_m / c.global_resolution_m + 2,
-                 withPlane, withPose);
+                 c.bin_height_m, withPlane, withPose);
         readGrid(in, local, c.local_resolution_m, c.local_size_m / c.local_resolution_m + 2,
-                 withPlane, withPose);
+                 c.bin_height_m, withPlane, withPose);
     } else {
-        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2, withPlane, withPose);
+        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2, c.bin_height_m,
+                 withPlane, withPose);
     }
     if (version >= 1) {
         uint32_t tag = 0;

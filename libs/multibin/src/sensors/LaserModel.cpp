@@ -1,5 +1,6 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/LaserModel.h"
+#include "multibin/sensors/ObservationChecks.h"
 
 #include <algorithm>
 #include <cmath>
@@ -102,14 +103,10 @@ void laserScanToPoints(const mrpt::obs::CObservation2DRangeScan& scan,
     out.clear();
     out.reserve(n);
     stats.beams += n;
-    // The beam angles derive from the aperture: NaN, zero (every beam on one line), negative or
-    // more than a turn is a corrupt scan, refused whole (one beam has no spacing to derive).
-    constexpr double kFullTurn_rad = 6.283185307179586;
-    if (n >= 2 && !(scan.aperture > 0 && scan.aperture <= kFullTurn_rad * (1 + 1e-6))) {
+    // The beam angles derive from the aperture: a corrupt one refuses the scan whole.
+    if (const std::string why = apertureProblem(scan); !why.empty()) {
         stats.badAperture += n;
-        throw std::invalid_argument("CObservation2DRangeScan '" + scan.sensorLabel +
-                                    "': aperture " + std::to_string(scan.aperture) +
-                                    " rad must be in (0, 2 pi] rad");
+        throw std::invalid_argument(why);
     }
 
     // Ranges for the mixed-pixel clustering: +inf = no return, NaN = unusable reading.

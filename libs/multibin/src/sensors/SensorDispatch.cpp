@@ -17,6 +17,7 @@
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/LaserModel.h"
 #include "multibin/sensors/LidarModel.h"
+#include "multibin/sensors/ObservationChecks.h"
 #include "multibin/sensors/RayModel.h"
 #include "multibin/sensors/StereoModel.h"
 
@@ -51,9 +52,15 @@ bool observationToSensorPoints(const mrpt::obs::CObservation& obs,
     out.stats = {};
     out.depthFrameError = false;
     out.cameraFrame = false;
+    // Every field a model reads, once, before any model reads it.
+    checkObservationFields(obs);
+    checkPose(robotPose.mean, "the robot pose of " + std::string(obs.GetRuntimeClass()->className) +
+                                  " '" + obs.sensorLabel + "'");
     if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs)) {
         out.sensorPose = scan->sensorPose;
         if (chooseModel(obs, opts, K::laser, {K::laser, K::lidar}) == K::lidar) {
+            if (const std::string why = apertureProblem(*scan); !why.empty())
+                throw std::invalid_argument(why);
             lidarScanToPoints(*scan, opts.lidar, minRange_m, maxRange_m, out.points,
                               out.stats.lidar);
             return true;

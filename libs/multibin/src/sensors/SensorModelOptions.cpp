@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/sensors/SensorModelOptions.h"
 
+#include "multibin/io/NumberText.h"
+
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <algorithm>
@@ -30,6 +32,7 @@ std::map<std::string, T> parseByLabel(StrictConfigSection& s, const std::string&
         if (colon == std::string::npos || colon == 0 || colon + 1 == item.size())
             s.fail(key, "expected LABEL:value, got '" + item + "'");
         const std::string label = item.substr(0, colon);
+        if (out.count(label)) s.fail(key, "label '" + label + "' is given twice");
         out[label] = parse(label, item.substr(colon + 1));
     }
     return out;
@@ -37,9 +40,8 @@ std::map<std::string, T> parseByLabel(StrictConfigSection& s, const std::string&
 
 std::map<std::string, double> parseAgc(StrictConfigSection& s, const std::string& key) {
     return parseByLabel<double>(s, key, [&](const std::string& label, const std::string& value) {
-        char* end = nullptr;
-        const double v = std::strtod(value.c_str(), &end);
-        if (end != value.c_str() + value.size() || !std::isfinite(v))
+        double v = 0;
+        if (!parseFiniteNumber(value, v))
             s.fail(key, "AGC value of '" + label + "' is not a number: '" + value + "'");
         return v;
     });

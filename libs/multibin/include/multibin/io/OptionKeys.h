@@ -43,28 +43,45 @@ struct OptionKey {
 template <class T>
 using OptionNames = std::vector<std::pair<std::string, T>>;
 
+/** The largest magnitude a value in `unit` can have and still mean something physical: lengths
+ * within 1e10 m (map coordinates have a tighter check of their own), times within
+ * four months, angles within 1000 rad, pixels within 1e6, cells within 1e6, per-metre rates within
+ * 1e6, and pure numbers (counts, factors, gains) within 1e9. A rule with no upper bound of its own
+ * gets this one, so every key has a physical range (a 1e308 m cell or a 1e160 m sigma floor is
+ * refused, not mapped into an empty raster). */
+inline double physicalLimit(const char* unit) {
+    const std::string u = unit;
+    if (u == "m") return 1e10;
+    if (u == "s") return 1e7;
+    if (u == "rad") return 1e3;
+    if (u == "px" || u == "cells" || u == "1/m") return 1e6;
+    return 1e9;
+}
+
 /** What a number (or each number of a list) of an option must be: finite, in [lo, hi] (lo
- * excluded if `loExcluded`), and odd if `odd`. */
+ * excluded if `loExcluded`), and odd if `odd`. `physicalHi`: hi is the unit's physical limit
+ * (|value| <= hi), not a bound of the key's own. */
 struct OptionRule {
     double lo = -std::numeric_limits<double>::infinity();
     double hi = std::numeric_limits<double>::infinity();
     bool loExcluded = false;
     bool odd = false;
     const char* unit = "";  //!< shown after the rule, as " (m)"
+    bool physicalHi = false;
 
     bool holds(double v) const {
         if (!std::isfinite(v) || (loExcluded ? !(v > lo) : !(v >= lo)) || !(v <= hi)) return false;
         return !odd || std::fmod(std::abs(v), 2.0) == 1.0;
     }
-    /** "must be positive and finite (m)", "must be from 3 to 15 (cells)", ... */
+    /** "must be positive and finite (m), at most 1e+10 m", "must be from 3 to 15 (cells)", ... */
     std::string text() const {
         std::ostringstream os;
         os << "must be ";
         if (odd) os << "an odd number ";
-        const bool bounded = std::isfinite(hi);
+        const bool bounded = std::isfinite(hi) && !physicalHi;
         if (loExcluded && lo == 0 && !bounded)
             os << "positive and finite";
-        else if (!std::isfinite(lo) && !bounded)
+        else if (!bounded && (!std::isfinite(lo) || lo == -hi))
             os << "finite";
         else if (bounded)
             os << "from " << lo << " to " << hi;
@@ -72,20 +89,24 @@ struct OptionRule {
             os << ">= " << lo << " and finite";
         // "(m)", not "[m]": MRPT's exception wrapper cuts a message at its first ']'.
         if (*unit) os << " (" << unit << ")";
+        if (physicalHi) {
+            os << (lo == -hi ? ", within +-" : ", at most ") << hi;
+            if (*unit) os << " " << unit;
+        }
         return os.str();
     }
 };
-/** Any finite number. */
+/** Any finite number within the unit's physical limit. */
 inline OptionRule finite(const char* unit = "") {
-    return {-OptionRule{}.hi, OptionRule{}.hi, false, false, unit};
+    return {-physicalLimit(unit), physicalLimit(unit), false, false, unit, true};
 }
-/** > 0 and finite. */
+/** > 0, at most the unit's physical limit. */
 inline OptionRule positive(const char* unit = "") {
-    return {0, OptionRule{}.hi, true, false, unit};
+    return {0, physicalLimit(unit), true, false, unit, true};
 }
-/** >= lo and finite. */
+/** >= lo, at most the unit's physical limit. */
 inline OptionRule atLeast(double lo, const char* unit = "") {
-    return {lo, OptionRule{}.hi, false, false, unit};
+    return {lo, physicalLimit(unit), false, false, unit, true};
 }
 /** In [lo, hi]. */
 inline OptionRule between(double lo, double hi, const char* unit = "") {

@@ -1,0 +1,160 @@
+/* Messages, third round (issue 37, kind 6): never empty, never a library's internals without
+ * what was being done, user text (labels, paths) escaped so that it cannot forge a line or
+ * reach the terminal as an escape sequence; inputs that are not regular files (a device, a FIFO)
+ * a one-line error naming the input, within seconds. */
+#include <gtest/gtest.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/obs/CObservationRobotPose.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <new>
+#include <stdexcept>
+#include <string>
+
+#include "multibin/io/ErrorMessage.h"
+#include "reliability_helpers.h"
+
+namespace fs = std::filesystem;
+using namespace reliability;
+
+// What the mapper prints for an exception: in words, with what was being done, never empty.
+TEST(Messages, LibraryInternalsAndEmptyMessagesSayWhatWasBeingDone) {
+    const std::string context = "reading rawlog 'x.rawlog'";
+    const std::string oom = multibin::userMessage(std::bad_alloc(), context);
+    EXPECT_EQ(oom.rfind(context + ": out of memory", 0), 0u) << oom;
+    const std::string len =
+        multibin::userMessage(std::length_error("basic_string::_M_create"), context);
+    EXPECT_EQ(len.rfind(context + ": a size beyond what memory can hold", 0), 0u) << len;
+    const std::string empty = multibin::userMessage(std::runtime_error(""), context);
+    EXPECT_EQ(empty.rfind(context + ": an error without a message", 0), 0u) << empty;
+    // A message that names its input stays as it is.
+    EXPECT_EQ(multibin::userMessage(std::runtime_error("rawlog 'a' is truncated"), context),
+              "rawlog 'a' is truncated");
+}
+
+// User text printed raw: ESC started terminal escape sequences, a newline forged a line.
+TEST(Messages, UserTextIsEscapedWhenPrinted) {
+    EXPECT_EQ(multibin::printableText("LASER\x1b[2J"), "LASER\\x1B[2J");
+    EXPECT_EQ(multibin::printableText("A\nelevation-mapper: error: forged"),
+              "A\\nelevation-mapper: error: forged");
+    EXPECT_EQ(multibin::printableText("cam\x9b"
+                                      "31m"),
+              "cam\\x9B31m");  // 8-bit CSI
+    EXPECT_EQ(multibin::printableText("cam\xc2\x9b"
+                                      "31m"),
+              "cam\\xC2\\x9B31m");  // UTF-8 CSI
+    EXPECT_EQ(multibin::printableText("Kamera \xc3\xa9t\xc3\xa9"), "Kamera \xc3\xa9t\xc3\xa9");
+}
+
+#ifdef ELEVATION_MAPPER_EXE
+namespace {
+struct MapperRun {
+    int exitCode;
+    std::string err;
+};
+/** The mapper on `flag input` (the mock-up for the rest), stopped after 30 s. */
+MapperRun runMapper(const fs::path& dir, const std::string& flag, const std::string& input) {
+    const fs::path src = MULTIBIN_SOURCE_DIR;
+    std::string args = " --config " + (src / "ini" / "mockup.ini").string() + " --rawlog " +
+                       (src / "rawlogs" / "mockup.rawlog").string();
+    const std::string given = flag + " '" + input + "'";
+    if (flag == "--config" || flag == "--rawlog") {
+        const size_t at = args.find(flag);
+        const size_t end = args.find(' ', args.find(' ', at) + 1);
+        args =
+            args.substr(0, at) + given + args.substr(end == std::string::npos ? args.size() : end);
+    } else {
+        args += " " + given;
+    }
+    const std::string cmd = "timeout 30 " + std::string(ELEVATION_MAPPER_EXE) + args +
+                            " --no-plots --out " + (dir / "out").string() + " > /dev/null 2> " +
+                            (dir / "stderr.txt").string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, readAll(dir / "stderr.txt")};
+}
+void expectOneLineNaming(const MapperRun& r, const std::string& what) {
+    EXPECT_EQ(r.exitCode, 1) << r.err;  // 124: timeout's, the mapper blocked
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("error: \n"), std::string::npos) << "an empty message";
+}
+}  // namespace
+
+// A device file gave "error: " and nothing after it; a FIFO blocked the mapper for ever.
+TEST(Messages, InputsThatAreNotRegularFilesAreOneLineErrorsNamingThem) {
+    const fs::path dir = scratchDir("messages_devices");
+    const fs::path fifo = dir / "fifo";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    for (const auto& [flag, input] : {std::pair{"--rawlog", std::string("/dev/zero")},
+                                      {"--rawlog", std::string("/dev/null")},
+                                      {"--rawlog", fifo.string()},
+                                      {"--config", std::string("/dev/zero")},
+                                      {"--config", fifo.string()},
+                                      {"--ground-truth", fifo.string()}}) {
+        SCOPED_TRACE(std::string(flag) + " " + input);
+        expectOneLineNaming(runMapper(dir, flag, input), "'" + input + "' is not a regular file");
+    }
+}
+
+// A label with a newline and terminal escapes, in an error that quotes it: one line, escaped.
+TEST(Messages, ALabelInAnErrorCannotForgeALineOrEscapeTheTerminal) {
+    const fs::path dir = scratchDir("messages_labels");
+    auto pose = mrpt::obs::CObservationRobotPose::Create();
+    pose->sensorLabel = "POSE\x1b[2J\nelevation-mapper: error: forged";
+    pose->pose.mean = mrpt::poses::CPose3D(std::nan(""), 0, 0, 0, 0, 0);
+    mrpt::obs::CSensoryFrame sf;
+    sf.insert(pose);
+    mrpt::io::CMemoryStream mem;
+    auto arch = mrpt::serialization::archiveFrom(mem);
+    arch << sf;
+    const fs::path rawlog = dir / "label.rawlog";
+    std::ofstream(rawlog, std::ios::binary)
+        .write(static_cast<const char*>(mem.getRawBufferData()), mem.getTotalBytesCount());
+    const MapperRun r = runMapper(dir, "--rawlog", rawlog.string());
+    expectOneLineNaming(r, "POSE\\x1B[2J\\nelevation-mapper: error: forged");
+    EXPECT_EQ(r.err.find('\x1b'), std::string::npos) << r.err;
+    // A path with the same text: the same.
+    const fs::path odd = dir / "odd\x1b[31m\nforged.rawlog";
+    std::ofstream(odd) << "not a rawlog";
+    const MapperRun p = runMapper(dir, "--rawlog", odd.string());
+    EXPECT_EQ(p.exitCode, 1) << p.err;
+    EXPECT_EQ(std::count(p.err.begin(), p.err.end(), '\n'), 1) << p.err;
+    EXPECT_EQ(p.err.find('\x1b'), std::string::npos) << p.err;
+}
+#endif
+
+#ifdef ELEVATION_MAPPER_EXE
+// Requests that took minutes (issue 37, kind 8): a profile line to a far point was sampled every
+// half cell along its whole length; an export resolution near the old cap (1e8 samples) took
+// minutes and wrote gigabytes, and failed after the other outputs were written. Both are
+// refused within seconds, before any output.
+TEST(Messages, SlowRequestsAreRefusedBeforeAnyOutput) {
+    const fs::path dir = scratchDir("messages_slow");
+    const fs::path src = MULTIBIN_SOURCE_DIR;
+    const std::string common = " --config " + (src / "ini" / "mockup.ini").string() + " --rawlog " +
+                               (src / "rawlogs" / "mockup.rawlog").string() + " --no-plots --out " +
+                               (dir / "out").string();
+    for (const auto& [extra, what] :
+         {std::pair{std::string(" --ground-truth ") + (src / "rawlogs" / "mockup_gt.asc").string() +
+                        " --profile 0,0,1e9,0",
+                    std::string("--profile")},
+          {std::string(" --export-resolution 0.0004"), std::string("--export-resolution")}}) {
+        SCOPED_TRACE(extra);
+        fs::remove_all(dir / "out");
+        const std::string cmd = "timeout 60 " + std::string(ELEVATION_MAPPER_EXE) + common + extra +
+                                " > /dev/null 2> " + (dir / "stderr.txt").string();
+        const int status = std::system(cmd.c_str());
+        const std::string err = readAll(dir / "stderr.txt");
+        EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << status << " " << err;
+        EXPECT_NE(err.find(what), std::string::npos) << err;
+        EXPECT_FALSE(fs::exists(dir / "out" / "elevation_map.bin")) << "an output was written";
+    }
+}
+#endif
