@@ -8,15 +8,19 @@
 
 namespace multibin {
 
-bool SightLine::set(const BinGrid& grid, const BinGrid::UpdatedCell& u,
-                    const Eigen::Vector3d& sensor_m) {
-    const double cell = grid.cellSize_m();
+bool SightLine::setEnds(const BinGrid& grid, const BinGrid::UpdatedCell& u,
+                        const Eigen::Vector3d& sensor_m) {
     tx_m = grid.cellCenter_m(u.ix);
     ty_m = grid.cellCenter_m(u.iy);
     tz_m = u.maxHeight_m;
     const double dx = sensor_m.x() - tx_m, dy = sensor_m.y() - ty_m;
     length_m = std::sqrt(dx * dx + dy * dy);  // libm hypot is several times slower
-    if (length_m < cell) return false;
+    return !(length_m < grid.cellSize_m());
+}
+
+void SightLine::setWalk(const BinGrid& grid, const Eigen::Vector3d& sensor_m) {
+    const double cell = grid.cellSize_m();
+    const double dx = sensor_m.x() - tx_m, dy = sensor_m.y() - ty_m;
     slope = (sensor_m.z() - tz_m) / length_m;
     inCellRise_m = std::abs(slope) * 0.7072 * cell;  // 0.7072: half a diagonal, rounded up
     ux = dx / length_m;
@@ -38,7 +42,6 @@ bool SightLine::set(const BinGrid& grid, const BinGrid::UpdatedCell& u,
     };
     clipAxis(tx_m, ux, w.ix0, w.nx);
     clipAxis(ty_m, uy, w.iy0, w.ny);
-    return true;
 }
 
 double targetCertainty(const BinGrid& grid, const BinGrid::UpdatedCell& u,

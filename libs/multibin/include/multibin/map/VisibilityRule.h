@@ -64,7 +64,16 @@ struct SightLine {
     double invCell = 0;     //!< 1 / cell [1/m], as BinGrid computes it
 
     /** The line of `u`; false (no ray) if the sensor lies within a cell of its centre. */
-    bool set(const BinGrid& grid, const BinGrid::UpdatedCell& u, const Eigen::Vector3d& sensor_m);
+    bool set(const BinGrid& grid, const BinGrid::UpdatedCell& u, const Eigen::Vector3d& sensor_m) {
+        if (!setEnds(grid, u, sensor_m)) return false;
+        setWalk(grid, sensor_m);
+        return true;
+    }
+    /** set()'s first half: the ends and the length (the fast path's culling needs no more). */
+    bool setEnds(const BinGrid& grid, const BinGrid::UpdatedCell& u,
+                 const Eigen::Vector3d& sensor_m);
+    /** set()'s second half: the slope, direction and extent of the walk. */
+    void setWalk(const BinGrid& grid, const Eigen::Vector3d& sensor_m);
     /** The cell index of a sample's coordinate (as BinGrid::cellIndex, without the clamp where
      * none can apply). */
     int cellOf(const BinGrid& grid, double coord_m) const {
@@ -75,6 +84,30 @@ struct SightLine {
 /** The certainty of the updated cell's surface as the map reports it (CellSurface), 0 if none. */
 double targetCertainty(const BinGrid& grid, const BinGrid::UpdatedCell& u,
                        const BinUpdateParams& binParams);
+
+/** targetCertainty, computed when first asked for (most updated cells edit nothing). Rays never
+ * edit updated cells, so a late look-up gives the value the rule takes first, as long as it is
+ * asked for before the cell's own edit (weakenBinsAboveMeasurements) when that runs. */
+class LazyTargetCertainty {
+public:
+    LazyTargetCertainty(const BinGrid& grid, const BinGrid::UpdatedCell& u,
+                        const BinUpdateParams& binParams)
+        : m_grid(grid), m_u(u), m_binParams(binParams) {}
+    double operator()() {
+        if (!m_known) {
+            m_value = targetCertainty(m_grid, m_u, m_binParams);
+            m_known = true;
+        }
+        return m_value;
+    }
+
+private:
+    const BinGrid& m_grid;
+    const BinGrid::UpdatedCell& m_u;
+    const BinUpdateParams& m_binParams;
+    double m_value = 0;
+    bool m_known = false;
+};
 
 /** The updated cell's own bins above `tz_m` (all it measured now) lose `decrement` each. */
 void weakenBinsAboveMeasurements(BinGrid& grid, const BinGrid::UpdatedCell& u, double tz_m,
