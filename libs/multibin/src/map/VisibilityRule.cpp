@@ -68,7 +68,6 @@ VisibilityStats applyVisibilityRule(BinGrid& grid, const Eigen::Vector3d& sensor
     VisibilityStats stats;
     if (!vis.enabled) return stats;
     const ConflictTest conflicts(vis, binParams);
-    const double step = 0.5 * grid.cellSize_m();
     // A rising ray stops once it clears the highest bin stored anywhere by the margin.
     const double stopHeight_m = grid.maxHeight_m() + vis.margin_m;
     for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
@@ -79,21 +78,13 @@ VisibilityStats applyVisibilityRule(BinGrid& grid, const Eigen::Vector3d& sensor
         SightLine ray;
         if (!ray.set(grid, u, sensor_m)) continue;
         stats.raysCast++;
-        int lastIx = u.ix, lastIy = u.iy;
-        for (double d = step; d < ray.walk_m; d += step) {
-            const double rayZ = ray.tz_m + ray.slope * d;
-            if (ray.slope > 0 && rayZ - ray.inCellRise_m > stopHeight_m) break;
-            const int ix = ray.cellOf(grid, ray.tx_m + ray.ux * d);
-            const int iy = ray.cellOf(grid, ray.ty_m + ray.uy * d);
-            if (ix == lastIx && iy == lastIy) continue;  // one test per cell entered
-            lastIx = ix;
-            lastIy = iy;
-            if (!grid.window().contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
-            stats.cellsVisited++;
-            editOccluder(
-                grid, ix, iy, rayZ + ray.inCellRise_m, conflicts, [target] { return target; },
-                decrement, stats);
-        }
+        forEachCellOnSightLine(grid, ray, u.ix, u.iy, stopHeight_m,
+                               [&](int ix, int iy, double, double rayHigh_m) {
+                                   stats.cellsVisited++;
+                                   editOccluder(
+                                       grid, ix, iy, rayHigh_m, conflicts,
+                                       [target] { return target; }, decrement, stats);
+                               });
     }
     return stats;
 }

@@ -81,6 +81,29 @@ struct SightLine {
     }
 };
 
+/** The cells the rule tests along `ray` from updated cell (startIx, startIy), in walking order,
+ * each once: `visit(ix, iy, d_m, rayHigh_m)` with the sample's distance from the cell and the
+ * line's height there (plus the in-cell rise). Cells outside the window or updated in this cycle
+ * are left out; a rising ray ends where it clears `stopHeight_m`. Which cells a ray crosses,
+ * apart from what the rule does to them. */
+template <class Visit>
+void forEachCellOnSightLine(const BinGrid& grid, const SightLine& ray, int startIx, int startIy,
+                            double stopHeight_m, Visit&& visit) {
+    const double step = 0.5 * grid.cellSize_m();
+    int lastIx = startIx, lastIy = startIy;
+    for (double d = step; d < ray.walk_m; d += step) {  // accumulated: the rule's rounding
+        const double rayZ = ray.tz_m + ray.slope * d;
+        if (ray.slope > 0 && rayZ - ray.inCellRise_m > stopHeight_m) break;
+        const int ix = ray.cellOf(grid, ray.tx_m + ray.ux * d);
+        const int iy = ray.cellOf(grid, ray.ty_m + ray.uy * d);
+        if (ix == lastIx && iy == lastIy) continue;  // one test per cell entered
+        lastIx = ix;
+        lastIy = iy;
+        if (!grid.window().contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
+        visit(ix, iy, d, rayZ + ray.inCellRise_m);
+    }
+}
+
 /** The certainty of the updated cell's surface as the map reports it (CellSurface), 0 if none. */
 double targetCertainty(const BinGrid& grid, const BinGrid::UpdatedCell& u,
                        const BinUpdateParams& binParams);
