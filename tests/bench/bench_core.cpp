@@ -8,6 +8,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -334,13 +335,26 @@ static void BM_DenseFrameOverRocks(benchmark::State& state) {
         }
         return z;
     };
+    // The terrain on a 5 mm raster over [-0.2, 2.2] x [-1.2, 1.2] m, for the lines of sight.
+    constexpr double kRaster_m = 0.005, kX0_m = -0.2, kY0_m = -1.2;
+    constexpr int kRasterN = 480;
+    std::vector<float> raster(size_t(kRasterN) * kRasterN);
+    for (int j = 0; j < kRasterN; j++)
+        for (int i = 0; i < kRasterN; i++)
+            raster[size_t(i + j * kRasterN)] =
+                float(ground(kX0_m + (i + 0.5) * kRaster_m, kY0_m + (j + 0.5) * kRaster_m));
+    auto rasterAt = [&](double x, double y) {
+        const int i = std::clamp(int((x - kX0_m) / kRaster_m), 0, kRasterN - 1);
+        const int j = std::clamp(int((y - kY0_m) / kRaster_m), 0, kRasterN - 1);
+        return double(raster[size_t(i + j * kRasterN)]);
+    };
     const Eigen::Vector3d camera(0.0, 0.0, 0.5);
     auto seen = [&](double x, double y, double z) {  // the line of sight above the terrain
         const double length = std::hypot(x - camera.x(), y - camera.y());
         for (double d = 0.01; d < length - 0.02; d += 0.005) {
             const double f = d / length;
             const double lx = x + (camera.x() - x) * f, ly = y + (camera.y() - y) * f;
-            if (z + (camera.z() - z) * f < ground(lx, ly) - 1e-3) return false;
+            if (z + (camera.z() - z) * f < rasterAt(lx, ly) - 2e-3) return false;
         }
         return true;
     };

@@ -6,6 +6,7 @@
  * sight lines meet in the unedited grid. */
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <random>
@@ -262,6 +263,41 @@ TEST(VisibilityStages, RaysClearTowardsTheSensorOrByTheFanTestMeetNoConflict) {
     EXPECT_GT(clearByRectangle, 100u);
     EXPECT_GT(clearByFan, clearByRectangle);
     EXPECT_GT(walked, 1000u);
+}
+
+TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
+    size_t clear = 0, walk = 0;
+    onRandomScenes(20261131, 25, [&](Scene& s, int id) {
+        const VisibilityParams v;
+        const BinUpdateParams p;
+        const BoundTest bounds{ConflictTest(v, p).minMargin_m()};
+        VisibilityScratch scratch;
+        const Region region = buildRegion(s.grid, s.sensor_m, scratch.regionBound);
+        const TowardsSensor towards =
+            buildTowardsSensor(s.grid, region, s.sensor_m, bounds, scratch.towardsSensor);
+        std::vector<RayState> state;
+        const FanOutcome out =
+            testEnvelope(s.grid, region, towards, s.sensor_m, bounds, scratch, state);
+        if (!out.ran) return;
+        const auto& updated = s.grid.updatedCells();
+        size_t sceneClear = 0;
+        for (size_t i = 0; i < updated.size(); i++) {
+            SightLine ray;
+            ASSERT_EQ(state[i] == RayState::NoRay, !ray.setEnds(s.grid, updated[i], s.sensor_m))
+                << id << " ray " << i;
+            if (state[i] == RayState::Clear) {
+                ASSERT_TRUE(conflictsOnLine(s.grid, updated[i], s.sensor_m, v, p).empty())
+                    << id << " ray " << i;
+                sceneClear++;
+            }
+            walk += state[i] == RayState::Walk;
+        }
+        clear += sceneClear;
+        EXPECT_EQ(out.noWalk, std::count(state.begin(), state.end(), RayState::Walk) == 0) << id;
+    });
+    std::cout << clear << " rays clear by the envelope test, " << walk << " to walk\n";
+    EXPECT_GT(clear, 10000u);
+    EXPECT_GT(walk, 1000u);
 }
 
 TEST(VisibilityStages, ColumnStretchesHoldEveryConflictAndTheirWalkEditsAsTheRule) {

@@ -67,8 +67,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     std::vector<RayState>& state = scratch.rayState;
     state.clear();
     FanOutcome decided;
-    if (fan == RayFan::Test)
-        decided = testFan(grid, region, towards, sensor_m, bounds, scratch, state);
+    decided = fan == RayFan::Test
+                  ? testFan(grid, region, towards, sensor_m, bounds, scratch, state)
+                  : testEnvelope(grid, region, towards, sensor_m, bounds, scratch, state);
     if (decided.noWalk) stats.raysCast += decided.clearRays;
     scratch.sampleAt.assign({0.0, step});
 

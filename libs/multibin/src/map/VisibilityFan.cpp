@@ -19,13 +19,6 @@ constexpr size_t kGroup = 8;  // rays whose steepest slope is tested at once
 constexpr int kUnitShift = 2, kUnitCells = 1 << kUnitShift;
 constexpr int kUnits = BinGrid::kBlockCells / kUnitCells;  // per side of a block
 
-/** A pseudo-angle of the direction (dx, dy) in [0, 4): increasing with the angle from +x,
- * counter-clockwise, one division instead of atan2 (not (0, 0)). */
-double pseudoAngle(double dx, double dy) {
-    if (dy >= 0) return dx >= 0 ? dy / (dx + dy) : 1 - dx / (dy - dx);
-    return dx <= 0 ? 2 - dy / (-dx - dy) : 3 + dx / (dx - dy);
-}
-
 /** Sorts a fan's (key, ray) entries by key. A scan's come in beam order, keys nearly sorted (up
  * or down) from some angle round to it: reversed and rotated to that order, insertion sort
  * finishes in about linear time. Otherwise (a frame's rows) a counting sort on buckets of keys,
@@ -368,38 +361,23 @@ void FanTest::testBlock(int bx, int by) {
     if (m_longestRay_m < nearStep_m) return;  // beyond every ray
     const double cx = (bx + 0.5) * m_block_m, cy = (by + 0.5) * m_block_m;
     // The rays within the block's angle: keys in [lo, hi], which may pass key 0 (the +x
-    // direction) on either side; all of them near the sensor. Keys are exact to far better than
-    // kKeySlack for squares at least kNearSensor_m away.
-    constexpr double kKeySlack = 1e-6, kNearSensor_m = 1e-3;
+    // direction) on either side; all of them near the sensor.
     const size_t nRays = m_s.keys.size();
     size_t ranges[2][2] = {{0, nRays}, {0, 0}};
-    if (std::max(gapX, gapY) >= kNearSensor_m) {
-        const bool acrossZero = x1 > sx && y0 <= sy && sy <= y1;
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (const double x : {x0, x1})
-            for (const double y : {y0, y1}) {
-                double k = pseudoAngle(x - sx, y - sy);
-                if (acrossZero && k < 2) k += 4;
-                lo = std::min(lo, k);
-                hi = std::max(hi, k);
-            }
-        lo -= kKeySlack;
-        hi += kKeySlack;
-        if (hi - lo < 2) {  // less than half a turn, as a square away from the sensor
-            auto first = [&](double k) {
-                return prefix(m_s.keys, [k](double key) { return key < k; });
-            };
-            auto after = [&](double k) {
-                return prefix(m_s.keys, [k](double key) { return !(k < key); });
-            };
-            ranges[0][0] = first(lo);
-            ranges[0][1] = after(hi);
-            if (lo < 0) {  // and from lo + 4 to the end
-                ranges[1][0] = first(lo + 4);
-                ranges[1][1] = nRays;
-            } else if (hi >= 4) {  // and from the start to hi - 4
-                ranges[1][1] = after(hi - 4);
-            }
+    if (double lo, hi; squareKeys(x0, x1, y0, y1, sx, sy, lo, hi)) {
+        auto first = [&](double k) {  // the first ray of key >= k
+            return prefix(m_s.keys, [k](double key) { return key < k; });
+        };
+        auto after = [&](double k) {  // the first ray of key > k
+            return prefix(m_s.keys, [k](double key) { return !(k < key); });
+        };
+        ranges[0][0] = first(lo);
+        ranges[0][1] = after(hi);
+        if (lo < 0) {  // and from lo + 4 to the end
+            ranges[1][0] = first(lo + 4);
+            ranges[1][1] = nRays;
+        } else if (hi >= 4) {  // and from the start to hi - 4
+            ranges[1][1] = after(hi - 4);
         }
     }
     for (const auto& range : ranges)

@@ -16,6 +16,8 @@
  * 5. walkStretches: the rule's samples within those stretches, each cell tested and edited. */
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <utility>
@@ -104,6 +106,38 @@ inline bool restOfRayClear(const TowardsSensor& towards, const BoundTest& bounds
            !bounds.mayConflict(towards.restBound(bx, by), std::min(tz_m, sensorZ_m) - kSlack_m);
 }
 
+/** A pseudo-angle of the direction (dx, dy) in [0, 4): increasing with the angle from +x,
+ * counter-clockwise, one division instead of atan2 (not (0, 0)). */
+inline double pseudoAngle(double dx, double dy) {
+    if (dy >= 0) return dx >= 0 ? dy / (dx + dy) : 1 - dx / (dy - dx);
+    return dx <= 0 ? 2 - dy / (-dx - dy) : 3 + dx / (dx - dy);
+}
+
+/** The pseudo-angles [lo, hi] (hi up to 6: past key 0 the keys continue from 4) within which
+ * every direction from the sensor (sx, sy) to a point of the square [x0, x1] x [y0, y1] lies,
+ * widened by 1e-6 (far above the keys' rounding for squares 1 mm or more from the sensor); false
+ * if the square lies within 1 mm of the sensor or spans half a turn or more (any direction). */
+inline bool squareKeys(double x0, double x1, double y0, double y1, double sx, double sy, double& lo,
+                       double& hi) {
+    constexpr double kKeySlack = 1e-6, kNearSensor_m = 1e-3;
+    const double gapX = std::max({x0 - sx, sx - x1, 0.0});
+    const double gapY = std::max({y0 - sy, sy - y1, 0.0});
+    if (!(std::max(gapX, gapY) >= kNearSensor_m)) return false;
+    const bool acrossZero = x1 > sx && y0 <= sy && sy <= y1;
+    lo = std::numeric_limits<double>::infinity();
+    hi = -lo;
+    for (const double x : {x0, x1})
+        for (const double y : {y0, y1}) {
+            double k = pseudoAngle(x - sx, y - sy);
+            if (acrossZero && k < 2) k += 4;
+            lo = std::min(lo, k);
+            hi = std::max(hi, k);
+        }
+    lo -= kKeySlack;
+    hi += kKeySlack;
+    return hi - lo < 2;  // less than half a turn, as a square away from the sensor
+}
+
 /** Stage 3's decision per updated cell. */
 enum class RayState : uint8_t { Walk, Clear, NoRay };
 
@@ -113,6 +147,30 @@ struct FanRay {
     int ix, iy;
     uint32_t updatedIndex;
     bool clear;  // no square it passes over can conflict (so far)
+};
+
+/** A ray of the envelope test: its key (pseudoAngle from the sensor), length, slope (at least
+ * 0) and the least height its samples can have, B (VisibilityEnvelope.cpp). */
+struct EnvRay {
+    double key, length, slope, low_m;
+    uint32_t updatedIndex;
+};
+
+/** A set of rays summed up: their largest slope (at least 0) and least B. Each of them passes
+ * over a square whose farthest point lies far_m from the sensor no lower than lowest_m(). */
+struct RayEnvelope {
+    double slope = 0;
+    double low_m = std::numeric_limits<double>::infinity();
+    void add(double s, double b) {
+        slope = std::max(slope, s);
+        low_m = std::min(low_m, b);
+    }
+    void add(const RayEnvelope& e) { add(e.slope, e.low_m); }
+    /** 1e-9 m and 1e-15 of the drop cover the rounding of the walk's heights. */
+    double lowest_m(double sensorZ_m, double far_m) const {
+        const double drop_m = slope * far_m;
+        return std::max(sensorZ_m - drop_m - 1e-15 * drop_m, low_m) - 1e-9;
+    }
 };
 
 /** The arrays of the stages, kept between calls on each thread (a frame's thousands of rays
@@ -127,6 +185,9 @@ struct VisibilityScratch {
     std::vector<int32_t> unitTableOf;
     std::vector<std::pair<double, double>> stretches;
     std::vector<double> sampleAt;
+    std::vector<EnvRay> envRays, envSorted;
+    std::vector<RayEnvelope> envGroups;
+    std::vector<double> hotNear;
 };
 
 /** Stage 3's outcome: `state` (one per updated cell) when it ran. */
@@ -144,6 +205,15 @@ struct FanOutcome {
 FanOutcome testFan(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
                    const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
                    VisibilityScratch& scratch, std::vector<RayState>& state);
+
+/** Stage 3 for a camera frame's thousands of rays (RayFan::Skip): the rays' lower envelope by
+ * direction (sectors of pseudo-angle, about one ray each), tested per block of the region, then
+ * per cell of the blocks it does not settle, against the rays within the cell's directions long
+ * enough to reach it. A ray is clear unless its sector holds a cell, within its reach, that may
+ * hold a bin above the envelope there. Same preconditions and outcome as testFan. */
+FanOutcome testEnvelope(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
+                        const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
+                        VisibilityScratch& scratch, std::vector<RayState>& state);
 
 /** Stage 4: the stretches [from, to] of distance from the target, in walking order, over block
  * columns (rows if the ray runs more along y) that may hold a bin conflicting with the ray;
