@@ -14,8 +14,11 @@
 #include "multibin/map/VisibilityConstraint.h"
 #include "multibin/map/VisibilityRule.h"
 #include "multibin/map/VisibilityStages.h"
+#include "visibility_test_util.h"
 
 using namespace multibin;
+using multibin::test::binsOf;
+using multibin::test::pointAt;
 using namespace multibin::visibility;
 
 namespace {
@@ -23,13 +26,6 @@ namespace {
 enum class Kind { Steps, Overhangs, Posts, Grazing, DenseFrame, SparseLidar, Floor };
 constexpr Kind kKinds[] = {Kind::Steps,      Kind::Overhangs,   Kind::Posts, Kind::Grazing,
                            Kind::DenseFrame, Kind::SparseLidar, Kind::Floor};
-
-PointWithCov pointAt(double x, double y, double z, double sigmaZ_m) {
-    PointWithCov p;
-    p.point_m = Eigen::Vector3f(float(x), float(y), float(z));
-    p.cov_m2 = {1e-6f, 0, 0, 1e-6f, 0, float(sigmaZ_m * sigmaZ_m)};
-    return p;
-}
 
 struct Scene {
     BinGrid grid;
@@ -120,24 +116,6 @@ Scene randomScene(std::mt19937& rng, Kind kind) {
     return s;
 }
 
-/** Every bin of the window, cell by cell in chain order, as raw bytes. */
-std::vector<std::array<uint32_t, 5>> binsOf(const BinGrid& g) {
-    std::vector<std::array<uint32_t, 5>> out;
-    const CellWindow& w = g.window();
-    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
-            g.forEachBin(ix, iy, [&](const Bin& b) {
-                std::array<uint32_t, 5> r;
-                std::memcpy(&r[0], &b.height_m, 4);
-                std::memcpy(&r[1], &b.variance_m2, 4);
-                std::memcpy(&r[2], &b.certainty, 4);
-                r[3] = b.pointCount;
-                r[4] = uint32_t(uint16_t(b.index)) | (uint32_t(ix - w.ix0) << 16);
-                out.push_back(r);
-            });
-    return out;
-}
-
 /** The distances from the updated cell at which the rule's sight line meets a conflicting bin in
  * the unedited grid (empty: its ray edits nothing). */
 std::vector<double> conflictsOnLine(const BinGrid& g, const BinGrid::UpdatedCell& u,
@@ -164,6 +142,22 @@ bool ownBinsConflict(const BinGrid& g, const BinGrid::UpdatedCell& u, const Visi
     g.forEachBin(u.ix, u.iy, [&](const Bin& b) { any |= conflicts(b, u.maxHeight_m); });
     return any;
 }
+
+/** Stages 1 and 2 of a scene's update, with the default parameters, as the constraint builds
+ * them. */
+struct FirstStages {
+    const VisibilityParams v;
+    const BinUpdateParams p;
+    const ConflictTest conflicts{v, p};
+    const BoundTest bounds{conflicts.minMargin_m()};
+    VisibilityScratch scratch;
+    const Region region;
+    const TowardsSensor towards;
+    explicit FirstStages(const Scene& s)
+        : region(buildRegion(s.grid, s.sensor_m, scratch.regionBound)),
+          towards(buildTowardsSensor(s.grid, region, s.sensor_m, bounds, scratch.towardsSensor)) {}
+    FirstStages(const FirstStages&) = delete;  // towards points into region
+};
 
 /** Runs `check(scene, kind)` on `perKind` scenes of each kind. */
 template <class Check>
@@ -229,13 +223,13 @@ TEST(VisibilityStages, RegionRulesOutOnlyUpdatesWithoutAnyConflict) {
 TEST(VisibilityStages, RaysClearTowardsTheSensorOrByTheFanTestMeetNoConflict) {
     size_t clearByRectangle = 0, clearByFan = 0, walked = 0;
     onRandomScenes(20261129, 25, [&](Scene& s, int id) {
-        const VisibilityParams v;
-        const BinUpdateParams p;
-        const BoundTest bounds{ConflictTest(v, p).minMargin_m()};
-        VisibilityScratch scratch;
-        const Region region = buildRegion(s.grid, s.sensor_m, scratch.regionBound);
-        const TowardsSensor towards =
-            buildTowardsSensor(s.grid, region, s.sensor_m, bounds, scratch.towardsSensor);
+        FirstStages st(s);
+        const VisibilityParams& v = st.v;
+        const BinUpdateParams& p = st.p;
+        const BoundTest& bounds = st.bounds;
+        VisibilityScratch& scratch = st.scratch;
+        const Region& region = st.region;
+        const TowardsSensor& towards = st.towards;
         std::vector<RayState> state;
         const FanOutcome fan = testFan(s.grid, region, towards, s.sensor_m, bounds, scratch, state);
         const auto& updated = s.grid.updatedCells();
@@ -268,13 +262,13 @@ TEST(VisibilityStages, RaysClearTowardsTheSensorOrByTheFanTestMeetNoConflict) {
 TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
     size_t clear = 0, walk = 0;
     onRandomScenes(20261131, 25, [&](Scene& s, int id) {
-        const VisibilityParams v;
-        const BinUpdateParams p;
-        const BoundTest bounds{ConflictTest(v, p).minMargin_m()};
-        VisibilityScratch scratch;
-        const Region region = buildRegion(s.grid, s.sensor_m, scratch.regionBound);
-        const TowardsSensor towards =
-            buildTowardsSensor(s.grid, region, s.sensor_m, bounds, scratch.towardsSensor);
+        FirstStages st(s);
+        const VisibilityParams& v = st.v;
+        const BinUpdateParams& p = st.p;
+        const BoundTest& bounds = st.bounds;
+        VisibilityScratch& scratch = st.scratch;
+        const Region& region = st.region;
+        const TowardsSensor& towards = st.towards;
         std::vector<RayState> state;
         const FanOutcome out =
             testEnvelope(s.grid, region, towards, s.sensor_m, bounds, scratch, state);
@@ -303,14 +297,14 @@ TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
 TEST(VisibilityStages, ColumnStretchesHoldEveryConflictAndTheirWalkEditsAsTheRule) {
     size_t conflicts = 0, rays = 0;
     onRandomScenes(20261130, 25, [&](Scene& s, int id) {
-        const VisibilityParams v;
-        const BinUpdateParams p;
-        const ConflictTest conflictTest(v, p);
-        const BoundTest bounds{conflictTest.minMargin_m()};
-        VisibilityScratch scratch;
-        const Region region = buildRegion(s.grid, s.sensor_m, scratch.regionBound);
-        const TowardsSensor towards =
-            buildTowardsSensor(s.grid, region, s.sensor_m, bounds, scratch.towardsSensor);
+        FirstStages st(s);
+        const VisibilityParams& v = st.v;
+        const BinUpdateParams& p = st.p;
+        const ConflictTest& conflictTest = st.conflicts;
+        const BoundTest& bounds = st.bounds;
+        VisibilityScratch& scratch = st.scratch;
+        const Region& region = st.region;
+        const TowardsSensor& towards = st.towards;
         const double stopHeight_m =
             std::min(s.grid.maxHeight_m(), BoundTest::tolerant_m(region.maxBound_m)) + v.margin_m;
         const double step = 0.5 * s.grid.cellSize_m();

@@ -20,7 +20,7 @@
 namespace multibin::visibility {
 
 namespace {
-constexpr double kMaxCoordinate_m = 1e5, kMaxHeight_m = 1e4, kHeightSlack_m = 1e-9;
+constexpr double kHeightSlack_m = 1e-9;
 constexpr unsigned kGroupShift = 6;  // sectors per group: 64
 
 /** The envelope's state for one update: the rays by sector of direction, and per sector the
@@ -67,36 +67,19 @@ private:
     RayEnvelope m_all;
 };
 
-/** The rays, as FanTest::collectRays decides the short ones and those clear towards the sensor;
- * the others' (key, length, slope, B) in m_s.envRays. */
+/** The rays firstLook leaves to test: their key, length, slope and B in m_s.envRays. Returns
+ * the rays firstLook decided. */
 size_t EnvelopeTest::collectRays(std::vector<RayState>& state, size_t& raysClear) {
-    const std::vector<BinGrid::UpdatedCell>& updated = m_grid.updatedCells();
-    state.assign(updated.size(), RayState::Walk);
     m_s.envRays.clear();
     const double sz = m_sensor_m.z();
-    size_t decided = 0;
-    for (size_t i = 0; i < updated.size(); i++) {
-        const BinGrid::UpdatedCell& u = updated[i];
+    auto add = [&](size_t i, const BinGrid::UpdatedCell& u, double dx, double dy, double length) {
         const double tz = u.maxHeight_m;
-        const double dx = m_sensor_m.x() - m_grid.cellCenter_m(u.ix);
-        const double dy = m_sensor_m.y() - m_grid.cellCenter_m(u.iy);
-        const double length = std::sqrt(dx * dx + dy * dy);  // as SightLine's
-        if (length < m_cell) {
-            state[i] = RayState::NoRay;
-            decided++;
-        } else if (restOfRayClear(m_towards, m_bounds, BinGrid::blockOf(u.ix),
-                                  BinGrid::blockOf(u.iy), tz, sz)) {
-            state[i] = RayState::Clear;
-            decided++;
-            raysClear++;
-        } else if (std::abs(tz) < kMaxHeight_m) {  // beyond: left to the walk
-            const double slope = (sz - tz) / length;
-            const double low_m = slope >= 0 ? tz + slope * m_step : sz;
-            m_s.envRays.push_back(
-                {pseudoAngle(-dx, -dy), length, std::max(slope, 0.0), low_m, uint32_t(i)});
-        }
-    }
-    return decided;
+        const double slope = (sz - tz) / length;
+        const double low_m = slope >= 0 ? tz + slope * m_step : sz;
+        m_s.envRays.push_back(
+            {pseudoAngle(-dx, -dy), length, std::max(slope, 0.0), low_m, uint32_t(i)});
+    };
+    return firstLook(m_grid, m_towards, m_bounds, m_sensor_m, state, raysClear, add);
 }
 
 /** The rays sorted by sector (a counting sort; about one ray per sector), and each group of
@@ -239,11 +222,7 @@ FanOutcome EnvelopeTest::run(std::vector<RayState>& state) {
         state[r.updatedIndex] = walk ? RayState::Walk : RayState::Clear;
         clear += !walk;
     }
-    FanOutcome out;
-    out.ran = true;
-    out.noWalk = decided + clear == state.size();
-    out.clearRays = raysClear + clear;
-    return out;
+    return FanOutcome::after(state.size(), decided, raysClear, clear);
 }
 }  // namespace
 
@@ -251,14 +230,7 @@ FanOutcome testEnvelope(const BinGrid& grid, const Region& region, const Towards
                         const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
                         VisibilityScratch& scratch, std::vector<RayState>& state) {
     state.clear();
-    const double block_m = BinGrid::kBlockCells * grid.cellSize_m();
-    const double regionExtent_m = std::max(
-        {std::abs(sensor_m.x()), std::abs(sensor_m.y()), std::abs(double(region.x0)) * block_m,
-         std::abs(double(region.y0)) * block_m, std::abs(double(region.x0) + region.nx) * block_m,
-         std::abs(double(region.y0) + region.ny) * block_m});
-    if (region.empty() || !(std::abs(sensor_m.z()) < kMaxHeight_m) ||
-        !(regionExtent_m < kMaxCoordinate_m))
-        return FanOutcome{};
+    if (!rayTestsApply(grid, region, sensor_m)) return FanOutcome{};
     return EnvelopeTest(grid, region, towards, sensor_m, bounds, scratch).run(state);
 }
 

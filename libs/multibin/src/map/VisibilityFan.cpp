@@ -14,7 +14,7 @@
 namespace multibin::visibility {
 
 namespace {
-constexpr double kMaxCoordinate_m = 1e5, kMaxHeight_m = 1e4, kHeightSlack_m = 1e-9;
+constexpr double kHeightSlack_m = 1e-9;
 constexpr size_t kGroup = 8;  // rays whose steepest slope is tested at once
 constexpr int kUnitShift = 2, kUnitCells = 1 << kUnitShift;
 constexpr int kUnits = BinGrid::kBlockCells / kUnitCells;  // per side of a block
@@ -120,42 +120,24 @@ private:
 };
 
 /** The rays (in the order of the updated cells) and their keys: pseudoAngle from the sensor.
- * Rays shorter than a cell, or clear by the rectangle towards the sensor, are decided here;
- * returns their number. */
+ * Returns the rays firstLook decided. */
 size_t FanTest::collectRays(std::vector<RayState>& state, size_t& raysClear) {
-    const std::vector<BinGrid::UpdatedCell>& updated = m_grid.updatedCells();
     m_s.rays.clear();
     m_s.fan.clear();
-    state.assign(updated.size(), RayState::Walk);
     m_lowestRay_m = m_sensor_m.z();
-    size_t decided = 0;
-    for (size_t i = 0; i < updated.size(); i++) {
-        const BinGrid::UpdatedCell& u = updated[i];
+    auto add = [&](size_t i, const BinGrid::UpdatedCell& u, double dx, double dy, double length) {
         const double tz = u.maxHeight_m;
-        const double tx = m_grid.cellCenter_m(u.ix), ty = m_grid.cellCenter_m(u.iy);
-        const double dx = m_sensor_m.x() - tx, dy = m_sensor_m.y() - ty;
-        const double length = std::sqrt(dx * dx + dy * dy);  // as SightLine's
-        if (length < m_cell) {
-            state[i] = RayState::NoRay;
-            decided++;
-        } else if (restOfRayClear(m_towards, m_bounds, BinGrid::blockOf(u.ix),
-                                  BinGrid::blockOf(u.iy), tz, m_sensor_m.z())) {
-            state[i] = RayState::Clear;  // as the walk's own test
-            decided++;
-            raysClear++;
-        } else if (std::abs(tz) < kMaxHeight_m) {  // beyond: left to the walk
-            m_s.fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(m_s.rays.size()));
-            m_lowestRay_m = std::min(m_lowestRay_m, tz);
-            // One division: the tests allow far more than its rounding.
-            const double invLength = 1.0 / length;
-            const double slope = (m_sensor_m.z() - tz) * invLength, ux = dx * invLength,
-                         uy = dy * invLength;
-            m_s.rays.push_back({tx, ty, ux, uy, std::abs(ux) + std::abs(uy), length, slope,
-                                std::abs(slope) * 0.7072 * m_cell, tz, u.ix, u.iy, uint32_t(i),
-                                true});
-        }
-    }
-    return decided;
+        m_s.fan.emplace_back(pseudoAngle(-dx, -dy), uint32_t(m_s.rays.size()));
+        m_lowestRay_m = std::min(m_lowestRay_m, tz);
+        // One division: the tests allow far more than its rounding.
+        const double invLength = 1.0 / length;
+        const double slope = (m_sensor_m.z() - tz) * invLength, ux = dx * invLength,
+                     uy = dy * invLength;
+        m_s.rays.push_back({m_grid.cellCenter_m(u.ix), m_grid.cellCenter_m(u.iy), ux, uy,
+                            std::abs(ux) + std::abs(uy), length, slope,
+                            std::abs(slope) * 0.7072 * m_cell, tz, u.ix, u.iy, uint32_t(i), true});
+    };
+    return firstLook(m_grid, m_towards, m_bounds, m_sensor_m, state, raysClear, add);
 }
 
 /** The keys, lengths and "fast slopes" (the slope, or +infinity where the slope test does not
@@ -409,7 +391,6 @@ void FanTest::testBlock(int bx, int by) {
 }
 
 FanOutcome FanTest::run(std::vector<RayState>& state) {
-    FanOutcome out;
     size_t raysClear = 0;
     const size_t decided = collectRays(state, raysClear);
     orderByKey();
@@ -422,11 +403,8 @@ FanOutcome FanTest::run(std::vector<RayState>& state) {
         state[r.updatedIndex] = r.clear ? RayState::Clear : RayState::Walk;
         fanClear += r.clear;
     }
-    // The rays left out of the fan (heights beyond kMaxHeight_m) are walked.
-    out.ran = true;
-    out.noWalk = decided + fanClear == state.size();
-    out.clearRays = raysClear + fanClear;
-    return out;
+    // The rays left out of the fan (heights beyond kMaxRayHeight_m) are walked.
+    return FanOutcome::after(state.size(), decided, raysClear, fanClear);
 }
 }  // namespace
 
@@ -434,14 +412,7 @@ FanOutcome testFan(const BinGrid& grid, const Region& region, const TowardsSenso
                    const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
                    VisibilityScratch& scratch, std::vector<RayState>& state) {
     state.clear();
-    const double block_m = BinGrid::kBlockCells * grid.cellSize_m();
-    const double regionExtent_m = std::max(
-        {std::abs(sensor_m.x()), std::abs(sensor_m.y()), std::abs(double(region.x0)) * block_m,
-         std::abs(double(region.y0)) * block_m, std::abs(double(region.x0) + region.nx) * block_m,
-         std::abs(double(region.y0) + region.ny) * block_m});
-    if (region.empty() || !(std::abs(sensor_m.z()) < kMaxHeight_m) ||
-        !(regionExtent_m < kMaxCoordinate_m))
-        return FanOutcome{};
+    if (!rayTestsApply(grid, region, sensor_m)) return FanOutcome{};
     return FanTest(grid, region, towards, sensor_m, bounds, scratch).run(state);
 }
 

@@ -105,4 +105,14 @@ TowardsSensor buildTowardsSensor(const BinGrid& grid, const Region& region,
     return towards;
 }
 
+bool rayTestsApply(const BinGrid& grid, const Region& region, const Eigen::Vector3d& sensor_m) {
+    const double block_m = BinGrid::kBlockCells * grid.cellSize_m();
+    const double regionExtent_m = std::max(
+        {std::abs(sensor_m.x()), std::abs(sensor_m.y()), std::abs(double(region.x0)) * block_m,
+         std::abs(double(region.y0)) * block_m, std::abs(double(region.x0) + region.nx) * block_m,
+         std::abs(double(region.y0) + region.ny) * block_m});
+    return !region.empty() && std::abs(sensor_m.z()) < kMaxRayHeight_m &&
+           regionExtent_m < kMaxCoordinate_m;
+}
+
 }  // namespace multibin::visibility

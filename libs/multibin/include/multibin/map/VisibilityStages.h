@@ -190,11 +190,53 @@ struct VisibilityScratch {
     std::vector<double> hotNear;
 };
 
+/** Stage 3 runs on sane extents only: heights below kMaxRayHeight_m and coordinates below
+ * kMaxCoordinate_m, where its tests' slack (1e-9 m) covers the rounding of the walk's heights. */
+constexpr double kMaxRayHeight_m = 1e4, kMaxCoordinate_m = 1e5;
+/** Whether stage 3 can run on this update (a region of sane extent, a sane sensor height). */
+bool rayTestsApply(const BinGrid& grid, const Region& region, const Eigen::Vector3d& sensor_m);
+
+/** Stage 3's first look at every updated cell's ray, the same for both tests: shorter than a
+ * cell (NoRay), clear by the rectangle towards the sensor (Clear), or passed to
+ * `test(i, u, dx, dy, length_m)` (offsets to the sensor) if below kMaxRayHeight_m; the others stay
+ * Walk. Returns the rays decided; `clear` counts the Clear ones. */
+template <class Test>
+size_t firstLook(const BinGrid& grid, const TowardsSensor& towards, const BoundTest& bounds,
+                 const Eigen::Vector3d& sensor_m, std::vector<RayState>& state, size_t& clear,
+                 Test&& test) {
+    const std::vector<BinGrid::UpdatedCell>& updated = grid.updatedCells();
+    state.assign(updated.size(), RayState::Walk);
+    size_t decided = 0;
+    for (size_t i = 0; i < updated.size(); i++) {
+        const BinGrid::UpdatedCell& u = updated[i];
+        const double dx = sensor_m.x() - grid.cellCenter_m(u.ix);
+        const double dy = sensor_m.y() - grid.cellCenter_m(u.iy);
+        const double length = std::sqrt(dx * dx + dy * dy);  // as SightLine's
+        if (length < grid.cellSize_m()) {
+            state[i] = RayState::NoRay;
+            decided++;
+        } else if (restOfRayClear(towards, bounds, BinGrid::blockOf(u.ix), BinGrid::blockOf(u.iy),
+                                  u.maxHeight_m, sensor_m.z())) {
+            state[i] = RayState::Clear;
+            decided++;
+            clear++;
+        } else if (std::abs(u.maxHeight_m) < kMaxRayHeight_m) {
+            test(i, u, dx, dy, length);
+        }
+    }
+    return decided;
+}
+
 /** Stage 3's outcome: `state` (one per updated cell) when it ran. */
 struct FanOutcome {
     bool ran = false;
     bool noWalk = false;   //!< every ray decided and none to walk
     size_t clearRays = 0;  //!< rays proven clear (counted as cast)
+    /** After a test of `rays` rays: `decided` settled by firstLook, `clearFirst` of them clear,
+     * and `clearByTest` proven clear by the test. */
+    static FanOutcome after(size_t rays, size_t decided, size_t clearFirst, size_t clearByTest) {
+        return {true, decided + clearByTest == rays, clearFirst + clearByTest};
+    }
 };
 /** Stage 3: the fan of rays at once (every ray starts at the sensor). A ray is proven clear when
  * nothing it passes over can hold a bin above it by the smallest conflict margin: each block high
