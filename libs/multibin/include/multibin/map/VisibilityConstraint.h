@@ -23,14 +23,15 @@ namespace multibin {
  * Heights can therefore go down as well as up. The bins edited are exactly those of the rule
  * (applyVisibilityRule, VisibilityRule.h: every ray sampled every half cell); this fast path
  * rules out, from the grid's block and cell height bounds, the places where no bin can conflict,
- * in five stages (VisibilityStages.h): the update's region, the rectangle towards the sensor, the
- * fan of rays against the blocks, a ray's block columns, and the rule's samples over the columns
- * left. The cost grows with the distinct updated cells, not with the points, and with the relief
- * near the lines of sight (doc/visibility.md). */
-/** How the updated cells' lines of sight are tested before any walk: the fan test (a scan's
- * rays: laser, lidar), or the walk's own tests alone (a camera frame's thousands of rays over
- * rough ground, where ordering and testing the fan measured slower than the walks it saves).
- * The bins edited are the same either way. */
+ * in five stages (VisibilityStages.h): the update's region, the rectangle towards the sensor, a
+ * test of all the rays at once (the fan or the envelope test, below), a ray's block columns, and
+ * the rule's samples over the columns left. The cost grows with the distinct updated cells, not
+ * with the points, and with the relief near the lines of sight (doc/visibility.md). */
+/** How the updated cells' lines of sight are tested before any walk: the fan test, each ray
+ * against the blocks within its angle (a scan's few hundred rays: laser, lidar), or the envelope
+ * test, the rays' lower envelope by direction against the cells near them (a camera frame's
+ * thousands of rays, for which ordering and testing the fan measured slower than the walks it
+ * saves). The bins edited are the same either way. */
 enum class RayFan { Test, Skip };
 
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
