@@ -66,10 +66,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
         buildTowardsSensor(grid, region, sensor_m, bounds, scratch.towardsSensor);
     std::vector<RayState>& state = scratch.rayState;
     state.clear();
-    FanOutcome decided;
-    decided = fan == RayFan::Test
-                  ? testFan(grid, region, towards, sensor_m, bounds, scratch, state)
-                  : testEnvelope(grid, region, towards, sensor_m, bounds, scratch, state);
+    const FanOutcome decided =
+        fan == RayFan::Test ? testFan(grid, region, towards, sensor_m, bounds, scratch, state)
+                            : testEnvelope(grid, region, towards, sensor_m, bounds, scratch, state);
     if (decided.noWalk) stats.raysCast += decided.clearRays;
     scratch.sampleAt.assign({0.0, step});
 

@@ -149,11 +149,10 @@ RayEnvelope EnvelopeTest::rayEnvelope(double lo, double hi, bool all, double nea
     return e;
 }
 
-/** Cell (ix, iy), whose bound lies above its block's envelope: against the rays within its own
- * directions and long enough to reach it; if they may meet a conflicting bin there, their
- * sectors are hot from its nearest distance on. */
+/** Cell (ix, iy), not updated in this cycle, whose bound lies above its block's envelope: against
+ * the rays within its own directions and long enough to reach it; if they may meet a conflicting
+ * bin there, their sectors are hot from its nearest distance on. */
 void EnvelopeTest::testCell(int ix, int iy, float bound_m) {
-    if (m_grid.updatedThisCycle(ix, iy)) return;  // the rule skips updated cells
     const double sx = m_sensor_m.x(), sy = m_sensor_m.y();
     const double x0 = ix * m_cell - kSlack_m, x1 = (ix + 1) * m_cell + kSlack_m;
     const double y0 = iy * m_cell - kSlack_m, y1 = (iy + 1) * m_cell + kSlack_m;
@@ -181,8 +180,9 @@ void EnvelopeTest::testCell(int ix, int iy, float bound_m) {
 /** Block (bx, by) of the region against the envelope of the rays within its directions; where
  * it may hold a bin above it, its cells that may. */
 void EnvelopeTest::testBlock(int bx, int by) {
-    const unsigned slot = unsigned(bx - m_region.x0) + unsigned(by - m_region.y0) * m_region.nx;
-    const float bound_m = m_region.bound_m[slot];
+    const unsigned blockSlot =
+        unsigned(bx - m_region.x0) + unsigned(by - m_region.y0) * m_region.nx;
+    const float bound_m = m_region.bound_m[blockSlot];
     const double sz = m_sensor_m.z();
     if (!m_bounds.mayConflict(bound_m, m_all.low_m - kHeightSlack_m)) return;  // below every ray
     const double block_m = BinGrid::kBlockCells * m_cell;
@@ -202,10 +202,14 @@ void EnvelopeTest::testBlock(int bx, int by) {
     const int ixHi = std::min((bx + 1) * BinGrid::kBlockCells, w.ix0 + w.nx);
     const int iyLo = std::max(by * BinGrid::kBlockCells, w.iy0);
     const int iyHi = std::min((by + 1) * BinGrid::kBlockCells, w.iy0 + w.ny);
+    const VisibilityIndex& index = m_grid.visibilityIndex();
     for (int iy = iyLo; iy < iyHi; iy++)
         for (int ix = ixLo; ix < ixHi; ix++) {
-            const float cellBound_m = m_grid.cellMaxHeight_m(ix, iy);
-            if (m_bounds.mayConflict(cellBound_m, blockLow_m)) testCell(ix, iy, cellBound_m);
+            const size_t slot = m_grid.store().slot(ix, iy);  // inside the window
+            const float cellBound_m = index.cellMaxHeight_m(slot);
+            // The rule skips the cells updated in this cycle.
+            if (m_bounds.mayConflict(cellBound_m, blockLow_m) && !index.updatedThisCycle(slot))
+                testCell(ix, iy, cellBound_m);
         }
 }
 
