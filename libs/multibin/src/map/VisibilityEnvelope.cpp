@@ -22,6 +22,7 @@ namespace multibin::visibility {
 namespace {
 constexpr double kHeightSlack_m = 1e-9;
 constexpr unsigned kGroupShift = 6;  // sectors per group: 64
+constexpr unsigned kRings = 32;      // length classes of a group's rays, a block wide each
 
 /** The envelope's state for one update: the rays by sector of direction, and per sector the
  * nearest distance of a cell that may conflict with the rays there. */
@@ -50,7 +51,10 @@ private:
     /** Calls f(first, last) for the sector ranges of keys [lo, hi] (one or two: past key 4). */
     template <class F>
     void forSectors(double lo, double hi, F&& f) const;
-    RayEnvelope groupEnvelope(double lo, double hi, bool all) const;
+    unsigned ringOf(double length_m) const {
+        return unsigned(std::min(std::max(length_m, 0.0) * m_invRing, double(kRings - 1)));
+    }
+    RayEnvelope groupEnvelope(double lo, double hi, bool all, double nearStep_m) const;
     RayEnvelope rayEnvelope(double lo, double hi, bool all, double nearStep_m) const;
     void testCell(int ix, int iy, float bound_m);
     void testBlock(int bx, int by);
@@ -64,7 +68,9 @@ private:
     const double m_cell, m_step;
     unsigned m_sectors = 1;
     double m_keyToSector = 0;
+    double m_invRing = 0;  // 1 / the rings' width [1/m]
     RayEnvelope m_all;
+    RayEnvelope m_allRings[kRings];
 };
 
 /** The rays firstLook leaves to test: their key, length, slope and B in m_s.envRays. Returns
@@ -97,12 +103,22 @@ void EnvelopeTest::bySector() {
     for (const EnvRay& r : m_s.envRays) m_s.envSorted[start[sectorOf(r.key)]++] = r;
     for (unsigned k = m_sectors; k > 0; k--) start[k] = start[k - 1];  // back to the starts
     start[0] = 0;
-    m_s.envGroups.assign(m_sectors >> kGroupShift, RayEnvelope{});
+    // Per group and ring r: the rays at least r ring widths long (a ray's ring and those below).
+    m_invRing = 1.0 / (BinGrid::kBlockCells * m_cell);
+    const size_t groups = m_sectors >> kGroupShift;
+    m_s.envGroups.assign(groups * kRings, RayEnvelope{});
     m_all = RayEnvelope{};
+    for (RayEnvelope& e : m_allRings) e = RayEnvelope{};
     for (const EnvRay& r : m_s.envSorted) {
-        m_s.envGroups[sectorOf(r.key) >> kGroupShift].add(r.slope, r.low_m);
+        const unsigned ring = ringOf(r.length);
+        m_s.envGroups[(sectorOf(r.key) >> kGroupShift) * kRings + ring].add(r.slope, r.low_m);
+        m_allRings[ring].add(r.slope, r.low_m);
         m_all.add(r.slope, r.low_m);
     }
+    for (size_t g = 0; g < groups; g++)
+        for (unsigned ring = kRings - 1; ring > 0; ring--)
+            m_s.envGroups[g * kRings + ring - 1].add(m_s.envGroups[g * kRings + ring]);
+    for (unsigned ring = kRings - 1; ring > 0; ring--) m_allRings[ring - 1].add(m_allRings[ring]);
     m_s.hotNear.assign(m_sectors, std::numeric_limits<double>::infinity());
 }
 
@@ -119,14 +135,15 @@ void EnvelopeTest::forSectors(double lo, double hi, F&& f) const {
     }
 }
 
-/** The envelope of the rays within keys [lo, hi] (every ray if `all`), by whole groups of
- * sectors: a superset, for a block's many. */
-RayEnvelope EnvelopeTest::groupEnvelope(double lo, double hi, bool all) const {
-    if (all) return m_all;
+/** The envelope of the rays within keys [lo, hi] (every ray if `all`) and at least nearStep_m
+ * long, by whole groups of sectors and rings of length: a superset, cheap. */
+RayEnvelope EnvelopeTest::groupEnvelope(double lo, double hi, bool all, double nearStep_m) const {
+    const unsigned ring = ringOf(nearStep_m);  // a ray at least nearStep_m long is in it or above
+    if (all) return m_allRings[ring];
     RayEnvelope e;
     forSectors(lo, hi, [&](unsigned first, unsigned last) {
         for (unsigned g = first >> kGroupShift; g <= last >> kGroupShift; g++)
-            e.add(m_s.envGroups[g]);
+            e.add(m_s.envGroups[g * kRings + ring]);
     });
     return e;
 }
@@ -166,6 +183,10 @@ void EnvelopeTest::testCell(int ix, int iy, float bound_m) {
     const double nearStep_m = near_m + m_step - 1e-9;
     double lo = 0, hi = 0;
     const bool all = !squareKeys(x0, x1, y0, y1, sx, sy, lo, hi);
+    // The groups' envelope first (cheap), then the rays one by one.
+    if (!m_bounds.mayConflict(
+            bound_m, groupEnvelope(lo, hi, all, nearStep_m).lowest_m(m_sensor_m.z(), far_m)))
+        return;
     const RayEnvelope e = rayEnvelope(lo, hi, all, nearStep_m);
     if (!m_bounds.mayConflict(bound_m, e.lowest_m(m_sensor_m.z(), far_m))) return;
     auto heat = [&](unsigned first, unsigned last) {
@@ -189,12 +210,16 @@ void EnvelopeTest::testBlock(int bx, int by) {
     const double sx = m_sensor_m.x(), sy = m_sensor_m.y();
     const double x0 = bx * block_m - kSlack_m, x1 = (bx + 1) * block_m + kSlack_m;
     const double y0 = by * block_m - kSlack_m, y1 = (by + 1) * block_m + kSlack_m;
+    const double gapX = std::max({x0 - sx, sx - x1, 0.0});
+    const double gapY = std::max({y0 - sy, sy - y1, 0.0});
     const double farX = std::max(std::abs(x0 - sx), std::abs(x1 - sx));
     const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
+    const double near_m = std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m;
     const double far_m = std::sqrt(farX * farX + farY * farY) + kSlack_m;
     double lo = 0, hi = 0;
     const bool all = !squareKeys(x0, x1, y0, y1, sx, sy, lo, hi);
-    const double blockLow_m = groupEnvelope(lo, hi, all).lowest_m(sz, far_m);
+    const double nearStep_m = near_m + m_step - 1e-9;  // no shorter ray has a sample here
+    const double blockLow_m = groupEnvelope(lo, hi, all, nearStep_m).lowest_m(sz, far_m);
     if (!m_bounds.mayConflict(bound_m, blockLow_m)) return;
     // Its cells inside the window; a cell no higher than the block's envelope is settled.
     const CellWindow& w = m_grid.window();
