@@ -173,12 +173,8 @@ void EnvelopeTest::testCell(int ix, int iy, float bound_m) {
     const double sx = m_sensor_m.x(), sy = m_sensor_m.y();
     const double x0 = ix * m_cell - kSlack_m, x1 = (ix + 1) * m_cell + kSlack_m;
     const double y0 = iy * m_cell - kSlack_m, y1 = (iy + 1) * m_cell + kSlack_m;
-    const double gapX = std::max({x0 - sx, sx - x1, 0.0});
-    const double gapY = std::max({y0 - sy, sy - y1, 0.0});
-    const double farX = std::max(std::abs(x0 - sx), std::abs(x1 - sx));
-    const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
-    const double near_m = std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m;
-    const double far_m = std::sqrt(farX * farX + farY * farY) + kSlack_m;
+    const SquareDistances distances = squareDistances(x0, x1, y0, y1, sx, sy);
+    const double near_m = distances.near_m, far_m = distances.far_m;
     // No sample of a ray shorter than this lies in the cell (1e-9 m spare).
     const double nearStep_m = near_m + m_step - 1e-9;
     double lo = 0, hi = 0;
@@ -210,12 +206,8 @@ void EnvelopeTest::testBlock(int bx, int by) {
     const double sx = m_sensor_m.x(), sy = m_sensor_m.y();
     const double x0 = bx * block_m - kSlack_m, x1 = (bx + 1) * block_m + kSlack_m;
     const double y0 = by * block_m - kSlack_m, y1 = (by + 1) * block_m + kSlack_m;
-    const double gapX = std::max({x0 - sx, sx - x1, 0.0});
-    const double gapY = std::max({y0 - sy, sy - y1, 0.0});
-    const double farX = std::max(std::abs(x0 - sx), std::abs(x1 - sx));
-    const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
-    const double near_m = std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m;
-    const double far_m = std::sqrt(farX * farX + farY * farY) + kSlack_m;
+    const SquareDistances distances = squareDistances(x0, x1, y0, y1, sx, sy);
+    const double near_m = distances.near_m, far_m = distances.far_m;
     double lo = 0, hi = 0;
     const bool all = !squareKeys(x0, x1, y0, y1, sx, sy, lo, hi);
     const double nearStep_m = near_m + m_step - 1e-9;  // no shorter ray has a sample here

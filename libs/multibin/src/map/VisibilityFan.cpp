@@ -326,12 +326,8 @@ void FanTest::testBlock(int bx, int by) {
     const double x0 = bx * m_block_m - kSlack_m, x1 = (bx + 1) * m_block_m + kSlack_m;
     const double y0 = by * m_block_m - kSlack_m, y1 = (by + 1) * m_block_m + kSlack_m;
     // Distances from the sensor to the (widened) block: nearest and farthest.
-    const double gapX = std::max({x0 - sx, sx - x1, 0.0});
-    const double gapY = std::max({y0 - sy, sy - y1, 0.0});
-    const double farX = std::max(std::abs(x0 - sx), std::abs(x1 - sx));
-    const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
-    const double near_m = std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m;
-    const double far_m = std::sqrt(farX * farX + farY * farY) + kSlack_m;
+    const SquareDistances distances = squareDistances(x0, x1, y0, y1, sx, sy);
+    const double near_m = distances.near_m, far_m = distances.far_m;
     // A ray rising towards the sensor passes over the block no lower than
     // sz - slope far_m + slope inCell_m (its samples there lie at most far_m from the sensor,
     // and tz + slope length is sz), wherever it ends: clear if its slope is at most maxSlope

@@ -113,6 +113,21 @@ inline double pseudoAngle(double dx, double dy) {
     return dx <= 0 ? 2 - dy / (-dx - dy) : 3 + dx / (dx - dy);
 }
 
+/** The nearest and farthest horizontal distances [m] from the sensor (sx, sy) to the square
+ * [x0, x1] x [y0, y1], each widened by kSlack_m. */
+struct SquareDistances {
+    double near_m, far_m;
+};
+inline SquareDistances squareDistances(double x0, double x1, double y0, double y1, double sx,
+                                       double sy) {
+    const double gapX = std::max({x0 - sx, sx - x1, 0.0});
+    const double gapY = std::max({y0 - sy, sy - y1, 0.0});
+    const double farX = std::max(std::abs(x0 - sx), std::abs(x1 - sx));
+    const double farY = std::max(std::abs(y0 - sy), std::abs(y1 - sy));
+    return {std::sqrt(gapX * gapX + gapY * gapY) - kSlack_m,
+            std::sqrt(farX * farX + farY * farY) + kSlack_m};
+}
+
 /** The pseudo-angles [lo, hi] (hi up to 6: past key 0 the keys continue from 4) within which
  * every direction from the sensor (sx, sy) to a point of the square [x0, x1] x [y0, y1] lies,
  * widened by 1e-6 (far above the keys' rounding for squares 1 mm or more from the sensor); false
