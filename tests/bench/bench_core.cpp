@@ -8,6 +8,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -308,6 +309,104 @@ static void BM_VisibilityShare(benchmark::State& state) {
     state.counters["visibility_share"] = tVis / (tUpdate + tVis);
 }
 BENCHMARK(BM_VisibilityShare)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+
+// The visibility constraint's share of a dense camera frame over rocks (issue 32): a 2 x 2 m
+// grid of 15 mm cells with 40 rocks (discs of 3-15 cm radius, 2-25 cm high) on a gently waving
+// floor, seen by a camera 0.5 m up at one edge: four points in every cell of its 80-degree view
+// that it sees (the line of sight from the camera passes above the terrain), 2 mm noise. The
+// map is built from two such frames first; each iteration inserts the frame again and applies
+// the constraint as the map does for a camera's frame (RayFan::Skip), timed apart in the same
+// loop. Counter `visibility_share` (target <= 0.25).
+static void BM_DenseFrameOverRocks(benchmark::State& state) {
+    std::mt19937 rng(32);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    struct Rock {
+        double x, y, r, h;
+    };
+    std::vector<Rock> rocks;
+    for (int k = 0; k < 40; k++)
+        rocks.push_back({0.3 + 1.6 * unit(rng), -0.9 + 1.8 * unit(rng), 0.03 + 0.12 * unit(rng),
+                         0.02 + 0.23 * unit(rng)});
+    auto ground = [&](double x, double y) {
+        double z = 0.01 * std::sin(5 * x) * std::cos(4 * y);
+        for (const Rock& r : rocks) {
+            const double d = std::hypot(x - r.x, y - r.y);
+            if (d < r.r) z = std::max(z, r.h * std::sqrt(1 - (d / r.r) * (d / r.r)));
+        }
+        return z;
+    };
+    // The terrain on a 5 mm raster over [-0.2, 2.2] x [-1.2, 1.2] m, for the lines of sight.
+    constexpr double kRaster_m = 0.005, kX0_m = -0.2, kY0_m = -1.2;
+    constexpr int kRasterN = 480;
+    std::vector<float> raster(size_t(kRasterN) * kRasterN);
+    for (int j = 0; j < kRasterN; j++)
+        for (int i = 0; i < kRasterN; i++)
+            raster[size_t(i + j * kRasterN)] =
+                float(ground(kX0_m + (i + 0.5) * kRaster_m, kY0_m + (j + 0.5) * kRaster_m));
+    auto rasterAt = [&](double x, double y) {
+        const int i = std::clamp(int((x - kX0_m) / kRaster_m), 0, kRasterN - 1);
+        const int j = std::clamp(int((y - kY0_m) / kRaster_m), 0, kRasterN - 1);
+        return double(raster[size_t(i + j * kRasterN)]);
+    };
+    const Eigen::Vector3d camera(0.0, 0.0, 0.5);
+    auto seen = [&](double x, double y, double z) {  // the line of sight above the terrain
+        const double length = std::hypot(x - camera.x(), y - camera.y());
+        for (double d = 0.01; d < length - 0.02; d += 0.005) {
+            const double f = d / length;
+            const double lx = x + (camera.x() - x) * f, ly = y + (camera.y() - y) * f;
+            if (z + (camera.z() - z) * f < rasterAt(lx, ly) - 2e-3) return false;
+        }
+        return true;
+    };
+    BinGrid grid(kCell_m);
+    grid.reset(kCell_m, CellWindow{-10, -67, 140, 134});
+    PointsWithCov pts;
+    std::normal_distribution<float> noise(0.f, 0.002f);
+    const CellWindow& w = grid.window();
+    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+            const double x = grid.cellCenter_m(ix), y = grid.cellCenter_m(iy);
+            if (x < 0.2 || std::abs(std::atan2(y, x)) > 0.7) continue;
+            for (int k = 0; k < 4; k++) {
+                const double px = x + kCell_m * (unit(rng) - 0.5),
+                             py = y + kCell_m * (unit(rng) - 0.5);
+                const double pz = ground(px, py);
+                if (!seen(px, py, pz)) continue;
+                PointWithCov p;
+                p.point_m = Eigen::Vector3f(float(px), float(py), float(pz) + noise(rng));
+                p.cov_m2 = {1e-6f, 0, 0, 1e-6f, 0, 4e-6f};
+                pts.push_back(p);
+            }
+        }
+    BinUpdateParams params;
+    VisibilityParams vis;
+    vis.enabled = state.range(0) != 0;
+    for (int k = 0; k < 2; k++) {  // the map so far
+        grid.beginCycle();
+        grid.insertPoints(pts, params);
+        applyVisibilityConstraint(grid, camera, vis, params, RayFan::Skip);
+    }
+    double tUpdate = 0, tVis = 0;
+    VisibilityStats vs;
+    for (auto _ : state) {
+        const auto t0 = Clock::now();
+        grid.beginCycle();
+        benchmark::DoNotOptimize(grid.insertPoints(pts, params));
+        const auto t1 = Clock::now();
+        vs = applyVisibilityConstraint(grid, camera, vis, params, RayFan::Skip);
+        const auto t2 = Clock::now();
+        tUpdate += seconds(t0, t1);
+        tVis += seconds(t1, t2);
+    }
+    state.counters["points"] = double(pts.size());
+    state.counters["updated_cells"] = double(grid.updatedCells().size());
+    state.counters["rays"] = double(vs.raysCast);
+    state.counters["bins_edited"] = double(vs.binsRemoved + vs.binsWeakened);
+    state.counters["visibility_us"] = 1e6 * tVis / double(state.iterations());
+    state.counters["bin_update_us"] = 1e6 * tUpdate / double(state.iterations());
+    state.counters["visibility_share"] = tVis / (tUpdate + tVis);
+}
+BENCHMARK(BM_DenseFrameOverRocks)->Arg(1)->Arg(0)->Unit(benchmark::kMicrosecond);
 
 // Moving the window by one cell on a full map of ny = 133 rows and nx columns (one bin per cell,
 // refilled between moves outside the timing: manual time covers moveWindowTo only, with its

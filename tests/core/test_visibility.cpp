@@ -9,124 +9,13 @@
 
 #include "multibin/map/CellSurface.h"
 #include "multibin/map/VisibilityConstraint.h"
+#include "multibin/map/VisibilityRule.h"
 #include "test_scenes.h"
+#include "visibility_test_util.h"
 
 using namespace multibin;
-
-namespace {
-PointWithCov pointAt(double x, double y, double z, double sigmaZ_m) {
-    PointWithCov p;
-    p.point_m = Eigen::Vector3f(float(x), float(y), float(z));
-    p.cov_m2 = {1e-6f, 0, 0, 1e-6f, 0, float(sigmaZ_m * sigmaZ_m)};
-    return p;
-}
-
-/** Reference: the constraint as it was before the local height bound (commit 483eb88), with
- * the target's certainty taken from the cell's surface (CellSurface) as the map reports it. Every
- * ray is sampled every half cell from the updated cell towards the sensor until it clears the
- * highest bin ever stored in the grid, and every cell it enters is tested. The library's version
- * must edit exactly the same bins. */
-VisibilityStats referenceVisibility(BinGrid& grid, const Eigen::Vector3d& sensor_m,
-                                    const VisibilityParams& vis, const BinUpdateParams& binParams) {
-    VisibilityStats stats;
-    if (!vis.enabled) return stats;
-    const double cell = grid.cellSize_m();
-    const double step = 0.5 * cell;
-    const double stopHeight = grid.maxHeight_m() + vis.margin_m;
-    const double invCell = 1.0 / cell;
-    constexpr double kNoClamp = 1e8;
-    auto conflictMargin = [&](const Bin& b) {
-        return vis.margin_m + 3.0 * BinGrid::sigma_m(b, binParams);
-    };
-    const double minConflictMargin = conflictMargin(Bin{});
-    auto conflicts = [&](const Bin& b, double lineHeight_m) {
-        const double above = b.height_m - lineHeight_m;
-        return above > minConflictMargin && above > conflictMargin(b);
-    };
-    for (const BinGrid::UpdatedCell& u : grid.updatedCells()) {
-        CellSurface surface;  // the cell's certainty as the map reports it
-        const double targetCertainty =
-            cellSurface(grid, u.ix, u.iy, binParams, surface) ? surface.certainty : 0.0;
-        const double tz = u.maxHeight_m;
-        const float decrement = vis.certaintyDecrement * float(u.points);
-        grid.editBins(u.ix, u.iy, [&](Bin& b) {
-            if (!conflicts(b, tz)) return true;
-            b.certainty -= decrement;
-            stats.binsWeakened++;
-            if (b.certainty > 0) return true;
-            stats.binsRemoved++;
-            return false;
-        });
-        const double tx = grid.cellCenter_m(u.ix), ty = grid.cellCenter_m(u.iy);
-        const double dx = sensor_m.x() - tx, dy = sensor_m.y() - ty;
-        const double length = std::sqrt(dx * dx + dy * dy);
-        if (length < cell) continue;
-        stats.raysCast++;
-        const double slope = (sensor_m.z() - tz) / length;
-        const double inCellRise = std::abs(slope) * 0.7072 * cell;
-        const double ux = dx / length, uy = dy / length;
-        const bool unclamped = std::abs(sensor_m.x() * invCell) < kNoClamp &&
-                               std::abs(sensor_m.y() * invCell) < kNoClamp &&
-                               std::abs(tx * invCell) < kNoClamp &&
-                               std::abs(ty * invCell) < kNoClamp;
-        auto cellOf = [&](double coord_m) {
-            return unclamped ? BinGrid::floorToInt(coord_m * invCell) : grid.cellIndex(coord_m);
-        };
-        const CellWindow& w = grid.window();
-        double walk = length;
-        auto clipAxis = [&](double origin, double dir, int i0, int n) {
-            if (dir > 0) walk = std::min(walk, ((i0 + n) * cell - origin) / dir + cell);
-            if (dir < 0) walk = std::min(walk, (i0 * cell - origin) / dir + cell);
-        };
-        clipAxis(tx, ux, w.ix0, w.nx);
-        clipAxis(ty, uy, w.iy0, w.ny);
-        int lastIx = u.ix, lastIy = u.iy;
-        for (double d = step; d < walk; d += step) {
-            const double rayZ = tz + slope * d;
-            if (slope > 0 && rayZ - inCellRise > stopHeight) break;
-            const int ix = cellOf(tx + ux * d);
-            const int iy = cellOf(ty + uy * d);
-            if (ix == lastIx && iy == lastIy) continue;
-            lastIx = ix;
-            lastIy = iy;
-            if (!grid.window().contains(ix, iy) || grid.updatedThisCycle(ix, iy)) continue;
-            stats.cellsVisited++;
-            const double rayHigh = rayZ + inCellRise;
-            grid.editBins(ix, iy, [&](Bin& b) {
-                if (!conflicts(b, rayHigh)) return true;
-                if (b.certainty < targetCertainty) {
-                    stats.binsRemoved++;
-                    return false;
-                }
-                b.certainty -= decrement;
-                stats.binsWeakened++;
-                if (b.certainty > 0) return true;
-                stats.binsRemoved++;
-                return false;
-            });
-        }
-    }
-    return stats;
-}
-
-/** Every bin of the window, cell by cell in chain order, as raw bytes. */
-std::vector<std::array<uint32_t, 5>> binsOf(const BinGrid& g) {
-    std::vector<std::array<uint32_t, 5>> out;
-    const CellWindow& w = g.window();
-    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
-            g.forEachBin(ix, iy, [&](const Bin& b) {
-                std::array<uint32_t, 5> r;
-                std::memcpy(&r[0], &b.height_m, 4);
-                std::memcpy(&r[1], &b.variance_m2, 4);
-                std::memcpy(&r[2], &b.certainty, 4);
-                r[3] = b.pointCount;
-                r[4] = uint32_t(uint16_t(b.index)) | (uint32_t(ix - w.ix0) << 16);
-                out.push_back(r);
-            });
-    return out;
-}
-}  // namespace
+using multibin::test::binsOf;
+using multibin::test::pointAt;
 
 TEST(Visibility, StaleOccluderLessCertainThanTheTargetIsRemoved) {
     BinGrid g(0.1);
@@ -145,6 +34,32 @@ TEST(Visibility, StaleOccluderLessCertainThanTheTargetIsRemoved) {
     EXPECT_EQ(s.binsRemoved, 1u);
     EXPECT_EQ(g.winningBin(10, 0), nullptr);
     ASSERT_NE(g.winningBin(20, 0), nullptr);
+}
+
+TEST(Visibility, RuleEditsABinJustAboveTheConflictHeightAndKeepsOneJustBelow) {
+    // By hand: sensor at (0.05, 0.05, 0.5), target cell centre (2.05, 0.05) at 0 m. The sample
+    // at d = 1.0 m from the target lies in cell 10 (x = 1.05): the ray is at 0.25 m there (slope
+    // 0.5 / 2.0), plus the in-cell rise 0.25 * 0.7072 * 0.1 m; a bin conflicts above that by the
+    // margin plus 3 sigma of the bin (ConflictTest). 2 mm above: removed; 2 mm below: kept.
+    BinUpdateParams p;
+    VisibilityParams v;
+    const double rayHigh_m = 0.25 + 0.25 * 0.7072 * 0.1;
+    for (const double offset_m : {0.002, -0.002}) {
+        BinGrid g(0.1);
+        g.reset(0.1, CellWindow{-5, -5, 30, 10});
+        g.beginCycle();
+        g.insertPoints({pointAt(1.05, 0.05, 0.3, 0.005)}, p);  // any height: for its sigma
+        const double conflictAt_m = rayHigh_m + ConflictTest(v, p).margin_m(*g.winningBin(10, 0));
+        g.reset(0.1, CellWindow{-5, -5, 30, 10});
+        g.beginCycle();
+        g.insertPoints({pointAt(1.05, 0.05, conflictAt_m + offset_m, 0.005)}, p);
+        g.beginCycle();
+        g.insertPoints({pointAt(2.05, 0.05, 0.0, 0.005), pointAt(2.05, 0.05, 0.0, 0.005)}, p);
+        const VisibilityStats s = applyVisibilityRule(g, {0.05, 0.05, 0.5}, v, p);
+        EXPECT_EQ(s.raysCast, 1u);
+        EXPECT_EQ(s.binsRemoved, offset_m > 0 ? 1u : 0u) << offset_m;
+        EXPECT_EQ(g.winningBin(10, 0) == nullptr, offset_m > 0) << offset_m;
+    }
 }
 
 TEST(Visibility, OccluderIsWeighedAgainstTheCellSurfaceNotItsWinningBin) {
@@ -207,7 +122,7 @@ TEST(Visibility, ConsistentTerrainIsUntouched) {
         BinGrid reference = g;
         // Sensor 0.25 m up: the line of sight runs low over the slope for a while.
         const VisibilityStats s = applyVisibilityConstraint(g, {0.05, 0.05, 0.25}, v, p);
-        const VisibilityStats r = referenceVisibility(reference, {0.05, 0.05, 0.25}, v, p);
+        const VisibilityStats r = applyVisibilityRule(reference, {0.05, 0.05, 0.25}, v, p);
         // Raised: weakened by the contradicting point to certainty 0, hence also removed.
         EXPECT_EQ(s.binsWeakened, raised ? 1u : 0u);
         EXPECT_EQ(s.binsRemoved, raised ? 1u : 0u);
@@ -215,7 +130,7 @@ TEST(Visibility, ConsistentTerrainIsUntouched) {
         EXPECT_EQ(s.binsWeakened, r.binsWeakened);
         EXPECT_EQ(binsOf(g), binsOf(reference));
         if (raised) EXPECT_EQ(g.winningBin(12, 0), nullptr) << "less certain than the target";
-        // The reference walks every cell under the line; the local bound only those near it.
+        // The rule walks every cell under the line; the local bound only those near it.
         EXPECT_LE(s.cellsVisited, r.cellsVisited);
         EXPECT_GT(r.cellsVisited, 5u);
     }
@@ -225,7 +140,7 @@ TEST(Visibility, LocalHeightBoundEditsTheSameBinsAsTheGlobalWalk) {
     // Random terrains with spikes and stale layers, random updates and sensor positions (above,
     // below, on a cell-centre line so samples fall on cell edges, far outside the window), on
     // windows that were moved and grown (block slots reused): the library's constraint must
-    // leave every bin bit-identical to the reference walk, with the same counts.
+    // leave every bin bit-identical to the rule (applyVisibilityRule), with the same counts.
     std::mt19937 rng(20261122);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     size_t edits = 0, visited = 0, visitedReference = 0, scenes = 0;
@@ -294,7 +209,7 @@ TEST(Visibility, LocalHeightBoundEditsTheSameBinsAsTheGlobalWalk) {
         // Every other scene without the fan test (a camera frame's rays): the walk's own tests.
         const RayFan fan = scene % 2 ? RayFan::Skip : RayFan::Test;
         const VisibilityStats s = applyVisibilityConstraint(g, sensor, v, p, fan);
-        const VisibilityStats r = referenceVisibility(reference, sensor, v, p);
+        const VisibilityStats r = applyVisibilityRule(reference, sensor, v, p);
         ASSERT_EQ(s.raysCast, r.raysCast) << "scene " << scene;
         ASSERT_EQ(s.binsRemoved, r.binsRemoved) << "scene " << scene;
         ASSERT_EQ(s.binsWeakened, r.binsWeakened) << "scene " << scene;
@@ -306,7 +221,7 @@ TEST(Visibility, LocalHeightBoundEditsTheSameBinsAsTheGlobalWalk) {
         scenes++;
     }
     std::cout << scenes << " scenes, " << edits << " bins edited; cells tested " << visited
-              << " against the reference's " << visitedReference << "\n";
+              << " against the rule's " << visitedReference << "\n";
     EXPECT_GT(edits, 300u) << "the scenes must exercise the constraint";
     EXPECT_LT(visited, visitedReference);
 }
@@ -316,7 +231,7 @@ namespace {
  * near a window edge), its rays ending on an arc of updated cells, rocks (discs up to 0.3 m) and
  * stale spikes near the sensor and beside the targets, so that rays pass just above or just
  * below blocks, units and cells. The library's fan test clears a ray only if no square it passes
- * over can conflict: every bin must stay bit-identical to the reference walk. With
+ * over can conflict: every bin must stay bit-identical to the rule. With
  * `farCornerTargets`, some rays also end in the cell of their block farthest from the sensor,
  * with a stale bin a cell or so towards the sensor within a centimetre of the conflict height:
  * there a ray's samples in its own block reach almost the block's farthest distance from the
@@ -443,7 +358,7 @@ std::pair<size_t, size_t> checkFansOverRocks(uint32_t seed, int sceneCount, bool
         const Eigen::Vector3d sensor(sx, sy, sz);
         BinGrid reference = g;
         const VisibilityStats s = applyVisibilityConstraint(g, sensor, v, p);
-        const VisibilityStats r = referenceVisibility(reference, sensor, v, p);
+        const VisibilityStats r = applyVisibilityRule(reference, sensor, v, p);
         EXPECT_EQ(s.raysCast, r.raysCast) << "scene " << scene;
         EXPECT_EQ(s.binsRemoved, r.binsRemoved) << "scene " << scene;
         EXPECT_EQ(s.binsWeakened, r.binsWeakened) << "scene " << scene;
