@@ -34,6 +34,7 @@
 #include "ObservationTally.h"
 #include "ProgressBar.h"
 #include "RawlogSource.h"
+#include "RunWarnings.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
@@ -276,6 +277,7 @@ int run(const Arguments& args) {
     using Clock = std::chrono::steady_clock;
     double insert_s = 0;  // the multi-bin map's own insertion time
     ObservationTally tally;
+    RunFacts facts;
     auto insertTimed = [&](const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& pose, bool poseHasCov) {
         tally.before(*elevation);
@@ -284,6 +286,7 @@ int run(const Arguments& args) {
                                          : elevation->insertObservation(obs, pose.mean);
         insert_s += std::chrono::duration<double>(Clock::now() - t0).count();
         tally.after(obs, inserted, *elevation);
+        facts.observationsWithPoseCovariance += inserted && poseHasCov;
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
     ProgressBar bar("mapping");
@@ -378,6 +381,8 @@ int run(const Arguments& args) {
             }
         }
     }
+    for (const std::string& w : runWarnings(*elevation, facts))
+        std::cout << "warning: " << w << "\n";
     return 0;
 }
 

@@ -546,7 +546,7 @@ bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y
     // Horizontal position taken as exact to the cell; only the height variance matters here.
     const float tiny = static_cast<float>(1e-12);
     pts[0].cov_m2 = {tiny, 0, 0, tiny, 0, float(sigma * sigma)};
-    growToCover(pts, Eigen::Vector3d(xr, yr, z));
+    growToCover(pts, Eigen::Vector3d(xr, yr, z), binUpdateParams());
     return insertPoints(pts).accepted == 1;
 }
 

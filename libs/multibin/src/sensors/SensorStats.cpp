@@ -44,4 +44,12 @@ size_t SensorModelStats::notFinite() const {
     return laser.notFinite + stereo.notFinite + depth.notFinite + lidar.notFinite;
 }
 
+std::optional<SensorModelKind> SensorModelStats::model() const {
+    if (laser.beams > 0) return SensorModelKind::laser;
+    if (lidar.returns > 0) return SensorModelKind::lidar;
+    if (stereo.pixels > 0 || stereo.pairs > 0) return SensorModelKind::stereo;
+    if (depth.points > 0) return SensorModelKind::depth;
+    return std::nullopt;
+}
+
 }  // namespace multibin::sensors

@@ -374,21 +374,26 @@ private:
     /** Observation -> sensor-frame points -> map frame -> grid. */
     bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);
-    /** Grows the window (if allowed) to cover map-frame points near the sensor. */
-    void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m);
+    /** Grows the window (if allowed) to cover map-frame points near the sensor that pass the
+     * eq 13 gate of `params`. */
+    void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
+                     const multibin::BinUpdateParams& params);
 
     /** True if growToCover() would change the window for these sensor-frame points seen from
      * `sensorInMap` (the robot pose's mean composed with the sensor pose), without propagating
      * more than the few points near the window's edge. */
     bool growthNeeded(const multibin::PointsWithCov& sensorPoints,
-                      const multibin::PosePropagator& propagator) const;
+                      const multibin::PosePropagator& propagator,
+                      const multibin::BinUpdateParams& params) const;
 
     /** The insertion core of one update cycle: BinGrid::insertPoints or insertSensorPoints. */
     using FuseIntoGrid =
         std::function<multibin::InsertStats(multibin::BinGrid&, const multibin::BinUpdateParams&)>;
     /** One update cycle of `grid`: insertion core, then the visibility constraint (with the
      * fan test for a scan's rays, not for a camera frame's: multibin::RayFan). */
-    multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid, const FuseIntoGrid& fuse,
+    multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid,
+                                         const multibin::BinUpdateParams& params,
+                                         const FuseIntoGrid& fuse,
                                          const std::optional<Eigen::Vector3d>& sensorOrigin_m,
                                          bool cameraFrame = false);
     /** recenter() on (x, y) relative to mapOrigin() [m]. */

@@ -2,6 +2,9 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
+
+#include "multibin/sensors/SensorModelOptions.h"
 
 namespace multibin::sensors {
 
@@ -74,6 +77,9 @@ struct SensorModelStats {
     size_t outOfRange() const;
     /** Readings with NaN or infinite values (the map's InsertStats::notFinite). */
     size_t notFinite() const;
+    /** The model that counted readings here (one observation's stats hold one model's counts);
+     * none if nothing was counted. */
+    std::optional<SensorModelKind> model() const;
 };
 
 }  // namespace multibin::sensors
