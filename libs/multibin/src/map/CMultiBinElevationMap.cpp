@@ -368,7 +368,10 @@ CMultiBinElevationMap::~CMultiBinElevationMap() = default;
 const multibin::BinGrid& CMultiBinElevationMap::grid() const { return m_impl->grid; }
 const multibin::BinGrid& CMultiBinElevationMap::localGrid() const { return m_impl->local; }
 bool CMultiBinElevationMap::fillIsStale() const { return m_impl->fillStale; }
-const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const { return m_impl->fill; }
+const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const {
+    fillIfLoaded();
+    return m_impl->fill;
+}
 const multibin::InsertStats& CMultiBinElevationMap::insertStats() const { return m_impl->stats; }
 const multibin::VisibilityStats& CMultiBinElevationMap::visibilityStats() const {
     return m_impl->visibilityStats;

@@ -337,7 +337,8 @@ public:
     size_t dem_get_size_y() const override;
     bool dem_get_z_by_cell(const size_t cx, const size_t cy, double& z_out) const override;
     bool dem_get_z(const double x, const double y, double& z_out) const override;
-    /** Runs gap filling if observations arrived since the last one (lazy: never per point). */
+    /** Runs gap filling if observations arrived since the last one (lazy: never per point). A
+     * map read from a file needs no call: it fills on its first query. */
     void dem_update_map() override;
     /** @} */
 
@@ -371,6 +372,13 @@ private:
      * where it filled the cell of (x, y). */
     HeightSource elevationQuery(bool subCell, double x_m, double y_m, double& height_m,
                                 double& sigma_m, bool includeFilled) const;
+    /** Gap filling of the whole window into the last fill (the caller holds the lock for
+     * writing): dem_update_map()'s work. */
+    void fillNow() const;
+    /** A map read from a file (bins, no insertion since) fills its gaps once, before its first
+     * query that may answer a filled height: it answers as the map that wrote it did. Called
+     * first by those queries; a no-op inside another entry point. */
+    void fillIfLoaded() const;
     /** Observation -> sensor-frame points -> map frame -> grid. */
     bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);
