@@ -278,6 +278,7 @@ int run(const Arguments& args) {
     double insert_s = 0;  // the multi-bin map's own insertion time
     ObservationTally tally;
     RunFacts facts;
+    PoseCounts poseCounts;  // a rawlog's: how its observations got their pose
     auto insertTimed = [&](const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& pose, bool poseHasCov) {
         tally.before(*elevation);
@@ -302,7 +303,8 @@ int run(const Arguments& args) {
                         m->insertObservation(*obs, pose.mean);
                 }
             },
-            [&](double f, size_t n) { bar.update(f, std::to_string(n) + " entries"); });
+            [&](double f, size_t n) { bar.update(f, std::to_string(n) + " entries"); },
+            elevation->insertionOptions.robot_pose_max_dt_s, &poseCounts);
     } else {
         const mrpt::maps::CSimpleMap sm = RawlogSource::loadSimplemap(args.simplemap);
         for (const auto& m : maps.maps)
@@ -356,6 +358,9 @@ int run(const Arguments& args) {
               << insertSummary(elevation->insertStats()) << "\n"
               << "observations with the default pose covariance: " << elevation->poseFallbackCount()
               << "\n"
+              << "rawlog poses: " << poseCounts.robotPose << " robot pose, "
+              << poseCounts.odometrySinceRobotPose << " robot pose + odometry since, "
+              << poseCounts.defaultCovariance << " default covariance\n"
               << "cells filled: " << fs_.median << " by weighted median, " << fs_.gaussian
               << " by Gaussian surface (" << fs_.supportAreas << " support areas); " << fs_.unfilled
               << " left unknown\n"
