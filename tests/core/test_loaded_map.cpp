@@ -80,3 +80,31 @@ TEST(LoadedMap, AfterAnInsertionTheFillIsExplicitAgain) {
     loaded.dem_update_map();
     EXPECT_NE(loaded.getElevation(0.525, 0.525, h, s), Map::HeightSource::Unknown);
 }
+
+// The recommended query answers height, sigma and source in one call: measured where measured
+// (what getHeight() says), filled in the hole (what dem_get_z() says), NaN and Unknown outside
+// the map, where the old queries left their outputs untouched.
+TEST(HeightQuery, OneAnswerWithSourceAndNaNWhereUnknown) {
+    const Map map = mapWithAFilledHole();
+    const Map::HeightAnswer measured = map.height(0.2, 0.3);
+    ASSERT_EQ(measured.source, Map::HeightSource::Measured);
+    double h = NAN, s = NAN;
+    ASSERT_TRUE(map.getHeight(0.2, 0.3, h, s));
+    EXPECT_EQ(measured.height_m, h);
+    EXPECT_EQ(measured.sigma_m, s);
+    EXPECT_NEAR(measured.height_m, 0.02, 0.005);  // the plane z = 0.1 x
+
+    const Map::HeightAnswer filled = map.height(0.525, 0.525);
+    EXPECT_TRUE(filled.known());
+    EXPECT_NE(filled.source, Map::HeightSource::Measured);
+    double z = NAN;
+    ASSERT_TRUE(map.dem_get_z(0.525, 0.525, z));
+    EXPECT_EQ(filled.height_m, z);
+    EXPECT_FALSE(map.getHeight(0.525, 0.525, h, s));  // measured only
+
+    const Map::HeightAnswer outside = map.height(5.0, 5.0);
+    EXPECT_FALSE(outside.known());
+    EXPECT_EQ(outside.source, Map::HeightSource::Unknown);
+    EXPECT_TRUE(std::isnan(outside.height_m) && std::isnan(outside.sigma_m));
+    EXPECT_FALSE(map.dem_get_z(5.0, 5.0, z));
+}

@@ -442,9 +442,11 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
-    return insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane
-               ? heightAt(x_m, y_m, height_m, sigma_m)
-               : cellHeight(x_m, y_m, height_m, sigma_m);
+    const HeightAnswer a = height(x_m, y_m);
+    if (a.source != HeightSource::Measured) return false;
+    height_m = a.height_m;
+    sigma_m = a.sigma_m;
+    return true;
 }
 
 bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, double& height_m,

@@ -100,10 +100,19 @@ bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
                      m_impl->origin_m.y() + m_impl->grid.cellCenter_m(w.iy0 + int(cy)), z_out);
 }
 
-bool CMultiBinElevationMap::dem_get_z(const double x, const double y, double& z_out) const {
+CMultiBinElevationMap::HeightAnswer CMultiBinElevationMap::height(double x_m, double y_m) const {
     fillIfLoaded();
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    double sigma;
-    return getElevation(x, y, z_out, sigma, insertionOptions.dem_return_filled) !=
-           HeightSource::Unknown;
+    HeightAnswer a;
+    double h = 0, s = 0;
+    a.source =
+        elevationQuery(insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane, x_m,
+                       y_m, h, s, insertionOptions.dem_return_filled);
+    if (a.known()) a.height_m = h, a.sigma_m = s;
+    return a;
+}
+
+bool CMultiBinElevationMap::dem_get_z(const double x, const double y, double& z_out) const {
+    const HeightAnswer a = height(x, y);
+    if (a.known()) z_out = a.height_m;
+    return a.known();
 }

@@ -50,10 +50,15 @@ namespace mrpt::maps {
  * covariances, propagated from the sensor model and the robot's 6-DoF pose PDF:
  * C = J_R C_R J_R^T + J_S C_S J_S^T.
  *
- * Observations accepted by insertObservation():
- * - mrpt::obs::CObservation2DRangeScan (laser; eq 14 continuity gate between consecutive scans),
- * - mrpt::obs::CObservation3DRangeScan (its points, or its depth image unprojected),
- * - mrpt::obs::CObservationPointCloud,
+ * Observations accepted by insertObservation() (the sensor model of each: its class's, or per
+ * sensor label with the key `sensor_models`):
+ * - mrpt::obs::CObservation2DRangeScan (laser; eq 14 continuity gate between consecutive scans;
+ *   or the lidar model),
+ * - mrpt::obs::CObservationStereoImages (stereo, eqs 4-10; OpenCV SGBM without a disparity),
+ * - mrpt::obs::CObservation3DRangeScan (depth camera: its points, or its depth image unprojected),
+ * - mrpt::obs::CObservationPointCloud (depth camera by default; lidar or stereo by label),
+ * - mrpt::obs::CObservationVelodyneScan (lidar, MRPT's calibrated point generation),
+ * - mrpt::obs::CObservationRotatingScan (lidar; single-row scans only),
  * - mrpt::obs::CObservationRobotPose: not inserted; the map keeps it and uses its covariance for
  *   the observations that follow while it is younger than TInsertionOptions::robot_pose_max_dt_s.
  *
@@ -232,13 +237,29 @@ public:
         const multibin::PoseVariances* pose = nullptr);
 
     /** @name Queries @{ */
+    /** Where a height comes from: Unknown (0), Measured (1), FilledMedian (2), FilledSurface (3),
+     * FilledHarmonic (4); the number is the `source` raster layer's value. */
+    using HeightSource = multibin::HeightSource;
+    /** The answer of height(): NaN and HeightSource::Unknown where nothing is known. */
+    struct HeightAnswer {
+        double height_m = std::numeric_limits<double>::quiet_NaN();  //!< [m]
+        double sigma_m = std::numeric_limits<double>::quiet_NaN();   //!< one sigma [m]
+        HeightSource source = HeightSource::Unknown;
+        bool known() const { return source != HeightSource::Unknown; }
+    };
+    /** The recommended query: the terrain's height at (x, y) [m, pose frame] with its sigma and
+     * where it comes from. Measured places answer the map's surface (`height_query`: the
+     * sub-cell plane by default, heightAt()); unobserved ones the gap filling's height when
+     * `dem_return_filled` (the last dem_update_map(); a map read from a file fills on its first
+     * query). dem_get_z() and getHeight() answer through it; the other queries are variants
+     * (doc/user-guide.md, "Height queries"). */
+    HeightAnswer height(double x_m, double y_m) const;
+
     const multibin::BinGrid& grid() const;
     multibin::BinUpdateParams binUpdateParams() const;
-    /** Where a height comes from (getElevation()): the library's one source enum. */
-    using HeightSource = multibin::HeightSource;
-    /** Height [m] and sigma [m] at (x, y): measured (the cell surface, as getHeight()) or, with
-     * includeFilled, the result of the last gap filling (dem_update_map()) for a cell that is
-     * still unobserved. Filled cells keep certainty 0. */
+    /** Variant of height(): height [m] and sigma [m] at (x, y): measured (the cell surface, as
+     * getHeight()) or, with includeFilled, the result of the last gap filling (dem_update_map())
+     * for a cell that is still unobserved. Filled cells keep certainty 0. */
     HeightSource getElevation(double x_m, double y_m, double& height_m, double& sigma_m,
                               bool includeFilled = true) const;
     /** The same with the cell's value (cellHeight()) where measured: one value per cell, what
@@ -250,9 +271,10 @@ public:
     /** The last gap filling's result over the grid window it was run on. */
     const multibin::fill::FillResult& lastFill() const;
 
-    /** Height [m] and sigma [m] at (x, y) from the cell surface (its winning bin merged with the
-     * adjacent bins that agree with it, multibin/map/CellSurface.h); false if unobserved. With the
-     * dual grid, where both grids know the place and agree within 3 sigma, their independent
+    /** height() where measured: height [m] and sigma [m] at (x, y) from the map's surface (the
+     * cell surface: its winning bin merged with the adjacent bins that agree with it,
+     * multibin/map/CellSurface.h, at the point as `height_query` says); false if unobserved. With
+     * the dual grid, where both grids know the place and agree within 3 sigma, their independent
      * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
     /** Height [m] and sigma [m] of the sub-cell surface at (x, y): the plane of the cell's
