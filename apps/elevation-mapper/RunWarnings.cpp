@@ -33,6 +33,8 @@ std::vector<Gate> gatesOf(const mrpt::maps::CMultiBinElevationMap& map) {
         {"laser low intensity", m.laser.lowIntensity,
          "laser_agc, laser_min_restored_intensity, laser_intensity_check_range_m"},
         {"laser mixed pixels", m.laser.mixedPixel, "laser_mixed_pixel_*"},
+        {"depth flying pixels", m.depth.flyingPixel, "depth_flying_pixel_*"},
+        {"depth frame border", m.depth.frameBorder, "depth_border_px"},
     };
 }
 }  // namespace

@@ -275,6 +275,10 @@ void visitKeys(Options& o, Visit&& visit) {
           positive("rad"));
     visit("depth_quantisation_step_per_m", depth.quantisationStep_per_m, atLeast(0, "1/m"));
     visit("depth_frame_sigma_relative", depth.frameSigmaRelative, atLeast(0));
+    visit("depth_flying_pixel_filter", depth.flyingPixelFilter);
+    visit("depth_flying_pixel_jump_relative", depth.flyingPixelJumpRelative, positive());
+    visit("depth_flying_pixel_radius_px", depth.flyingPixelRadius_px, atLeast(1, "px"));
+    visit("depth_border_px", depth.borderWidth_px, atLeast(0, "px"));
     visit("depth_max_elevation_uncertainty_m", depth.maxElevationUncertainty_m, atLeast(0, "m"));
 }
 }  // namespace

@@ -21,7 +21,8 @@ StereoStats& StereoStats::operator+=(const StereoStats& o) {
 
 DepthStats& DepthStats::operator+=(const DepthStats& o) {
     return util::addMembers(*this, o, &DepthStats::points, &DepthStats::notFinite,
-                            &DepthStats::outOfRange, &DepthStats::kept);
+                            &DepthStats::outOfRange, &DepthStats::flyingPixel,
+                            &DepthStats::frameBorder, &DepthStats::kept);
 }
 
 LidarStats& LidarStats::operator+=(const LidarStats& o) {

@@ -156,6 +156,15 @@ struct DepthModelOptions {
      * frameSigmaRelative r (key `depth_frame_sigma_relative` [-]). Both 0: points independent. */
     double quantisationStep_per_m = 0.003;
     double frameSigmaRelative = 0.005;
+    /** Depth-frame artefacts (DepthArtefacts.h; frames with a pixel grid only, not point
+     * clouds): flying pixels within flyingPixelRadius_px of a jump between neighbouring pixels
+     * larger than flyingPixelJumpRelative x the nearer depth, and the frame's border of
+     * borderWidth_px (keys `depth_flying_pixel_filter`, `depth_flying_pixel_jump_relative`,
+     * `depth_flying_pixel_radius_px`, `depth_border_px`). */
+    bool flyingPixelFilter = true;
+    double flyingPixelJumpRelative = 0.05;
+    int flyingPixelRadius_px = 1;
+    int borderWidth_px = 0;
     /** Eq 13's Delta_max for this model's points [m] (key `depth_max_elevation_uncertainty_m`): a
      * point counts if 3 sigma_z <= it. 0: the map's max_elevation_uncertainty_m
      * (doc/sensor-reach.md). */
