@@ -69,11 +69,13 @@ void screenForGrowth(const GrowthScreen& g, const float* xs, const float* ys, co
  * InsertStats::kBelowHorizon_rad below the map's horizontal; `down` is the sensor-to-map
  * rotation's last row. */
 size_t countSeenBelow(const PointsWithCov& sensorPoints, const Eigen::Vector3d& down) {
-    const double sinLimit = std::sin(multibin::InsertStats::kBelowHorizon_rad);
+    // d < -sin(limit) |v|, without a square root per point: d < 0 and d^2 > sin^2 |v|^2.
+    const double sin2 = std::pow(std::sin(multibin::InsertStats::kBelowHorizon_rad), 2);
     size_t n = 0;
     for (const PointWithCov& p : sensorPoints) {
         const Eigen::Vector3d v = p.point_m.cast<double>();
-        n += down.dot(v) < -sinLimit * v.norm();
+        const double d = down.dot(v);
+        n += size_t(d < 0) & size_t(d * d > sin2 * v.squaredNorm());
     }
     return n;
 }
