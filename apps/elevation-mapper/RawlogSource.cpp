@@ -17,6 +17,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "PoseOverTime.h"
 #include "RawlogSourceGuard.h"
 #include "RawlogStreamGuard.h"
 #include "multibin/io/ErrorMessage.h"
@@ -194,26 +195,28 @@ bool finitePose(const mrpt::poses::CPose3D& p) {
 }  // namespace
 
 size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& visit,
-                                     const Progress& progress) {
+                                     const Progress& progress, double robotPoseMaxDt_s,
+                                     PoseCounts* counts) {
     mrpt::io::CFileGZInputStream in;
     openOrThrow(in, path, "rawlog");
     const FileSize size = fileSize(path);
     const double total = std::max<double>(1.0, double(size.progress_bytes));
-    return forEachInStream(in, "rawlog '" + path + "'", size.bound_bytes, visit,
-                           [&](double, size_t n) {
-                               if (progress) progress(double(in.getPosition()) / total, n);
-                           });
+    return forEachInStream(
+        in, "rawlog '" + path + "'", size.bound_bytes, visit,
+        [&](double, size_t n) {
+            if (progress) progress(double(in.getPosition()) / total, n);
+        },
+        robotPoseMaxDt_s, counts);
 }
 
 size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& name,
                                      uint64_t sizeBound_bytes, const Visitor& visit,
-                                     const Progress& progress) {
+                                     const Progress& progress, double robotPoseMaxDt_s,
+                                     PoseCounts* counts) {
     RawlogStreamGuard guard(in);
     auto arch = mrpt::serialization::archiveFrom(guard);
     const uint64_t start = in.getPosition();
-    mrpt::poses::CPose3DPDFGaussian pose;  // latest CObservationRobotPose, or odometry
-    bool poseHasCov = false;
-    mrpt::poses::CPose3D odometry;
+    PoseOverTime poses(robotPoseMaxDt_s);
     size_t entries = 0;
     auto entryName = [&] { return name + ": entry " + std::to_string(entries); };
     auto visitObs = [&](const mrpt::obs::CObservation::Ptr& obs) {
@@ -221,11 +224,16 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
             if (!finitePose(rp->pose.mean))
                 throw std::runtime_error(entryName() + ": robot pose '" + rp->sensorLabel +
                                          "' is not finite");
-            pose = rp->pose;
-            poseHasCov = true;
+            poses.robotPose(rp->pose, rp->timestamp);
         }
         try {
-            visit(obs, pose, poseHasCov);
+            if (std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(obs)) {
+                const auto& rp = static_cast<const mrpt::obs::CObservationRobotPose&>(*obs);
+                visit(obs, rp.pose, true);  // itself: not a pose to count
+            } else {
+                const PoseOverTime::Pose p = poses.at(obs->timestamp);
+                visit(obs, p.pdf, p.hasCovariance);
+            }
         } catch (const std::exception& e) {
             throw std::runtime_error(entryName() + ": " + multibin::oneLineMessage(e));
         }
@@ -280,31 +288,31 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
                                              " (2D odometry) has no pose change");
                 k++;
             }
-            // Odometry, used only while no CObservationRobotPose has been seen.
-            mrpt::poses::CPose3D step;
+            // Odometry: the pose from the origin, and since the latest robot pose (PoseOverTime).
+            mrpt::poses::CPose3DPDFGaussian step;
             bool haveStep = false;
             // MRPT's best estimate compares covariances: none when they are NaN.
             auto a2 = acts->getBestMovementEstimation();
             if (!a2) a2 = acts->getActionByClass<mrpt::obs::CActionRobotMovement2D>();
             if (a2) {
-                step = mrpt::poses::CPose3D(a2->poseChange->getMeanVal());
+                step.copyFrom(*a2->poseChange);
                 haveStep = true;
             } else if (auto m3 = acts->getActionByClass<mrpt::obs::CActionRobotMovement3D>()) {
-                step = m3->poseChange.mean;
+                step = m3->poseChange;
                 haveStep = true;
             }
-            if (haveStep && !finitePose(step))
+            if (haveStep && !finitePose(step.mean))
                 throw std::runtime_error(entryName() +
                                          " (an action collection): the odometry "
                                          "is not finite");
-            if (haveStep) odometry = odometry + step;
-            if (!poseHasCov) pose.mean = odometry;
+            if (haveStep) poses.odometry(step);
         } else {
             throw std::runtime_error(entryName() + " is a " + obj->GetRuntimeClass()->className +
                                      ", not an observation, sensory frame or action");
         }
         if (progress) progress(0.0, entries + 1);
     }
+    if (counts) *counts = poses.counts();
     return entries;
 }
 

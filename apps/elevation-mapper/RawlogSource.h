@@ -11,10 +11,13 @@
 #include <memory>
 #include <string>
 
+#include "PoseOverTime.h"
+
 /** Streams the observations of a rawlog (either format: actions + sensory frames, or
- * observations only), each with the robot pose PDF it was taken at: the latest
- * CObservationRobotPose (mean and covariance), else the odometry of the actions composed from the
- * origin (mean only).
+ * observations only), each with the robot pose PDF it was taken at (PoseOverTime): the latest
+ * CObservationRobotPose within robot_pose_max_dt_s, else that pose composed with the odometry
+ * since it (covariance grown by the odometry's), else the odometry composed from the origin
+ * (mean only: the map's default covariance).
  *
  * Every entry is checked before use: a null entry, an object of another class, a null action or
  * odometry PDF, a non-finite odometry are errors naming the file and the entry. Reading an entry
@@ -32,14 +35,18 @@ public:
 
     /** Reads the whole rawlog; throws std::runtime_error naming the file and the entry on a
      * truncated, corrupt or hostile file, and on an error of `visit` (prefixed with the file and
-     * the entry). Returns the number of entries read. */
+     * the entry). Returns the number of entries read. `robotPoseMaxDt_s`: how long a
+     * CObservationRobotPose stays valid without odometry (the map's robot_pose_max_dt_s);
+     * `counts`, if given, receives how the observations got their pose. */
     static size_t forEachInRawlog(const std::string& path, const Visitor& visit,
-                                  const Progress& progress);
+                                  const Progress& progress, double robotPoseMaxDt_s = 0.5,
+                                  PoseCounts* counts = nullptr);
     /** The same on an open stream of uncompressed rawlog bytes; `name` names it in errors,
      * `sizeBound_bytes` bounds the bytes it holds from its current position. */
     static size_t forEachInStream(mrpt::io::CStream& in, const std::string& name,
                                   uint64_t sizeBound_bytes, const Visitor& visit,
-                                  const Progress& progress);
+                                  const Progress& progress, double robotPoseMaxDt_s = 0.5,
+                                  PoseCounts* counts = nullptr);
 
     /** Loads a simplemap file (gz-compressed or not); throws std::runtime_error naming the file
      * (and the keyframe) if it is missing, truncated, corrupt or holds a null keyframe pose,

@@ -36,6 +36,7 @@
 #include "ObservationTally.h"
 #include "ProgressBar.h"
 #include "RawlogSource.h"
+#include "RunWarnings.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
@@ -281,6 +282,8 @@ int run(const Arguments& args, std::string& stage) {
     using Clock = std::chrono::steady_clock;
     double insert_s = 0;  // the multi-bin map's own insertion time
     ObservationTally tally;
+    RunFacts facts;
+    PoseCounts poseCounts;  // a rawlog's: how its observations got their pose
     auto insertTimed = [&](const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& pose, bool poseHasCov) {
         tally.before(*elevation);
@@ -289,6 +292,7 @@ int run(const Arguments& args, std::string& stage) {
                                          : elevation->insertObservation(obs, pose.mean);
         insert_s += std::chrono::duration<double>(Clock::now() - t0).count();
         tally.after(obs, inserted, *elevation);
+        facts.observationsWithPoseCovariance += inserted && poseHasCov;
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
     stage = "mapping " + inputName;
@@ -305,7 +309,8 @@ int run(const Arguments& args, std::string& stage) {
                         m->insertObservation(*obs, pose.mean);
                 }
             },
-            [&](double f, size_t n) { bar.update(f, std::to_string(n) + " entries"); });
+            [&](double f, size_t n) { bar.update(f, std::to_string(n) + " entries"); },
+            elevation->insertionOptions.robot_pose_max_dt_s, &poseCounts);
     } else {
         const mrpt::maps::CSimpleMap sm = RawlogSource::loadSimplemap(args.simplemap);
         for (const auto& m : maps.maps)
@@ -363,6 +368,9 @@ int run(const Arguments& args, std::string& stage) {
               << insertSummary(elevation->insertStats()) << "\n"
               << "observations with the default pose covariance: " << elevation->poseFallbackCount()
               << "\n"
+              << "rawlog poses: " << poseCounts.robotPose << " robot pose, "
+              << poseCounts.odometrySinceRobotPose << " robot pose + odometry since, "
+              << poseCounts.defaultCovariance << " default covariance\n"
               << "cells filled: " << fs_.median << " by weighted median, " << fs_.gaussian
               << " by Gaussian surface (" << fs_.supportAreas << " support areas); " << fs_.unfilled
               << " left unknown\n"
@@ -376,6 +384,8 @@ int run(const Arguments& args, std::string& stage) {
         std::cout << "\nEvaluation against " << args.groundTruth << " (report.json):\n" << table;
         if (args.plots) drawFigures(folder, selection.asc ? nullptr : &layers);
     }
+    for (const std::string& w : runWarnings(*elevation, facts))
+        std::cout << "warning: " << w << "\n";
     return 0;
 }
 

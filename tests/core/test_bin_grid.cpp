@@ -241,6 +241,10 @@ TEST(BinGrid, BlockClassificationDecidesAsTheScalarGates) {
             ss.badCovariance++;
             continue;
         }
+        if (!params.passesEq13(c.zz)) {  // before the window: too uncertain anywhere
+            ss.tooUncertain++;
+            continue;
+        }
         const int ix = scalar.cellIndex(p.point_m.x()), iy = scalar.cellIndex(p.point_m.y());
         if (!scalar.window().contains(ix, iy)) {
             ss.outsideMap++;

@@ -19,35 +19,15 @@
 #include <random>
 #include <string>
 
+#include "mrpt_datasets.h"
 #include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin::sensors;
 
 namespace {
-/** The observations of a rawlog of MRPT's datasets folder (fails the test if it is missing: the
- * set-up installs mrpt-common). */
-std::vector<mrpt::obs::CObservation::Ptr> datasetObservations(const std::string& name) {
-    mrpt::obs::CRawlog rawlog;
-    const std::string path = std::string(MRPT_DATASETS_DIR) + "/" + name;
-    EXPECT_TRUE(rawlog.loadFromRawLogFile(path)) << path << " (Debian package mrpt-common)";
-    std::vector<mrpt::obs::CObservation::Ptr> out;
-    for (size_t i = 0; i < rawlog.size(); i++) {
-        if (rawlog.getType(i) == mrpt::obs::CRawlog::etObservation)
-            out.push_back(rawlog.getAsObservation(i));
-        else if (rawlog.getType(i) == mrpt::obs::CRawlog::etSensoryFrame)
-            for (const auto& o : *rawlog.getAsObservations(i)) out.push_back(o);
-    }
-    for (auto& o : out) o->load();
-    return out;
-}
-
-/** A nearly exact robot pose at the origin (1 mm, 1 mrad). */
-mrpt::poses::CPose3DPDFGaussian originPose() {
-    mrpt::poses::CPose3DPDFGaussian pdf;
-    for (int i = 0; i < 6; i++) pdf.cov(i, i) = 1e-6;
-    return pdf;
-}
+using multibin::test::datasetObservations;
+using multibin::test::originPose;
 
 /** Every cell of the map with a measured height has a finite height and sigma; returns how many
  * cells are measured. */
@@ -84,29 +64,12 @@ TEST(MrptDatasets, Vlp16ScanFloorIsMrptsPlaneAndEveryReturnIsAccountedFor) {
     mrpt::maps::CSimplePointsMap mrptPoints;
     mrptPoints.insertObservation(*velodyne);
     ASSERT_EQ(mrptPoints.size(), 11305u);
-    std::vector<Eigen::Vector3d> P;
-    for (size_t i = 0; i < mrptPoints.size(); i++) {
-        float x, y, z;
-        mrptPoints.getPoint(i, x, y, z);
-        P.emplace_back(x, y, z);
-    }
-    std::mt19937 rng(1);
-    std::uniform_int_distribution<size_t> pick(0, P.size() - 1);
-    size_t bestInliers = 0;
-    Eigen::Vector3d n(0, 0, 1);
-    double d = 0;
-    for (int it = 0; it < 3000; it++) {
-        const Eigen::Vector3d a = P[pick(rng)], b = P[pick(rng)], c = P[pick(rng)];
-        Eigen::Vector3d m = (b - a).cross(c - a);
-        if (m.norm() < 1e-9) continue;
-        m = m.normalized() * (m.z() < 0 ? -1.0 : 1.0);
-        if (m.z() < 0.8) continue;
-        size_t inliers = 0;
-        for (const auto& p : P) inliers += std::abs(m.dot(p) - m.dot(a)) < 0.05;
-        if (inliers > bestInliers) bestInliers = inliers, n = m, d = m.dot(a);
-    }
-    ASSERT_GT(bestInliers, 1000u);
-    auto floorZ = [&](double x, double y) { return (d - n.x() * x - n.y() * y) / n.z(); };
+    const std::vector<Eigen::Vector3d> P = multibin::test::pointsOf(mrptPoints);
+    const multibin::test::FloorPlane floor = multibin::test::fitFloorPlane(P);
+    ASSERT_GT(floor.inliers, 1000u);
+    const Eigen::Vector3d n = floor.normal;
+    const size_t bestInliers = floor.inliers;
+    auto floorZ = [&](double x, double y) { return floor.z(x, y); };
 
     mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
     c.resolution_m = 0.25;

@@ -15,10 +15,10 @@
 namespace multibin {
 
 InsertStats& InsertStats::operator+=(const InsertStats& o) {
-    return util::addMembers(*this, o, &InsertStats::accepted, &InsertStats::outOfRange,
-                            &InsertStats::notFinite, &InsertStats::badCovariance,
-                            &InsertStats::outsideMap, &InsertStats::outsideBinRange,
-                            &InsertStats::tooUncertain, &InsertStats::continuityRejected);
+    return util::addMembers(
+        *this, o, &InsertStats::accepted, &InsertStats::outOfRange, &InsertStats::notFinite,
+        &InsertStats::badCovariance, &InsertStats::outsideMap, &InsertStats::outsideBinRange,
+        &InsertStats::tooUncertain, &InsertStats::continuityRejected, &InsertStats::seenBelow);
 }
 
 BinGrid::BinGrid(double cellSize_m) : m_store(cellSize_m) { m_index.reset(window()); }
@@ -199,10 +199,11 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
         const int f = flags[i];
         const int finite = f & 1, positiveDefinite = f >> 1 & 1, eq13 = f >> 2 & 1,
                   binFits = f >> 3 & 1;
-        // The first gate failed decides, in the order of the scalar checks.
+        // The first gate failed decides, in the order of the scalar checks; eq 13 before the
+        // window: a point too uncertain to grow the map is too uncertain, wherever it lies.
         const int rest =
-            (1 - inWindow) * kOutsideMap +
-            inWindow * ((1 - eq13) * kTooUncertain + eq13 * (1 - binFits) * kOutsideBinRange);
+            (1 - eq13) * kTooUncertain +
+            eq13 * ((1 - inWindow) * kOutsideMap + inWindow * (1 - binFits) * kOutsideBinRange);
         const int status =
             (1 - finite) * kNotFinite +
             finite * ((1 - positiveDefinite) * kCheckSingular + positiveDefinite * rest);

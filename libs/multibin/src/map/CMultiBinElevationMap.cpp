@@ -370,7 +370,10 @@ CMultiBinElevationMap::~CMultiBinElevationMap() = default;
 const multibin::BinGrid& CMultiBinElevationMap::grid() const { return m_impl->grid; }
 const multibin::BinGrid& CMultiBinElevationMap::localGrid() const { return m_impl->local; }
 bool CMultiBinElevationMap::fillIsStale() const { return m_impl->fillStale; }
-const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const { return m_impl->fill; }
+const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const {
+    fillIfLoaded();
+    return m_impl->fill;
+}
 const multibin::InsertStats& CMultiBinElevationMap::insertStats() const { return m_impl->stats; }
 const multibin::VisibilityStats& CMultiBinElevationMap::visibilityStats() const {
     return m_impl->visibilityStats;
@@ -441,9 +444,11 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
 
 bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
                                       double& sigma_m) const {
-    return insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane
-               ? heightAt(x_m, y_m, height_m, sigma_m)
-               : cellHeight(x_m, y_m, height_m, sigma_m);
+    const HeightAnswer a = height(x_m, y_m);
+    if (a.source != HeightSource::Measured) return false;
+    height_m = a.height_m;
+    sigma_m = a.sigma_m;
+    return true;
 }
 
 bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, double& height_m,
@@ -552,7 +557,7 @@ bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y
     // Horizontal position taken as exact to the cell; only the height variance matters here.
     const float tiny = static_cast<float>(1e-12);
     pts[0].cov_m2 = {tiny, 0, 0, tiny, 0, float(sigma * sigma)};
-    growToCover(pts, Eigen::Vector3d(xr, yr, z));
+    growToCover(pts, Eigen::Vector3d(xr, yr, z), binUpdateParams());
     return insertPoints(pts).accepted == 1;
 }
 

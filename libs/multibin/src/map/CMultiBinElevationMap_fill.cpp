@@ -2,8 +2,9 @@
  * CMultiBinElevationMap: gap filling and the DEM queries that return filled heights.
  *
  * Filling is lazy: insertions only mark the last fill stale, and dem_update_map() (MRPT's hook
- * for "make every observation count") refills the whole window once. Filled cells keep
- * certainty 0; a cell measured after the fill answers with its measurement. */
+ * for "make every observation count") refills the whole window once. A map read from a file
+ * fills itself on its first query (fillIfLoaded()), so it answers as the map that wrote it. Filled
+ * cells keep certainty 0; a cell measured after the fill answers with its measurement. */
 #include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
@@ -14,7 +15,10 @@ using namespace mrpt::maps;
 
 void CMultiBinElevationMap::dem_update_map() {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
-    if (!m_impl->fillStale) return;
+    if (m_impl->fillStale) fillNow();
+}
+
+void CMultiBinElevationMap::fillNow() const {
     const multibin::CellWindow w = m_impl->grid.window();
     multibin::fill::HeightRaster raster(multibin::Lattice{m_impl->grid.cellSize_m(), w});
     const Eigen::Vector2d& o = m_impl->origin_m;  // getHeight() takes pose-frame coordinates
@@ -32,10 +36,27 @@ void CMultiBinElevationMap::dem_update_map() {
     m_impl->fillStale = false;
 }
 
+void CMultiBinElevationMap::fillIfLoaded() const {
+    // Inside another entry point the lock is held: the outermost one has filled, or skipped.
+    if (m_impl->lock.heldByThisThread()) return;
+    // Bins that no insertion put there came from a file (serialization clears the counts):
+    // the map that wrote them had filled its gaps, so this one fills once, on first query.
+    auto loadedAndUnfilled = [&] {
+        return m_impl->fillStale && m_impl->stats.accepted == 0 && m_impl->grid.binCount() > 0;
+    };
+    {
+        const multibin::MapLock::Shared lock(m_impl->lock);
+        if (!loadedAndUnfilled()) return;
+    }
+    const multibin::MapLock::Exclusive lock(m_impl->lock);
+    if (loadedAndUnfilled()) fillNow();
+}
+
 CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x_m, double y_m,
                                                                         double& height_m,
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
+    fillIfLoaded();
     return elevationQuery(insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane,
                           x_m, y_m, height_m, sigma_m, includeFilled);
 }
@@ -44,6 +65,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double 
                                                                          double& height_m,
                                                                          double& sigma_m,
                                                                          bool includeFilled) const {
+    fillIfLoaded();
     return elevationQuery(false, x_m, y_m, height_m, sigma_m, includeFilled);
 }
 
@@ -70,6 +92,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::elevationQuery(
 
 bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
                                               double& z_out) const {
+    fillIfLoaded();
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (cx >= dem_get_size_x() || cy >= dem_get_size_y()) return false;
     const multibin::CellWindow& w = m_impl->grid.window();
@@ -77,9 +100,19 @@ bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
                      m_impl->origin_m.y() + m_impl->grid.cellCenter_m(w.iy0 + int(cy)), z_out);
 }
 
+CMultiBinElevationMap::HeightAnswer CMultiBinElevationMap::height(double x_m, double y_m) const {
+    fillIfLoaded();
+    HeightAnswer a;
+    double h = 0, s = 0;
+    a.source =
+        elevationQuery(insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane, x_m,
+                       y_m, h, s, insertionOptions.dem_return_filled);
+    if (a.known()) a.height_m = h, a.sigma_m = s;
+    return a;
+}
+
 bool CMultiBinElevationMap::dem_get_z(const double x, const double y, double& z_out) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    double sigma;
-    return getElevation(x, y, z_out, sigma, insertionOptions.dem_return_filled) !=
-           HeightSource::Unknown;
+    const HeightAnswer a = height(x, y);
+    if (a.known()) z_out = a.height_m;
+    return a.known();
 }

@@ -66,6 +66,21 @@ void screenForGrowth(const GrowthScreen& g, const float* xs, const float* ys, co
     }
 }
 
+/** How many of the sensor-frame points lie along rays that point more than
+ * InsertStats::kBelowHorizon_rad below the map's horizontal; `down` is the sensor-to-map
+ * rotation's last row. */
+size_t countSeenBelow(const PointsWithCov& sensorPoints, const Eigen::Vector3d& down) {
+    // d < -sin(limit) |v|, without a square root per point: d < 0 and d^2 > sin^2 |v|^2.
+    const double sin2 = std::pow(std::sin(multibin::InsertStats::kBelowHorizon_rad), 2);
+    size_t n = 0;
+    for (const PointWithCov& p : sensorPoints) {
+        const Eigen::Vector3d v = p.point_m.cast<double>();
+        const double d = down.dot(v);
+        n += size_t(d < 0) & size_t(d * d > sin2 * v.squaredNorm());
+    }
+    return n;
+}
+
 /** Options may be set in code after construction: every insertion entry point checks them
  * before they reach the grid (a NaN certainty increment makes invalid bins). */
 void validateOptions(const CMultiBinElevationMap& map) {
@@ -221,22 +236,28 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     m_impl->stats.notFinite += sensed.stats.notFinite();
     if (sensorPoints.empty()) return false;
 
+    // Eq 13's limit is the sensor model's (a lidar's far points may be kept with their sigma):
+    // growth, the gate and the visibility constraint all see the same one.
+    multibin::BinUpdateParams params = binUpdateParams();
+    if (const auto model = sensed.stats.model())
+        params.maxElevationUncertainty_m = insertionOptions.sensors.maxElevationUncertaintyFor(
+            *model, params.maxElevationUncertainty_m);
     const multibin::PosePropagator propagator(robotPose, sensorPose);
     const Eigen::Vector3d& sensor_m = propagator.sensorOriginInMap_m();
+    m_impl->stats.seenBelow +=
+        countSeenBelow(sensorPoints, propagator.rotationSensorToMap().row(2).transpose());
     if (isDualGrid()) recenterRelative(robotPose.mean.x(), robotPose.mean.y());
-    const bool grow = !isDualGrid() && growthNeeded(sensorPoints, propagator);
+    const bool grow = !isDualGrid() && growthNeeded(sensorPoints, propagator, params);
     if (grow || sensed.depthFrameError) {
         // Growth is sized by all map-frame points, and a depth frame's shared error is counted
         // per map cell: propagate them first.
         PointsWithCov mapPoints;
         multibin::PoseVariances pose;
         propagator.apply(sensorPoints, mapPoints, &pose);
-        if (grow) growToCover(mapPoints, sensor_m);
+        if (grow) growToCover(mapPoints, sensor_m, params);
         multibin::BinGrid& grid = gridFor(obs);
         size_t ownGateRejected = 0;
         if (sensed.depthFrameError) {
-            const multibin::BinUpdateParams params = binUpdateParams();
-            const multibin::CellWindow& w = grid.window();
             ownGateRejected = multibin::sensors::addFrameSharedCovariance(
                 mapPoints, sensor_m, insertionOptions.sensors.depth,
                 [&](const PointsWithCov& pts, std::vector<Eigen::Vector2i>& cells,
@@ -244,20 +265,19 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
                     for (size_t i = 0; i < pts.size(); i++) {
                         const PointWithCov& p = pts[i];
                         cells[i] = {grid.cellIndex(p.point_m.x()), grid.cellIndex(p.point_m.y())};
-                        // What the grid would count as too uncertain: finite, inside the window.
+                        // What the grid would count as too uncertain (inside the window or not).
                         failsOwnGate[i] = p.point_m.allFinite() && std::isfinite(p.cov_m2.zz) &&
-                                          w.contains(cells[i].x(), cells[i].y()) &&
                                           !params.passesEq13(p.cov_m2.zz);
                     }
                 });
         }
         return insertIntoGrid(
-                   grid,
-                   [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
+                   grid, params,
+                   [&](multibin::BinGrid& g, const multibin::BinUpdateParams& gridParams) {
                        if (!sensed.depthFrameError)
-                           return g.insertPoints(mapPoints, params, continuityBound_m, &pose);
+                           return g.insertPoints(mapPoints, gridParams, continuityBound_m, &pose);
                        // Eq 13 was applied to each point's own variance above.
-                       multibin::BinUpdateParams shared = params;
+                       multibin::BinUpdateParams shared = gridParams;
                        shared.maxElevationUncertainty_m = std::numeric_limits<double>::infinity();
                        multibin::InsertStats s =
                            g.insertPoints(mapPoints, shared, continuityBound_m, &pose);
@@ -269,16 +289,18 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
     }
     // The window stays as it is: propagate and fuse block by block (bit-identical result).
     return insertIntoGrid(
-               gridFor(obs),
-               [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
-                   return g.insertSensorPoints(propagator, sensorPoints, params, continuityBound_m);
+               gridFor(obs), params,
+               [&](multibin::BinGrid& g, const multibin::BinUpdateParams& gridParams) {
+                   return g.insertSensorPoints(propagator, sensorPoints, gridParams,
+                                               continuityBound_m);
                },
                sensor_m, sensed.cameraFrame)
                .accepted > 0;
 }
 
 bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
-                                         const multibin::PosePropagator& propagator) const {
+                                         const multibin::PosePropagator& propagator,
+                                         const multibin::BinUpdateParams& params) const {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || sensorPoints.empty()) return false;
     const multibin::CellWindow& w = m_impl->grid.window();
@@ -304,7 +326,6 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     screen.y1_m = y1;
     screen.half_m = half;
     screen.originNorm_m = s.cwiseAbs().sum();
-    const multibin::BinUpdateParams params = binUpdateParams();
     constexpr size_t kBatch = 256;
     PointWithCov exact[kBatch];
     size_t pending = 0;
@@ -343,7 +364,7 @@ multibin::InsertStats CMultiBinElevationMap::insertPoints(
     validateOptions(*this);
     m_impl->originFixed = true;  // the points are relative to it
     return insertIntoGrid(
-        isDualGrid() ? m_impl->local : m_impl->grid,
+        isDualGrid() ? m_impl->local : m_impl->grid, binUpdateParams(),
         [&](multibin::BinGrid& g, const multibin::BinUpdateParams& params) {
             return g.insertPoints(mapPoints, params, continuityBound_m, pose);
         },
@@ -358,9 +379,8 @@ void CMultiBinElevationMap::growToCoverPoints(const PointsWithCov& mapPoints,
 }
 
 multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
-    multibin::BinGrid& grid, const FuseIntoGrid& fuse,
+    multibin::BinGrid& grid, const multibin::BinUpdateParams& params, const FuseIntoGrid& fuse,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m, bool cameraFrame) {
-    const multibin::BinUpdateParams params = binUpdateParams();
     grid.beginCycle();
     grid.setInsertionThreads(insertionOptions.insertion_threads);
     m_impl->fillStale = true;
@@ -379,12 +399,12 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
 }
 
 void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
-                                        const Eigen::Vector3d& sensor_m) {
+                                        const Eigen::Vector3d& sensor_m,
+                                        const multibin::BinUpdateParams& params) {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || mapPoints.empty()) return;
     const double half = 0.5 * c.max_size_m;
     double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
-    const multibin::BinUpdateParams params = binUpdateParams();
     for (const PointWithCov& p : mapPoints) {
         const double x = p.point_m.x(), y = p.point_m.y();
         if (!canGrowTheMap(p, sensor_m, half, params)) continue;

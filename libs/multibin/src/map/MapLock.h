@@ -43,6 +43,14 @@ public:
     using Shared = Guard<false>;
     using Exclusive = Guard<true>;
 
+    /** Whether this thread holds the lock (for reading or writing): an entry point called
+     * inside another may not take it for writing. */
+    bool heldByThisThread() const {
+        for (const auto& e : held())
+            if (e.first == this) return true;
+        return false;
+    }
+
 private:
     void acquire(bool exclusive) const {
         if (exclusive) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "RayPoint.h"
+#include "multibin/sensors/DepthArtefacts.h"
 #include "multibin/util/VectorClones.h"
 
 namespace multibin::sensors {
@@ -23,6 +24,71 @@ void appendPointsMap(const mrpt::maps::CPointsMap& pts, const DepthModelOptions&
                      double minRange_m, double maxRange_m, PointsWithCov& out, DepthStats& stats) {
     stats.points += pts.size();
     count(appendCloudPoints(pts, minRange_m, maxRange_m, opts.raySigmas(), out), stats);
+}
+}  // namespace
+
+namespace {
+/** The 3D points of a frame whose pixels are known (points3D_idxs_x/y), without the artefacts
+ * DepthArtefacts.h marks (counted): the arrays to make points from. */
+void withoutArtefacts(const mrpt::obs::CObservation3DRangeScan& scan, const DepthModelOptions& opts,
+                      std::vector<float>& xs, std::vector<float>& ys, std::vector<float>& zs,
+                      DepthStats& stats) {
+    const size_t n = scan.points3D_x.size();
+    int rows = int(scan.cameraParams.nrows), cols = int(scan.cameraParams.ncols);
+    for (size_t i = 0; i < n; i++) {  // pixels beyond the stated size: the grid the indices need
+        rows = std::max(rows, int(scan.points3D_idxs_y[i]) + 1);
+        cols = std::max(cols, int(scan.points3D_idxs_x[i]) + 1);
+    }
+    // MRPT's sensor frame looks along +x: x is the depth.
+    std::vector<float> depth(size_t(rows) * size_t(cols), 0.f);
+    auto pixel = [&](size_t i) {
+        return size_t(scan.points3D_idxs_y[i]) * size_t(cols) + scan.points3D_idxs_x[i];
+    };
+    for (size_t i = 0; i < n; i++)
+        if (scan.points3D_x[i] > 0 && std::isfinite(scan.points3D_x[i]))
+            depth[pixel(i)] = scan.points3D_x[i];
+    const std::vector<DepthPixel> marks = depthArtefacts(depth, rows, cols, opts);
+    for (size_t i = 0; i < n; i++) {
+        const DepthPixel m = marks[pixel(i)];
+        if (m == DepthPixel::FlyingPixel && depth[pixel(i)] > 0) {
+            stats.flyingPixel++;
+        } else if (m == DepthPixel::FrameBorder && depth[pixel(i)] > 0) {
+            stats.frameBorder++;
+        } else {
+            xs.push_back(scan.points3D_x[i]);
+            ys.push_back(scan.points3D_y[i]);
+            zs.push_back(scan.points3D_z[i]);
+        }
+    }
+}
+
+/** The range image of a frame without its artefacts (zeroed, counted): a copy holding only what
+ * unprojection needs. */
+mrpt::obs::CObservation3DRangeScan rangeImageWithoutArtefacts(
+    const mrpt::obs::CObservation3DRangeScan& scan, const DepthModelOptions& opts,
+    DepthStats& stats) {
+    mrpt::obs::CObservation3DRangeScan out;
+    out.hasRangeImage = true;
+    out.rangeImage = scan.rangeImage;
+    out.rangeUnits = scan.rangeUnits;
+    out.range_is_depth = scan.range_is_depth;
+    out.cameraParams = scan.cameraParams;
+    out.sensorPose = scan.sensorPose;
+    const int rows = int(scan.rangeImage.rows()), cols = int(scan.rangeImage.cols());
+    std::vector<float> depth(size_t(rows) * size_t(cols));
+    for (int r = 0; r < rows; r++)
+        for (int c = 0; c < cols; c++)
+            depth[size_t(r) * size_t(cols) + size_t(c)] =
+                float(scan.rangeImage(r, c)) * scan.rangeUnits;
+    const std::vector<DepthPixel> marks = depthArtefacts(depth, rows, cols, opts);
+    for (int r = 0; r < rows; r++)
+        for (int c = 0; c < cols; c++) {
+            const DepthPixel m = marks[size_t(r) * size_t(cols) + size_t(c)];
+            if (m == DepthPixel::Keep || out.rangeImage(r, c) == 0) continue;
+            (m == DepthPixel::FlyingPixel ? stats.flyingPixel : stats.frameBorder)++;
+            out.rangeImage(r, c) = 0;
+        }
+    return out;
 }
 }  // namespace
 
@@ -39,6 +105,15 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
                 "': points3D_x, points3D_y and points3D_z have different sizes (" +
                 std::to_string(nx) + ", " + std::to_string(ny) + ", " + std::to_string(nz) + ")");
         stats.points += nx;
+        // Without pixel indices the points have no image to find artefacts in.
+        if (scan.points3D_idxs_x.size() == nx && scan.points3D_idxs_y.size() == nx && nx > 0) {
+            std::vector<float> xs, ys, zs;
+            withoutArtefacts(scan, opts, xs, ys, zs, stats);
+            count(appendRayPoints(xs.data(), ys.data(), zs.data(), xs.size(), minRange_m,
+                                  maxRange_m, opts.raySigmas(), out),
+                  stats);
+            return;
+        }
         count(
             appendRayPoints(scan.points3D_x.data(), scan.points3D_y.data(), scan.points3D_z.data(),
                             nx, minRange_m, maxRange_m, opts.raySigmas(), out),
@@ -47,8 +122,14 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
         mrpt::maps::CSimplePointsMap local;
         mrpt::obs::T3DPointsProjectionParams pp;
         pp.takeIntoAccountSensorPoseOnRobot = false;  // sensor frame (+x forward)
-        // unprojectInto() only fills caches of the observation; the data are not changed.
-        const_cast<mrpt::obs::CObservation3DRangeScan&>(scan).unprojectInto(local, pp);
+        DepthStats removed;
+        mrpt::obs::CObservation3DRangeScan filtered =
+            rangeImageWithoutArtefacts(scan, opts, removed);
+        filtered.unprojectInto(local, pp);
+        // The zeroed pixels are not in `local`: seen, and counted as what removed them.
+        stats.points += removed.flyingPixel + removed.frameBorder;
+        stats.flyingPixel += removed.flyingPixel;
+        stats.frameBorder += removed.frameBorder;
         appendPointsMap(local, opts, minRange_m, maxRange_m, out, stats);
     }
 }

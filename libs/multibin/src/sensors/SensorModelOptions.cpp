@@ -79,6 +79,25 @@ SensorModelKind SensorModelOptions::modelFor(const std::string& label,
     return it == modelByLabel.end() ? classDefault : it->second;
 }
 
+double SensorModelOptions::maxElevationUncertaintyFor(SensorModelKind kind, double map_m) const {
+    double own_m = 0;
+    switch (kind) {
+        case SensorModelKind::laser:
+            own_m = laser.maxElevationUncertainty_m;
+            break;
+        case SensorModelKind::lidar:
+            own_m = lidar.maxElevationUncertainty_m;
+            break;
+        case SensorModelKind::stereo:
+            own_m = stereo.maxElevationUncertainty_m;
+            break;
+        case SensorModelKind::depth:
+            own_m = depth.maxElevationUncertainty_m;
+            break;
+    }
+    return own_m > 0 ? own_m : map_m;
+}
+
 LidarModelOptions LidarModelOptions::forSensor(const std::string& name) {
     // Sources and derivations: doc/sensor-models.md, "Lidar".
     LidarModelOptions o;
@@ -180,6 +199,7 @@ void visitKeys(Options& o, Visit&& visit) {
           laser.continuityAllowance_m, atLeast(0, "m"));
     visit({"laser_continuity_max_dt_s", "laser_continuity_max_dt"}, laser.continuityMaxDt_s,
           positive("s"));
+    visit("laser_max_elevation_uncertainty_m", laser.maxElevationUncertainty_m, atLeast(0, "m"));
     // Stereo
     visit("stereo_left_intrinsics_sigma", stereo.leftIntrinsicsSigma, atLeast(0));
     visit("stereo_right_intrinsics_sigma", stereo.rightIntrinsicsSigma, atLeast(0));
@@ -215,6 +235,7 @@ void visitKeys(Options& o, Visit&& visit) {
           positive("px"));
     visit({"stereo_cloud_baseline_m", "stereo_cloud_baseline"}, stereo.cloudBaseline_m,
           positive("m"));
+    visit("stereo_max_elevation_uncertainty_m", stereo.maxElevationUncertainty_m, atLeast(0, "m"));
     // Lidar: the sensor's published figures first, then the keys that override them
     custom(
         "lidar_sensor",
@@ -240,6 +261,7 @@ void visitKeys(Options& o, Visit&& visit) {
           atLeast(0, "rad"));
     visit({"lidar_beam_divergence_rad", "lidar_beam_divergence"}, lidar.beamDivergence_rad,
           atLeast(0, "rad"));
+    visit("lidar_max_elevation_uncertainty_m", lidar.maxElevationUncertainty_m, atLeast(0, "m"));
     custom(
         "sensor_models",
         [&](StrictConfigSection& s, const std::string& key) {
@@ -255,6 +277,11 @@ void visitKeys(Options& o, Visit&& visit) {
           positive("rad"));
     visit("depth_quantisation_step_per_m", depth.quantisationStep_per_m, atLeast(0, "1/m"));
     visit("depth_frame_sigma_relative", depth.frameSigmaRelative, atLeast(0));
+    visit("depth_flying_pixel_filter", depth.flyingPixelFilter);
+    visit("depth_flying_pixel_jump_relative", depth.flyingPixelJumpRelative, positive());
+    visit("depth_flying_pixel_radius_px", depth.flyingPixelRadius_px, atLeast(1, "px"));
+    visit("depth_border_px", depth.borderWidth_px, atLeast(0, "px"));
+    visit("depth_max_elevation_uncertainty_m", depth.maxElevationUncertainty_m, atLeast(0, "m"));
 }
 }  // namespace
 

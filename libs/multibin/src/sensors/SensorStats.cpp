@@ -21,7 +21,8 @@ StereoStats& StereoStats::operator+=(const StereoStats& o) {
 
 DepthStats& DepthStats::operator+=(const DepthStats& o) {
     return util::addMembers(*this, o, &DepthStats::points, &DepthStats::notFinite,
-                            &DepthStats::outOfRange, &DepthStats::kept);
+                            &DepthStats::outOfRange, &DepthStats::flyingPixel,
+                            &DepthStats::frameBorder, &DepthStats::kept);
 }
 
 LidarStats& LidarStats::operator+=(const LidarStats& o) {
@@ -42,6 +43,14 @@ size_t SensorModelStats::outOfRange() const {
 
 size_t SensorModelStats::notFinite() const {
     return laser.notFinite + stereo.notFinite + depth.notFinite + lidar.notFinite;
+}
+
+std::optional<SensorModelKind> SensorModelStats::model() const {
+    if (laser.beams > 0) return SensorModelKind::laser;
+    if (lidar.returns > 0) return SensorModelKind::lidar;
+    if (stereo.pixels > 0 || stereo.pairs > 0) return SensorModelKind::stereo;
+    if (depth.points > 0) return SensorModelKind::depth;
+    return std::nullopt;
 }
 
 }  // namespace multibin::sensors

@@ -50,10 +50,15 @@ namespace mrpt::maps {
  * covariances, propagated from the sensor model and the robot's 6-DoF pose PDF:
  * C = J_R C_R J_R^T + J_S C_S J_S^T.
  *
- * Observations accepted by insertObservation():
- * - mrpt::obs::CObservation2DRangeScan (laser; eq 14 continuity gate between consecutive scans),
- * - mrpt::obs::CObservation3DRangeScan (its points, or its depth image unprojected),
- * - mrpt::obs::CObservationPointCloud,
+ * Observations accepted by insertObservation() (the sensor model of each: its class's, or per
+ * sensor label with the key `sensor_models`):
+ * - mrpt::obs::CObservation2DRangeScan (laser; eq 14 continuity gate between consecutive scans;
+ *   or the lidar model),
+ * - mrpt::obs::CObservationStereoImages (stereo, eqs 4-10; OpenCV SGBM without a disparity),
+ * - mrpt::obs::CObservation3DRangeScan (depth camera: its points, or its depth image unprojected),
+ * - mrpt::obs::CObservationPointCloud (depth camera by default; lidar or stereo by label),
+ * - mrpt::obs::CObservationVelodyneScan (lidar, MRPT's calibrated point generation),
+ * - mrpt::obs::CObservationRotatingScan (lidar; single-row scans only),
  * - mrpt::obs::CObservationRobotPose: not inserted; the map keeps it and uses its covariance for
  *   the observations that follow while it is younger than TInsertionOptions::robot_pose_max_dt_s.
  *
@@ -238,13 +243,29 @@ public:
                            const Eigen::Vector3d& sensor_m);
 
     /** @name Queries @{ */
+    /** Where a height comes from: Unknown (0), Measured (1), FilledMedian (2), FilledSurface (3),
+     * FilledHarmonic (4); the number is the `source` raster layer's value. */
+    using HeightSource = multibin::HeightSource;
+    /** The answer of height(): NaN and HeightSource::Unknown where nothing is known. */
+    struct HeightAnswer {
+        double height_m = std::numeric_limits<double>::quiet_NaN();  //!< [m]
+        double sigma_m = std::numeric_limits<double>::quiet_NaN();   //!< one sigma [m]
+        HeightSource source = HeightSource::Unknown;
+        bool known() const { return source != HeightSource::Unknown; }
+    };
+    /** The recommended query: the terrain's height at (x, y) [m, pose frame] with its sigma and
+     * where it comes from. Measured places answer the map's surface (`height_query`: the
+     * sub-cell plane by default, heightAt()); unobserved ones the gap filling's height when
+     * `dem_return_filled` (the last dem_update_map(); a map read from a file fills on its first
+     * query). dem_get_z() and getHeight() answer through it; the other queries are variants
+     * (doc/user-guide.md, "Height queries"). */
+    HeightAnswer height(double x_m, double y_m) const;
+
     const multibin::BinGrid& grid() const;
     multibin::BinUpdateParams binUpdateParams() const;
-    /** Where a height comes from (getElevation()): the library's one source enum. */
-    using HeightSource = multibin::HeightSource;
-    /** Height [m] and sigma [m] at (x, y): measured (the cell surface, as getHeight()) or, with
-     * includeFilled, the result of the last gap filling (dem_update_map()) for a cell that is
-     * still unobserved. Filled cells keep certainty 0. */
+    /** Variant of height(): height [m] and sigma [m] at (x, y): measured (the cell surface, as
+     * getHeight()) or, with includeFilled, the result of the last gap filling (dem_update_map())
+     * for a cell that is still unobserved. Filled cells keep certainty 0. */
     HeightSource getElevation(double x_m, double y_m, double& height_m, double& sigma_m,
                               bool includeFilled = true) const;
     /** The same with the cell's value (cellHeight()) where measured: one value per cell, what
@@ -256,9 +277,10 @@ public:
     /** The last gap filling's result over the grid window it was run on. */
     const multibin::fill::FillResult& lastFill() const;
 
-    /** Height [m] and sigma [m] at (x, y) from the cell surface (its winning bin merged with the
-     * adjacent bins that agree with it, multibin/map/CellSurface.h); false if unobserved. With the
-     * dual grid, where both grids know the place and agree within 3 sigma, their independent
+    /** height() where measured: height [m] and sigma [m] at (x, y) from the map's surface (the
+     * cell surface: its winning bin merged with the adjacent bins that agree with it,
+     * multibin/map/CellSurface.h, at the point as `height_query` says); false if unobserved. With
+     * the dual grid, where both grids know the place and agree within 3 sigma, their independent
      * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
     /** Height [m] and sigma [m] of the sub-cell surface at (x, y): the plane of the cell's
@@ -343,7 +365,8 @@ public:
     size_t dem_get_size_y() const override;
     bool dem_get_z_by_cell(const size_t cx, const size_t cy, double& z_out) const override;
     bool dem_get_z(const double x, const double y, double& z_out) const override;
-    /** Runs gap filling if observations arrived since the last one (lazy: never per point). */
+    /** Runs gap filling if observations arrived since the last one (lazy: never per point). A
+     * map read from a file needs no call: it fills on its first query. */
     void dem_update_map() override;
     /** @} */
 
@@ -377,24 +400,36 @@ private:
      * where it filled the cell of (x, y). */
     HeightSource elevationQuery(bool subCell, double x_m, double y_m, double& height_m,
                                 double& sigma_m, bool includeFilled) const;
+    /** Gap filling of the whole window into the last fill (the caller holds the lock for
+     * writing): dem_update_map()'s work. */
+    void fillNow() const;
+    /** A map read from a file (bins, no insertion since) fills its gaps once, before its first
+     * query that may answer a filled height: it answers as the map that wrote it did. Called
+     * first by those queries; a no-op inside another entry point. */
+    void fillIfLoaded() const;
     /** Observation -> sensor-frame points -> map frame -> grid. */
     bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);
-    /** Grows the window (if allowed) to cover map-frame points near the sensor. */
-    void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m);
+    /** Grows the window (if allowed) to cover map-frame points near the sensor that pass the
+     * eq 13 gate of `params`. */
+    void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
+                     const multibin::BinUpdateParams& params);
 
     /** True if growToCover() would change the window for these sensor-frame points seen from
      * `sensorInMap` (the robot pose's mean composed with the sensor pose), without propagating
      * more than the few points near the window's edge. */
     bool growthNeeded(const multibin::PointsWithCov& sensorPoints,
-                      const multibin::PosePropagator& propagator) const;
+                      const multibin::PosePropagator& propagator,
+                      const multibin::BinUpdateParams& params) const;
 
     /** The insertion core of one update cycle: BinGrid::insertPoints or insertSensorPoints. */
     using FuseIntoGrid =
         std::function<multibin::InsertStats(multibin::BinGrid&, const multibin::BinUpdateParams&)>;
     /** One update cycle of `grid`: insertion core, then the visibility constraint (with the
      * fan test for a scan's rays, not for a camera frame's: multibin::RayFan). */
-    multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid, const FuseIntoGrid& fuse,
+    multibin::InsertStats insertIntoGrid(multibin::BinGrid& grid,
+                                         const multibin::BinUpdateParams& params,
+                                         const FuseIntoGrid& fuse,
                                          const std::optional<Eigen::Vector3d>& sensorOrigin_m,
                                          bool cameraFrame = false);
     /** recenter() on (x, y) relative to mapOrigin() [m]. */

@@ -53,6 +53,10 @@ struct LaserModelOptions {
     /** Scans further apart in time are not consecutive: no gate [s] (key
      * `laser_continuity_max_dt_s`). */
     double continuityMaxDt_s = 1.0;
+    /** Eq 13's Delta_max for this model's points [m] (key `laser_max_elevation_uncertainty_m`): a
+     * point counts if 3 sigma_z <= it. 0: the map's max_elevation_uncertainty_m
+     * (doc/sensor-reach.md). */
+    double maxElevationUncertainty_m = 0;
 };
 
 /** Stereo camera (STOC-style) model options. */
@@ -130,6 +134,10 @@ struct StereoModelOptions {
      * `stereo_texture_min_std_grey`, `stereo_texture_radius_px`; doc/sensor-models.md). */
     double textureMinStd_grey = 1.5;
     int textureRadius_px = 2;
+    /** Eq 13's Delta_max for this model's points [m] (key `stereo_max_elevation_uncertainty_m`): a
+     * point counts if 3 sigma_z <= it. 0: the map's max_elevation_uncertainty_m
+     * (doc/sensor-reach.md). */
+    double maxElevationUncertainty_m = 0;
 };
 
 /** Structured-light depth camera model (Nguyen, Izadi, Lovell 2012):
@@ -148,6 +156,19 @@ struct DepthModelOptions {
      * frameSigmaRelative r (key `depth_frame_sigma_relative` [-]). Both 0: points independent. */
     double quantisationStep_per_m = 0.003;
     double frameSigmaRelative = 0.005;
+    /** Depth-frame artefacts (DepthArtefacts.h; frames with a pixel grid only, not point
+     * clouds): flying pixels within flyingPixelRadius_px of a jump between neighbouring pixels
+     * larger than flyingPixelJumpRelative x the nearer depth, and the frame's border of
+     * borderWidth_px (keys `depth_flying_pixel_filter`, `depth_flying_pixel_jump_relative`,
+     * `depth_flying_pixel_radius_px`, `depth_border_px`). */
+    bool flyingPixelFilter = true;
+    double flyingPixelJumpRelative = 0.05;
+    int flyingPixelRadius_px = 1;
+    int borderWidth_px = 0;
+    /** Eq 13's Delta_max for this model's points [m] (key `depth_max_elevation_uncertainty_m`): a
+     * point counts if 3 sigma_z <= it. 0: the map's max_elevation_uncertainty_m
+     * (doc/sensor-reach.md). */
+    double maxElevationUncertainty_m = 0;
 
     /** Standard deviation of the error shared by a frame's points at range r [m] along the ray. */
     double frameSigma_m(double r_m) const {
@@ -179,6 +200,10 @@ struct LidarModelOptions {
     RangeSigmaCurve rangeSigma{0.03, 0.0, 0.0};  //!< key `lidar_range_sigma_coeffs`
     double angularSigma_rad = 0.001;             //!< key `lidar_angular_sigma_rad` [rad]
     double beamDivergence_rad = 0.003;           //!< key `lidar_beam_divergence_rad` [rad]
+    /** Eq 13's Delta_max for this model's points [m] (key `lidar_max_elevation_uncertainty_m`): a
+     * point counts if 3 sigma_z <= it. 0: the map's max_elevation_uncertainty_m
+     * (doc/sensor-reach.md). */
+    double maxElevationUncertainty_m = 0;
 
     /** The published figures of `name` (vlp16, os1, utm30lx); throws std::invalid_argument for
      * another name. */
@@ -214,6 +239,9 @@ struct SensorModelOptions {
 
     /** The model of data labelled `label`: its entry in modelByLabel, else `classDefault`. */
     SensorModelKind modelFor(const std::string& label, SensorModelKind classDefault) const;
+    /** Eq 13's Delta_max [m] for the points of a `kind` model: its own
+     * maxElevationUncertainty_m, or `map_m` (the map's) where that is 0. */
+    double maxElevationUncertaintyFor(SensorModelKind kind, double map_m) const;
 
     /** Reads the keys present in `s` (the others keep their value), then validate(). */
     void read(StrictConfigSection& s);

@@ -2,6 +2,9 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
+
+#include "multibin/sensors/SensorModelOptions.h"
 
 namespace multibin::sensors {
 
@@ -40,10 +43,12 @@ struct StereoStats {
 
 /** What the depth model did with the points it was given. */
 struct DepthStats {
-    size_t points = 0;      //!< points seen
-    size_t notFinite = 0;   //!< NaN or infinite coordinates
-    size_t outOfRange = 0;  //!< range outside [min_range, max_range] (0 = no return)
-    size_t kept = 0;        //!< turned into points with covariance
+    size_t points = 0;       //!< points seen
+    size_t notFinite = 0;    //!< NaN or infinite coordinates
+    size_t outOfRange = 0;   //!< range outside [min_range, max_range] (0 = no return)
+    size_t flyingPixel = 0;  //!< at a depth jump (depth_flying_pixel_*; DepthArtefacts.h)
+    size_t frameBorder = 0;  //!< within depth_border_px of the frame's edge
+    size_t kept = 0;         //!< turned into points with covariance
     DepthStats& operator+=(const DepthStats& o);
 };
 
@@ -74,6 +79,9 @@ struct SensorModelStats {
     size_t outOfRange() const;
     /** Readings with NaN or infinite values (the map's InsertStats::notFinite). */
     size_t notFinite() const;
+    /** The model that counted readings here (one observation's stats hold one model's counts);
+     * none if nothing was counted. */
+    std::optional<SensorModelKind> model() const;
 };
 
 }  // namespace multibin::sensors
