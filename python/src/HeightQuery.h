@@ -12,14 +12,15 @@
 
 namespace multibin::python {
 
-/** Height [m], sigma [m] and source at (x, y) [m, pose frame]: the sub-cell surface where
- * measured (getHeight's answer), else the last gap filling's value; NaN and Unknown where the
- * map knows nothing. */
+/** Height [m], sigma [m] and source at (x, y) [m, pose frame]: the map's recommended query,
+ * height(): the sub-cell surface where measured, else the gap filling's value (option
+ * dem_return_filled); NaN and Unknown where the map knows nothing. */
 inline HeightSource queryHeight(const mrpt::maps::CMultiBinElevationMap& map, double x_m,
                                 double y_m, double& height_m, double& sigma_m) {
-    const HeightSource src = map.getElevation(x_m, y_m, height_m, sigma_m, true);
-    if (src == HeightSource::Unknown) height_m = sigma_m = std::numeric_limits<double>::quiet_NaN();
-    return src;
+    const auto answer = map.height(x_m, y_m);  // NaN where unknown
+    height_m = answer.height_m;
+    sigma_m = answer.sigma_m;
+    return answer.source;
 }
 
 /** queryHeight over n points: heights, sigmas [m] and sources (HeightSource as a number). */

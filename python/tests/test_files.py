@@ -66,7 +66,7 @@ def test_the_mappers_map_answers_python_as_it_answers_cpp_bit_for_bit(mapper_out
                                                                       filled):
     """elevation_map.bin written by elevation-mapper, queried by a C++ program that loads it
     with MRPT, and loaded in Python: the same height, sigma and source at every point, measured
-    and (after the gap filling, which a saved map does not hold) filled."""
+    and filled (a loaded map fills on its first query, as fill() does again)."""
     if not QUERY_TABLE:
         pytest.skip("MULTIBIN_QUERY_TABLE not set (run through ctest)")
     out, _ = mapper_output
@@ -85,7 +85,7 @@ def test_the_mappers_map_answers_python_as_it_answers_cpp_bit_for_bit(mapper_out
     np.testing.assert_array_equal(table[:, :2], xy)
     h, s, src = m.height(xy[:, 0], xy[:, 1])
     assert np.count_nonzero(src == multibin.SOURCE_MEASURED) > 5000
-    assert (np.count_nonzero(src >= multibin.SOURCE_FILLED_MEDIAN) > 500) == filled
+    assert np.count_nonzero(src >= multibin.SOURCE_FILLED_MEDIAN) > 500
     assert np.count_nonzero(src == multibin.SOURCE_UNKNOWN) > 1000
     np.testing.assert_array_equal(h, table[:, 2])  # NaN where NaN
     np.testing.assert_array_equal(s, table[:, 3])

@@ -342,6 +342,7 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 }
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
+    fillIfLoaded();  // a loaded map's rasters hold its filled cells, as the writer's did
     const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::CellWindow& w = m_impl->grid.window();
     multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
@@ -384,6 +385,7 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
 }
 
 void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
+    fillIfLoaded();
     const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::EsriAsciiGrid g = toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height);
     const int rows = g.rows(), cols = g.cols();
