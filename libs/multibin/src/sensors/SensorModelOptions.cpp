@@ -154,6 +154,46 @@ bool curveHolds(const RangeSigmaCurve& r) {
     return r.c0_m >= 0 && r.c1 >= 0 && r.c2_per_m >= 0 && r.c0_m + r.c1 + r.c2_per_m > 0;
 }
 
+/** The stereo model's keys (one list with the others: visitKeys). */
+template <class Stereo, class Visit>
+void visitStereoKeys(Stereo& stereo, Visit& visit) {
+    visit("stereo_left_intrinsics_sigma", stereo.leftIntrinsicsSigma, atLeast(0));
+    visit("stereo_right_intrinsics_sigma", stereo.rightIntrinsicsSigma, atLeast(0));
+    visit("stereo_extrinsics_sigma", stereo.extrinsicsSigma, atLeast(0));
+    visit({"stereo_matching_sigma_px", "stereo_matching_sigma"}, stereo.matchingSigma_px,
+          atLeast(0, "px"));
+    visit("stereo_subsample", stereo.subsample, atLeast(1, "px"));
+    visit({"stereo_min_depth_m", "stereo_min_depth"}, stereo.minDepth_m, atLeast(0, "m"));
+    visit("stereo_sgbm_min_disparity", stereo.sgbmMinDisparity);
+    visit("stereo_sgbm_num_disparities", stereo.sgbmNumDisparities, atLeast(0));
+    visit("stereo_sgbm_full_width", stereo.sgbmFullWidth);
+    visit("stereo_sgbm_block_size", stereo.sgbmBlockSize, oddBetween(1, 255));
+    visit("stereo_sgbm_p1", stereo.sgbmP1, atLeast(0));
+    visit("stereo_sgbm_p2", stereo.sgbmP2, atLeast(0));
+    visit("stereo_sgbm_disp12_max_diff", stereo.sgbmDisp12MaxDiff);
+    visit("stereo_sgbm_uniqueness_ratio", stereo.sgbmUniquenessRatio, atLeast(0));
+    visit("stereo_sgbm_speckle_window_size", stereo.sgbmSpeckleWindowSize, atLeast(0));
+    visit("stereo_sgbm_speckle_range", stereo.sgbmSpeckleRange, atLeast(0));
+    visit("stereo_sgbm_mode", stereo.sgbmMode, kSgbmModes);
+    visit("stereo_halo_filter", stereo.haloFilter);
+    visit({"stereo_halo_jump_px", "stereo_halo_jump"}, stereo.haloJump_px, positive("px"));
+    visit({"stereo_halo_radius_px", "stereo_halo_radius"}, stereo.haloRadius_px, atLeast(1, "px"));
+    visit("stereo_near_cluster_filter", stereo.nearClusterFilter);
+    visit({"stereo_near_cluster_max_area_px", "stereo_near_cluster_max_area"},
+          stereo.nearClusterMaxArea_px, atLeast(1, "px"));
+    visit({"stereo_near_cluster_step_px", "stereo_near_cluster_step"}, stereo.nearClusterStep_px,
+          positive("px"));
+    visit({"stereo_near_cluster_jump_px", "stereo_near_cluster_jump"}, stereo.nearClusterJump_px,
+          positive("px"));
+    visit("stereo_texture_min_std_grey", stereo.textureMinStd_grey, atLeast(0));
+    visit("stereo_texture_radius_px", stereo.textureRadius_px, atLeast(1, "px"));
+    visit({"stereo_cloud_focal_length_px", "stereo_cloud_focal_length"}, stereo.cloudFocalLength_px,
+          positive("px"));
+    visit({"stereo_cloud_baseline_m", "stereo_cloud_baseline"}, stereo.cloudBaseline_m,
+          positive("m"));
+    visit("stereo_max_elevation_uncertainty_m", stereo.maxElevationUncertainty_m, atLeast(0, "m"));
+}
+
 /** The sensor-model keys of `o` (a SensorModelOptions or a const one), for the options protocol
  * (multibin/io/OptionKeys.h). Keys with a syntax of their own (curves, label maps, the lidar
  * preset) are custom options: `parse` for reading (unused when writing a const one) and
@@ -162,7 +202,6 @@ template <class Options, class Visit>
 void visitKeys(Options& o, Visit&& visit) {
     constexpr bool reading = !std::is_const_v<Options>;
     auto& laser = o.laser;
-    auto& stereo = o.stereo;
     auto& lidar = o.lidar;
     auto& depth = o.depth;
     const auto custom = [&](const char* key, auto parse, auto format) {
@@ -200,42 +239,7 @@ void visitKeys(Options& o, Visit&& visit) {
     visit({"laser_continuity_max_dt_s", "laser_continuity_max_dt"}, laser.continuityMaxDt_s,
           positive("s"));
     visit("laser_max_elevation_uncertainty_m", laser.maxElevationUncertainty_m, atLeast(0, "m"));
-    // Stereo
-    visit("stereo_left_intrinsics_sigma", stereo.leftIntrinsicsSigma, atLeast(0));
-    visit("stereo_right_intrinsics_sigma", stereo.rightIntrinsicsSigma, atLeast(0));
-    visit("stereo_extrinsics_sigma", stereo.extrinsicsSigma, atLeast(0));
-    visit({"stereo_matching_sigma_px", "stereo_matching_sigma"}, stereo.matchingSigma_px,
-          atLeast(0, "px"));
-    visit("stereo_subsample", stereo.subsample, atLeast(1, "px"));
-    visit({"stereo_min_depth_m", "stereo_min_depth"}, stereo.minDepth_m, atLeast(0, "m"));
-    visit("stereo_sgbm_min_disparity", stereo.sgbmMinDisparity);
-    visit("stereo_sgbm_num_disparities", stereo.sgbmNumDisparities, atLeast(0));
-    visit("stereo_sgbm_full_width", stereo.sgbmFullWidth);
-    visit("stereo_sgbm_block_size", stereo.sgbmBlockSize, oddBetween(1, 255));
-    visit("stereo_sgbm_p1", stereo.sgbmP1, atLeast(0));
-    visit("stereo_sgbm_p2", stereo.sgbmP2, atLeast(0));
-    visit("stereo_sgbm_disp12_max_diff", stereo.sgbmDisp12MaxDiff);
-    visit("stereo_sgbm_uniqueness_ratio", stereo.sgbmUniquenessRatio, atLeast(0));
-    visit("stereo_sgbm_speckle_window_size", stereo.sgbmSpeckleWindowSize, atLeast(0));
-    visit("stereo_sgbm_speckle_range", stereo.sgbmSpeckleRange, atLeast(0));
-    visit("stereo_sgbm_mode", stereo.sgbmMode, kSgbmModes);
-    visit("stereo_halo_filter", stereo.haloFilter);
-    visit({"stereo_halo_jump_px", "stereo_halo_jump"}, stereo.haloJump_px, positive("px"));
-    visit({"stereo_halo_radius_px", "stereo_halo_radius"}, stereo.haloRadius_px, atLeast(1, "px"));
-    visit("stereo_near_cluster_filter", stereo.nearClusterFilter);
-    visit({"stereo_near_cluster_max_area_px", "stereo_near_cluster_max_area"},
-          stereo.nearClusterMaxArea_px, atLeast(1, "px"));
-    visit({"stereo_near_cluster_step_px", "stereo_near_cluster_step"}, stereo.nearClusterStep_px,
-          positive("px"));
-    visit({"stereo_near_cluster_jump_px", "stereo_near_cluster_jump"}, stereo.nearClusterJump_px,
-          positive("px"));
-    visit("stereo_texture_min_std_grey", stereo.textureMinStd_grey, atLeast(0));
-    visit("stereo_texture_radius_px", stereo.textureRadius_px, atLeast(1, "px"));
-    visit({"stereo_cloud_focal_length_px", "stereo_cloud_focal_length"}, stereo.cloudFocalLength_px,
-          positive("px"));
-    visit({"stereo_cloud_baseline_m", "stereo_cloud_baseline"}, stereo.cloudBaseline_m,
-          positive("m"));
-    visit("stereo_max_elevation_uncertainty_m", stereo.maxElevationUncertainty_m, atLeast(0, "m"));
+    visitStereoKeys(o.stereo, visit);
     // Lidar: the sensor's published figures first, then the keys that override them
     custom(
         "lidar_sensor",
