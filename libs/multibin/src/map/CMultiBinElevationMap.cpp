@@ -110,7 +110,8 @@ void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::st
             throw std::invalid_argument(
                 iniName(source) + ", section '" + sec + "': unknown section (this map reads '" +
                 parent + tag + "NN_creationOpts', '" + parent + tag + "NN_insertOpts' and '" +
-                parent + tag + "NN_traversabilityOpts', NN from 00 to " + std::to_string(count - 1) + ")");
+                parent + tag + "NN_traversabilityOpts', NN from 00 to " +
+                std::to_string(count - 1) + ")");
     }
 }
 

@@ -304,7 +304,8 @@ public:
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
     /** @name Traversability (multibin/traversability/TerrainFeatures.h, doc/traversability.md)
      * @{ */
-    /** The robot's limits and how the layers are computed (ini section `..._traversabilityOpts`). */
+    /** The robot's limits and how the layers are computed (ini section `..._traversabilityOpts`).
+     */
     multibin::traversability::TraversabilityOptions traversabilityOptions;
     /** Step, slope, roughness with their sigmas, P(untraversable) and the foothold probability of
      * every cell of the grid window (NaN where unknown), from the sub-cell surface, the bins and
