@@ -15,6 +15,7 @@
 
 #include "CMultiBinElevationMap_impl.h"
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/BinUpdate.h"
 #include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
@@ -50,6 +51,19 @@ uint64_t cellDigest(const multibin::BinGrid& grid, int ix, int iy, float filled_
     return h;
 }
 
+/** The variance of a surface's points about their weighted least-squares plane beyond what their
+ * noise explains [m^2]: each point's weighted squared residual w e^2 is 1 on average for noise
+ * alone, so the excess of the weighted residual sum over points - 3, per unit of weight, is the
+ * relief inside the cell that its plane does not follow. 0 with fewer than 4 points. */
+double reliefVariance_m2(const multibin::PlaneMoments& m, double points) {
+    const double a = m.sxx, b = m.sxy, c = m.syy, det = a * c - b * b;
+    if (points < 4 || !(m.weight > 0)) return 0;
+    double rss = m.szz;
+    if (det > 1e-3 * (a + c) * (a + c))
+        rss -= ((c * m.sxz - b * m.syz) * m.sxz + (a * m.syz - b * m.sxz) * m.syz) / det;
+    return std::max(0.0, rss - (points - 3)) / m.weight;
+}
+
 /** The surface samples of cell (col, row) of `s` (absolute cell (ix, iy)): the sub-cell surface
  * at k x k points without the pose part (a common offset no feature sees), else the filled
  * height; and the cell's certain bins beside its surface. */
@@ -76,15 +90,19 @@ void sampleCell(const multibin::BinGrid& grid, const multibin::BinGrid* local,
             s.height_m[i] = ok ? float(p.height_m) : NAN;
             s.sigma_m[i] = ok ? float(std::sqrt(p.variance_m2)) : NAN;
         }
+    multibin::PlaneMoments merged;
+    double points = 0;
     grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
-        if (!(b.certainty > 0) || (b.index >= surface.firstBin && b.index <= surface.lastBin))
-            return;
+        const bool inSurface = b.index >= surface.firstBin && b.index <= surface.lastBin;
+        if (inSurface) multibin::mergePlaneMoments(merged, b.plane), points += b.pointCount;
+        if (!(b.certainty > 0) || inSurface) return;
         const float sigma =
             float(std::sqrt(std::max(double(b.variance_m2), params.varianceFloor_m2)));
         if (!(b.height_m >= s.binLow_m[c])) s.binLow_m[c] = b.height_m, s.binLowSigma_m[c] = sigma;
         if (!(b.height_m <= s.binHigh_m[c]))
             s.binHigh_m[c] = b.height_m, s.binHighSigma_m[c] = sigma;
     });
+    s.relief_m2[c] = float(reliefVariance_m2(merged, points));
 }
 
 }  // namespace

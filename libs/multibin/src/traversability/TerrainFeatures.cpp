@@ -26,6 +26,15 @@ void DiscAccumulator::add(double dx_m, double dy_m, double h_m) {
     m_max = std::max(m_max, h_m), m_min = std::min(m_min, h_m);
 }
 
+void DiscAccumulator::add(double dx_m, double dy_m, double h_m, double reliefVariance_m2) {
+    add(dx_m, dy_m, h_m);
+    if (!(reliefVariance_m2 > 0)) return;
+    m_relief += reliefVariance_m2;
+    const double halfWidth = std::sqrt(3 * reliefVariance_m2);
+    addStepOnly(h_m - halfWidth);
+    addStepOnly(h_m + halfWidth);
+}
+
 void DiscAccumulator::addStepOnly(double h_m) {
     m_max = std::max(m_max, h_m), m_min = std::min(m_min, h_m);
 }
@@ -40,7 +49,7 @@ bool DiscAccumulator::features(DiscFeatures& out) const {
     const double b = (cyy * cxh - cxy * cyh) / det, c = (cxx * cyh - cxy * cxh) / det;
     out.step_m = m_max - m_min;
     out.slope_deg = std::atan(std::hypot(b, c)) * kRadToDeg;
-    out.roughness_m = std::sqrt(std::max(0.0, chh - b * cxh - c * cyh) / n);
+    out.roughness_m = std::sqrt((std::max(0.0, chh - b * cxh - c * cyh) + m_relief) / n);
     return true;
 }
 
@@ -53,6 +62,7 @@ SurfaceSamples::SurfaceSamples(const Lattice& l, int k) : lattice(l), perCell(k)
     sigma_m.assign(samples, kNaN);
     for (auto* v : {&binLow_m, &binLowSigma_m, &binHigh_m, &binHighSigma_m})
         v->assign(l.cellCount(), kNaN);
+    relief_m2.assign(l.cellCount(), 0.f);
 }
 
 void SurfaceSamples::setCell(int col, int row, float h_m, float s_m) {
@@ -169,7 +179,8 @@ std::vector<float> fixedNormalDraws(size_t count) {
 /** A known surface point or bin around one cell. */
 struct Known {
     float dx_m, dy_m, h_m, sigma_m;
-    int draw;  //!< column of the draws table: group * 3 + (0 surface, 1 low bin, 2 high bin)
+    float relief_m2;  //!< the relief below the samples of its cell [m^2]
+    int draw;         //!< column of the draws table: group * 3 + (0 surface, 1 low bin, 2 high bin)
     uint8_t discs;
     bool stepOnly;
 };
@@ -180,7 +191,8 @@ struct Realisation {
     float footLo = 1e30f, footHi = -1e30f, clearLo = 1e30f, clearHi = -1e30f;
 
     void add(const Known& p, float h) {
-        if (p.discs & kDisc) p.stepOnly ? disc.addStepOnly(h) : disc.add(p.dx_m, p.dy_m, h);
+        if (p.discs & kDisc)
+            p.stepOnly ? disc.addStepOnly(h) : disc.add(p.dx_m, p.dy_m, h, p.relief_m2);
         if (p.discs & kFoot) footLo = std::min(footLo, h), footHi = std::max(footHi, h);
         if (p.discs & kClear) clearLo = std::min(clearLo, h), clearHi = std::max(clearHi, h);
     }
@@ -205,7 +217,9 @@ bool gatherCell(const SurfaceSamples& s, const Stencil& st, const Traversability
         if (sc < 0 || sr < 0 || sc >= s.sx() || sr >= s.sy()) continue;
         const size_t i = s.sampleIndex(sc, sr);
         if (!std::isfinite(s.height_m[i])) continue;
-        known.push_back({p.dx_m, p.dy_m, s.height_m[i], s.sigma_m[i], p.group * 3, p.discs, false});
+        const float relief = s.relief_m2[s.lattice.index(sc / k, sr / k)];
+        known.push_back(
+            {p.dx_m, p.dy_m, s.height_m[i], s.sigma_m[i], relief, p.group * 3, p.discs, false});
         if (p.discs & kDisc) discKnown++;
         centreKnown = centreKnown || (p.dsc >= 0 && p.dsc < k && p.dsr >= 0 && p.dsr < k);
     }
@@ -219,10 +233,10 @@ bool gatherCell(const SurfaceSamples& s, const Stencil& st, const Traversability
                     dy = float(c.dr * s.lattice.cellSize_m);
         if (std::isfinite(s.binLow_m[i]))
             known.push_back(
-                {dx, dy, s.binLow_m[i], s.binLowSigma_m[i], c.group * 3 + 1, c.discs, true});
+                {dx, dy, s.binLow_m[i], s.binLowSigma_m[i], 0.f, c.group * 3 + 1, c.discs, true});
         if (std::isfinite(s.binHigh_m[i]))
             known.push_back(
-                {dx, dy, s.binHigh_m[i], s.binHighSigma_m[i], c.group * 3 + 2, c.discs, true});
+                {dx, dy, s.binHigh_m[i], s.binHighSigma_m[i], 0.f, c.group * 3 + 2, c.discs, true});
     }
     return true;
 }

@@ -23,6 +23,10 @@ struct DiscFeatures {
 class DiscAccumulator {
 public:
     void add(double dx_m, double dy_m, double h_m);
+    /** A point with the relief it stands for: heights spread uniformly with variance
+     * reliefVariance_m2 about h_m (inside a cell, below the lattice); it adds that variance to
+     * the roughness and its range (h +- sqrt(3 var)) to the step. */
+    void add(double dx_m, double dy_m, double h_m, double reliefVariance_m2);
     /** A height that counts for the step only (a bin beside a cell's surface) [m]. */
     void addStepOnly(double h_m);
     size_t count() const { return m_n; }
@@ -35,6 +39,7 @@ private:
     double m_h0 = 0;                                             // first height (conditioning)
     double m_sh = 0, m_sxh = 0, m_syh = 0, m_shh = 0;
     double m_max = -1e300, m_min = 1e300;
+    double m_relief = 0;  // sum of the points' relief variances [m^2]
 };
 
 /** The map's surface as the traversability layers read it: k x k samples per cell of a lattice
@@ -52,6 +57,9 @@ struct SurfaceSamples {
     std::vector<float> binLowSigma_m;
     std::vector<float> binHigh_m;  //!< per cell: the highest other certain bin [m]; NaN if none
     std::vector<float> binHighSigma_m;
+    /** per cell: the variance of its surface's points about their plane beyond their noise
+     * (relief finer than the samples) [m^2]; 0 if none or unknown */
+    std::vector<float> relief_m2;
 
     SurfaceSamples() = default;
     /** Every sample unknown, no bins. */
