@@ -320,6 +320,10 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
             multibin::eval::scoreArea("mrf_crop", m_truth, methods, m_lattice, m_mrfLattice));
 
     out.write("report.json", multibin::eval::reportJson(scores, order, m_lattice, areas));
+    // The truth's own cell means: what thresholded heights at the map's resolution reach at best.
+    MethodEstimate truthCells;
+    truthCells.name = "truth_cell_means";
+    truthCells.height_m = m_truth;
     auto saveRaster = [&](const std::string& name, const CellArray& values) {
         out.writeWith(name, [&](const std::string& path) {
             rasterOf(m_lattice, values).save(path);
@@ -331,7 +335,7 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     out.write("profile.csv", profileCsv(m_truth, methods));
     return multibin::eval::reportTable(scores, order, areas) +
            evaluateTraversability(out, m_evaluated, m_lattice, m_options.groundTruthPath,
-                                  {filled, heightGrid});
+                                  {filled, heightGrid, truthCells});
 }
 
 std::string EvaluationRun::profileCsv(const CellArray& truth,

@@ -256,12 +256,14 @@ void computeCell(const std::vector<Known>& known, const std::vector<float>& z, i
     for (const Known& p : known) mean.add(p, p.h_m);
     DiscFeatures f;
     if (!mean.disc.features(f)) return;  // stays unknown: no plane
-    out.step_m[k] = float(f.step_m);
-    out.slope_deg[k] = float(f.slope_deg);
-    out.roughness_m[k] = float(f.roughness_m);
+    const DiscFeatures calibrated{o.step.apply(f.step_m), o.slope.apply(f.slope_deg),
+                                  o.roughness.apply(f.roughness_m)};
+    out.step_m[k] = float(calibrated.step_m);
+    out.slope_deg[k] = float(calibrated.slope_deg);
+    out.roughness_m[k] = float(calibrated.roughness_m);
     const int draws = o.monte_carlo_draws;
     if (draws == 0) {
-        out.untraversable[k] = mean.untraversable(f, o) ? 1.f : 0.f;
+        out.untraversable[k] = mean.untraversable(calibrated, o) ? 1.f : 0.f;
         out.foothold[k] = mean.goodFoothold(o) ? 1.f : 0.f;
         out.stepSigma_m[k] = out.slopeSigma_deg[k] = out.roughnessSigma_m[k] = 0.f;
         return;
@@ -288,17 +290,26 @@ void computeCell(const std::vector<Known>& known, const std::vector<float>& z, i
     if (valid == 0) return;
     const DiscFeatures shift{f.step_m - step.s / valid, f.slope_deg - slope.s / valid,
                              f.roughness_m - rough.s / valid};
+    // Each draw calibrated, with its own draw of what the lattice cannot resolve.
+    const float* model = z.data() + size_t(draws) * stride;
     int bad = 0;
-    for (DiscFeatures& d : drawn) {
-        d.step_m += shift.step_m, d.slope_deg += shift.slope_deg;
-        d.roughness_m += shift.roughness_m;
-        bad += mean.untraversable(d, o);
+    for (size_t n = 0; n < drawn.size(); n++) {
+        const DiscFeatures& d = drawn[n];
+        const float* zm = model + 3 * n;
+        const DiscFeatures c{
+            o.step.apply(d.step_m + shift.step_m) + o.step.model_sigma * zm[0],
+            o.slope.apply(d.slope_deg + shift.slope_deg) + o.slope.model_sigma * zm[1],
+            o.roughness.apply(d.roughness_m + shift.roughness_m) + o.roughness.model_sigma * zm[2]};
+        bad += mean.untraversable(c, o);
     }
     out.untraversable[k] = float(bad) / float(valid);
     out.foothold[k] = float(good) / float(valid);
-    out.stepSigma_m[k] = step.sigma(valid);
-    out.slopeSigma_deg[k] = slope.sigma(valid);
-    out.roughnessSigma_m[k] = rough.sigma(valid);
+    const auto total = [&](const Moments& m, const TraversabilityOptions::FeatureCalibration& c) {
+        return float(std::hypot(c.gain * m.sigma(valid), c.model_sigma));
+    };
+    out.stepSigma_m[k] = total(step, o.step);
+    out.slopeSigma_deg[k] = total(slope, o.slope);
+    out.roughnessSigma_m[k] = total(rough, o.roughness);
 }
 
 }  // namespace
@@ -307,8 +318,9 @@ void computeLayers(const SurfaceSamples& s, const TraversabilityOptions& o,
                    TraversabilityLayers& out, const std::vector<uint8_t>& cellMask) {
     if (!(out.lattice == s.lattice)) out = TraversabilityLayers(s.lattice);
     const Stencil st = makeStencil(s.lattice.cellSize_m, s.perCell, o);
+    // Per draw: the surface's errors (3 per stencil cell), then the features' model errors (3).
     const std::vector<float> z =
-        fixedNormalDraws(size_t(std::max(0, o.monte_carlo_draws)) * size_t(st.groups) * 3);
+        fixedNormalDraws(size_t(std::max(0, o.monte_carlo_draws)) * (size_t(st.groups) * 3 + 3));
     std::vector<Known> known;
     for (int row = 0; row < s.lattice.ny(); row++)
         for (int col = 0; col < s.lattice.nx(); col++) {

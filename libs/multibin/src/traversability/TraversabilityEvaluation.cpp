@@ -9,8 +9,10 @@
 namespace multibin::traversability {
 
 std::vector<int8_t> truthClasses(const EsriAsciiGrid& truth, const Lattice& lattice,
-                                 const TraversabilityOptions& o) {
+                                 const TraversabilityOptions& o,
+                                 std::vector<DiscFeatures>* features) {
     std::vector<int8_t> out(lattice.cellCount(), -1);
+    if (features) features->assign(lattice.cellCount(), DiscFeatures{NAN, NAN, NAN});
     const double d = truth.cellsize_m, r = o.radius_m;
     const int reach = int(std::ceil(r / d));
     for (int row = 0; row < lattice.ny(); row++)
@@ -33,6 +35,7 @@ std::vector<int8_t> truthClasses(const EsriAsciiGrid& truth, const Lattice& latt
             DiscFeatures f;
             if (double(acc.count()) < o.min_known_fraction * double(inDisc) || !acc.features(f))
                 continue;
+            if (features) (*features)[lattice.index(col, row)] = f;
             out[lattice.index(col, row)] = f.step_m > o.max_step_m ||
                                            f.slope_deg > o.max_slope_deg ||
                                            f.roughness_m > o.max_roughness_m;
@@ -112,8 +115,8 @@ std::string scoresTable(const std::map<std::string, ClassifierScore>& scores,
     t << "method                 precision  recall      F1     ECE  coverage   cells\n";
     for (const std::string& name : order) {
         const ClassifierScore& s = scores.at(name);
-        std::snprintf(line, sizeof line, "%-22s %9.3f %7.3f %7.3f %7.3f %9.3f %7zu\n",
-                      name.c_str(), s.precision, s.recall, s.f1, s.ece, s.coverage, s.scored);
+        std::snprintf(line, sizeof line, "%-22s %9.3f %7.3f %7.3f %7.3f %9.3f %7zu\n", name.c_str(),
+                      s.precision, s.recall, s.f1, s.ece, s.coverage, s.scored);
         t << line;
     }
     if (order.empty()) return t.str();
@@ -121,8 +124,8 @@ std::string scoresTable(const std::map<std::string, ClassifierScore>& scores,
     t << "reliability of " << order.front() << " (P in deciles: cells, mean P, observed):\n";
     for (size_t b = 0; b < 10; b++) {
         std::snprintf(line, sizeof line, "  %.1f-%.1f %8zu %7.3f %7.3f\n", 0.1 * double(b),
-                      0.1 * double(b + 1), s.reliability[b].cells,
-                      s.reliability[b].meanProbability, s.reliability[b].observed);
+                      0.1 * double(b + 1), s.reliability[b].cells, s.reliability[b].meanProbability,
+                      s.reliability[b].observed);
         t << line;
     }
     return t.str();

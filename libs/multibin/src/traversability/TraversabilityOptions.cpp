@@ -24,6 +24,15 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("monte_carlo_draws", o.monte_carlo_draws, between(0, 4096));
     visit("min_known_fraction", o.min_known_fraction, between(0.05, 1));
     visit("use_bins", o.use_bins);
+    visit("step_bias_m", o.step.bias, finite("m"));
+    visit("step_gain", o.step.gain, positive());
+    visit("step_model_sigma_m", o.step.model_sigma, atLeast(0, "m"));
+    visit("slope_bias_deg", o.slope.bias, finite("deg"));
+    visit("slope_gain", o.slope.gain, positive());
+    visit("slope_model_sigma_deg", o.slope.model_sigma, atLeast(0, "deg"));
+    visit("roughness_bias_m", o.roughness.bias, finite("m"));
+    visit("roughness_gain", o.roughness.gain, positive());
+    visit("roughness_model_sigma_m", o.roughness.model_sigma, atLeast(0, "m"));
 }
 }  // namespace
 

@@ -18,7 +18,8 @@ namespace multibin::traversability {
  * own definitions, on a raster far finer than a cell), 1 untraversable, 0 traversable, -1 where
  * fewer than min_known_fraction of the disc's samples are known. */
 std::vector<int8_t> truthClasses(const EsriAsciiGrid& truth, const Lattice& lattice,
-                                 const TraversabilityOptions& options);
+                                 const TraversabilityOptions& options,
+                                 std::vector<DiscFeatures>* features = nullptr);
 
 /** Heights per cell of `lattice` (row-major, NaN unknown, 1 sample per cell, no bins) as
  * SurfaceSamples with sigma 0: the input of the thresholded-height baselines. */

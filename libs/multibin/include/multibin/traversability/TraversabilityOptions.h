@@ -45,6 +45,20 @@ struct TraversabilityOptions {
      * the step (a step inside the cell that the cell's one height flattens) */
     bool use_bins = true;
 
+    /** How a feature of the map relates to the truth's at the map's resolution: the truth's
+     * feature is bias + gain x the map's, give or take a Gaussian error of sigma model_sigma
+     * (what the lattice cannot resolve), on top of the map's own uncertainty. Identity (0, 1, 0)
+     * by default; the presets carry a fit on the tuning boards (doc/traversability.md). */
+    struct FeatureCalibration {
+        double bias = 0;         //!< [m] or [deg]
+        double gain = 1;         //!< [-]
+        double model_sigma = 0;  //!< [m] or [deg]
+        double apply(double mapFeature) const { return bias + gain * mapFeature; }
+    };
+    FeatureCalibration step;       //!< [step_bias_m, step_gain, step_model_sigma_m]
+    FeatureCalibration slope;      //!< [slope_bias_deg, slope_gain, slope_model_sigma_deg]
+    FeatureCalibration roughness;  //!< [roughness_bias_m, roughness_gain, roughness_model_sigma_m]
+
     /** The radius of the largest disc any layer reads [m]. */
     double reach_m() const;
 
