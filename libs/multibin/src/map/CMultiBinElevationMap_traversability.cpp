@@ -68,8 +68,8 @@ double reliefVariance_m2(const multibin::PlaneMoments& m, double points) {
  * at k x k points without the pose part (a common offset no feature sees), else the filled
  * height; and the cell's certain bins beside its surface. */
 void sampleCell(const multibin::BinGrid& grid, const multibin::BinGrid* local,
-                const multibin::BinUpdateParams& params, float filled_m, float filledSigma_m,
-                int col, int row, SurfaceSamples& s) {
+                const multibin::BinUpdateParams& params, double binShare, float filled_m,
+                float filledSigma_m, int col, int row, SurfaceSamples& s) {
     const int k = s.perCell;
     const int ix = s.lattice.window.ix0 + col, iy = s.lattice.window.iy0 + row;
     const double cell_m = s.lattice.cellSize_m;
@@ -92,10 +92,11 @@ void sampleCell(const multibin::BinGrid& grid, const multibin::BinGrid* local,
         }
     multibin::PlaneMoments merged;
     double points = 0;
+    const double minCertainty = binShare * surface.certainty;
     grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
         const bool inSurface = b.index >= surface.firstBin && b.index <= surface.lastBin;
         if (inSurface) multibin::mergePlaneMoments(merged, b.plane), points += b.pointCount;
-        if (!(b.certainty > 0) || inSurface) return;
+        if (!(b.certainty > 0) || inSurface || b.certainty < minCertainty) return;
         const float sigma =
             float(std::sqrt(std::max(double(b.variance_m2), params.varianceFloor_m2)));
         if (!(b.height_m >= s.binLow_m[c])) s.binLow_m[c] = b.height_m, s.binLowSigma_m[c] = sigma;
@@ -108,6 +109,13 @@ void sampleCell(const multibin::BinGrid& grid, const multibin::BinGrid* local,
 }  // namespace
 
 TraversabilityLayers CMultiBinElevationMap::traversabilityLayers() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    updateTraversability();
+    const std::lock_guard<std::mutex> cacheLock(m_impl->traversability.mutex);
+    return m_impl->traversability.layers;
+}
+
+void CMultiBinElevationMap::updateTraversability() const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     multibin::TraversabilityCache& cache = m_impl->traversability;
     const std::lock_guard<std::mutex> cacheLock(cache.mutex);
@@ -154,8 +162,8 @@ TraversabilityLayers CMultiBinElevationMap::traversabilityLayers() const {
             for (int col = 0; col < lattice.nx(); col++) {
                 const size_t c = lattice.index(col, row);
                 if (resample[c])
-                    sampleCell(grid, local, params, filled[c], filledSigma[c], col, row,
-                               cache.samples);
+                    sampleCell(grid, local, params, o.bin_min_certainty_share, filled[c],
+                               filledSigma[c], col, row, cache.samples);
             }
         const int reach_cells = int(std::ceil(o.reach_m() / lattice.cellSize_m)) + 1;
         multibin::traversability::computeLayers(
@@ -165,7 +173,6 @@ TraversabilityLayers CMultiBinElevationMap::traversabilityLayers() const {
                                                         reach_cells));
     }
     cache.valid = true;
-    return cache.layers;
 }
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::traversabilityRaster(

@@ -24,6 +24,7 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("monte_carlo_draws", o.monte_carlo_draws, between(0, 4096));
     visit("min_known_fraction", o.min_known_fraction, between(0.05, 1));
     visit("use_bins", o.use_bins);
+    visit("bin_min_certainty_share", o.bin_min_certainty_share, between(0, 1));
     visit("step_bias_m", o.step.bias, finite("m"));
     visit("step_gain", o.step.gain, positive());
     visit("step_model_sigma_m", o.step.model_sigma, atLeast(0, "m"));

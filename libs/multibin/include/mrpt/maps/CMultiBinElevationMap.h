@@ -312,6 +312,9 @@ public:
      * the last gap filling (dem_update_map()). Recomputed only where the map changed since the
      * last call (all of it after a change of traversabilityOptions or of the window). */
     multibin::traversability::TraversabilityLayers traversabilityLayers() const;
+    /** Brings the layers up to date (as traversabilityLayers()) without copying them: for a
+     * live loop that reads them through the queries below. */
+    void updateTraversability() const;
     /** Layers of traversabilityRaster(). */
     enum class TraversabilityLayer {
         Untraversable,  //!< P(untraversable) [-]
