@@ -112,7 +112,7 @@ struct StencilPoint {
     int group;         //!< the cell it lies in, numbered over the stencil's cells
     uint8_t discs;
 };
-/** A cell around the centre cell whose bins count (its centre inside a disc). */
+/** A cell around the centre cell whose bins count (some of it inside a disc). */
 struct StencilCell {
     int dc, dr;
     int group;
@@ -152,7 +152,9 @@ Stencil makeStencil(double cell_m, int k, const TraversabilityOptions& o) {
         }
     for (int dr = -rc; dr <= rc; dr++)
         for (int dc = -rc; dc <= rc; dc++) {
-            const double dx = dc * cell_m, dy = dr * cell_m;
+            // A cell whose any part lies in a disc: its other surface may lie anywhere in it.
+            const double dx = std::max(0.0, (std::abs(dc) - 0.5) * cell_m);
+            const double dy = std::max(0.0, (std::abs(dr) - 0.5) * cell_m);
             const uint8_t discs = discsAt(dx * dx + dy * dy, o);
             if (discs) s.cells.push_back({dc, dr, (dr + rc) * side + (dc + rc), discs});
         }

@@ -46,7 +46,7 @@ struct TraversabilityOptions {
     bool use_bins = true;
     /** [bin_min_certainty_share] such a bin counts only with at least this share of the
      * surface's certainty (a stray return or a mixed pixel makes a bin of its own) [-] */
-    double bin_min_certainty_share = 0.5;
+    double bin_min_certainty_share = 0.25;
 
     /** How a feature of the map relates to the truth's at the map's resolution: the truth's
      * feature is bias + gain x the map's, give or take a Gaussian error of sigma model_sigma
