@@ -7,30 +7,14 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
 #include <string>
-#include <utility>
-#include <vector>
 
 namespace {
-using ObservationsWithPdf =
-    std::vector<std::pair<mrpt::obs::CObservation::Ptr, mrpt::poses::CPose3DPDFGaussian>>;
-
-/** The shipped mock-up's laser scans or stereo frames with their keyframe pose PDFs, in order. */
-bool loadMockup(ObservationsWithPdf& out, bool lasers) {
-    mrpt::maps::CSimpleMap simplemap;
-    if (!simplemap.loadFromFile(std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/mockup.simplemap"))
-        return false;
-    mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
-        simplemap,
-        [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
-            if (lasers !=
-                (dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs) != nullptr))
-                return;
-            obs.load();
-            out.emplace_back(
-                std::dynamic_pointer_cast<mrpt::obs::CObservation>(obs.duplicateGetSmartPtr()),
-                pdf);
-        });
-    return true;
+/** The shipped mock-up's keyframes (rawlogs/mockup.simplemap); false if missing. */
+bool loadMockup(mrpt::maps::CSimpleMap& simplemap) {
+    return simplemap.loadFromFile(std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/mockup.simplemap");
+}
+bool isLaser(const mrpt::obs::CObservation& obs) {
+    return dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs) != nullptr;
 }
 
 mrpt::maps::CMultiBinElevationMap mockupMap() {
@@ -50,23 +34,29 @@ mrpt::maps::CMultiBinElevationMap mockupMap() {
 // after each one (the hexapod defaults) or not (0). The update's cost per observation is the
 // difference of the two, divided by `observations`.
 static void BM_MockupWithTraversability(benchmark::State& state) {
-    ObservationsWithPdf observations;
-    if (!loadMockup(observations, state.range(0) != 0)) {
+    mrpt::maps::CSimpleMap simplemap;
+    if (!loadMockup(simplemap)) {
         state.SkipWithError("rawlogs/mockup.simplemap not found");
         return;
     }
-    const bool update = state.range(1) != 0;
-    state.SetLabel(std::string(state.range(0) ? "laser" : "stereo") +
+    const bool lasers = state.range(0) != 0, update = state.range(1) != 0;
+    state.SetLabel(std::string(lasers ? "laser" : "stereo") +
                    (update ? ", layers updated after each" : ", insertion only"));
+    size_t observations = 0;
     for (auto _ : state) {
         mrpt::maps::CMultiBinElevationMap map = mockupMap();
-        for (const auto& [obs, pdf] : observations) {
-            map.insertObservation(*obs, pdf);
-            if (update) map.updateTraversability();
-        }
+        observations = 0;
+        mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
+            simplemap,
+            [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
+                if (isLaser(obs) != lasers) return;
+                map.insertObservation(obs, pdf);
+                if (update) map.updateTraversability();
+                observations++;
+            });
         benchmark::DoNotOptimize(map);
     }
-    state.counters["observations"] = double(observations.size());
+    state.counters["observations"] = double(observations);
 }
 BENCHMARK(BM_MockupWithTraversability)
     ->Args({1, 0})
@@ -78,14 +68,13 @@ BENCHMARK(BM_MockupWithTraversability)
 // The layers of the whole mock-up map computed once from nothing (what a batch run's export
 // costs).
 static void BM_MockupLayersFromScratch(benchmark::State& state) {
-    ObservationsWithPdf lasers, stereo;
-    if (!loadMockup(lasers, true) || !loadMockup(stereo, false)) {
+    mrpt::maps::CSimpleMap simplemap;
+    if (!loadMockup(simplemap)) {
         state.SkipWithError("rawlogs/mockup.simplemap not found");
         return;
     }
     mrpt::maps::CMultiBinElevationMap map = mockupMap();
-    for (const auto* set : {&lasers, &stereo})
-        for (const auto& [obs, pdf] : *set) map.insertObservation(*obs, pdf);
+    map.insertSimpleMapWithPosePdfs(simplemap);
     for (auto _ : state) {
         const mrpt::maps::CMultiBinElevationMap copy = map;  // a copy recomputes everything
         copy.updateTraversability();

@@ -5,6 +5,7 @@
 #include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/obs/CObservationPointCloud.h>
 
 #include <cmath>
 #include <random>
@@ -154,4 +155,37 @@ TEST(TraversabilityMap, OccupancyGridPointsAndFoothold) {
     EXPECT_GT(std::abs(f.x_m - 0.3), 0.03);  // away from the edge
     EXPECT_NEAR(f.z_m, f.x_m > 0.3 ? 0.1 : 0.0, 0.01);
     EXPECT_FALSE(map.bestFoothold(2.0, 2.0, 0.1).found);
+}
+
+TEST(TraversabilityMap, TheLiveUpdateAfterTheWindowGrewEqualsAFullRecompute) {
+    // Point clouds seen from a robot at the origin: the map grows to cover each.
+    CMultiBinElevationMap map;
+    const auto cloud = [](double x0, double z) {
+        auto obs = mrpt::obs::CObservationPointCloud::Create();
+        obs->sensorLabel = "CLOUD";
+        auto pts = mrpt::maps::CSimplePointsMap::Create();
+        for (double y = -0.15; y < 0.15; y += 0.005)
+            for (double x = x0; x < x0 + 0.3; x += 0.005)
+                pts->insertPoint(float(x), float(y), float(z + 0.2 * (x - x0)));
+        obs->pointcloud = pts;
+        return obs;
+    };
+    const mrpt::poses::CPose3D robot;
+    ASSERT_TRUE(map.insertObservation(*cloud(0.2, 0.0), robot));
+    const auto before = map.traversabilityLayers();
+    ASSERT_TRUE(map.insertObservation(*cloud(3.0, 0.1), robot));
+    const auto live = map.traversabilityLayers();
+    ASSERT_FALSE(live.lattice == before.lattice);  // the window grew
+    const CMultiBinElevationMap copy = map;        // a copy computes its layers afresh
+    const auto full = copy.traversabilityLayers();
+    ASSERT_EQ(live.size(), full.size());
+    int differ = 0, known = 0;
+    for (size_t k = 0; k < live.size(); k++) {
+        differ +=
+            !((std::isnan(live.untraversable[k]) && std::isnan(full.untraversable[k])) ||
+              (live.untraversable[k] == full.untraversable[k] && live.step_m[k] == full.step_m[k]));
+        known += live.known(k);
+    }
+    EXPECT_EQ(differ, 0);
+    EXPECT_GT(known, 200);
 }

@@ -123,9 +123,29 @@ void CMultiBinElevationMap::updateTraversability() const {
     o.validate();
     const multibin::BinGrid& grid = m_impl->grid;
     const multibin::Lattice lattice = grid.lattice();
-    const bool full = !cache.valid || !(cache.samples.lattice == lattice) ||
+    const bool full = !cache.valid || cache.samples.lattice.cellSize_m != lattice.cellSize_m ||
                       cache.samples.perCell != o.samples_per_cell ||
                       cache.options.text() != o.text() || isDualGrid();
+    if (!full && !(cache.samples.lattice == lattice)) {
+        // The window moved or grew: what it kept is kept; the new cells' digest (0) differs
+        // from any real one, so they and the cells whose discs reach them are computed below.
+        SurfaceSamples samples(lattice, o.samples_per_cell);
+        samples.copyFrom(cache.samples);
+        TraversabilityLayers layers(lattice);
+        layers.copyFrom(cache.layers);
+        std::vector<uint64_t> signature(lattice.cellCount(), 0);
+        const multibin::CellWindow& old = cache.samples.lattice.window;
+        for (int row = 0; row < lattice.ny(); row++)
+            for (int col = 0; col < lattice.nx(); col++) {
+                const int ix = lattice.window.ix0 + col, iy = lattice.window.iy0 + row;
+                if (old.contains(ix, iy))
+                    signature[lattice.index(col, row)] =
+                        cache.signature[cache.samples.lattice.index(ix - old.ix0, iy - old.iy0)];
+            }
+        cache.samples = std::move(samples);
+        cache.layers = std::move(layers);
+        cache.signature = std::move(signature);
+    }
     if (full) {
         cache.samples = SurfaceSamples(lattice, o.samples_per_cell);
         cache.signature.assign(lattice.cellCount(), 0);

@@ -74,6 +74,30 @@ void SurfaceSamples::setCell(int col, int row, float h_m, float s_m) {
         }
 }
 
+void SurfaceSamples::copyFrom(const SurfaceSamples& o) {
+    const CellWindow& w = lattice.window;
+    const CellWindow& v = o.lattice.window;
+    const int k = perCell;
+    for (int iy = std::max(w.iy0, v.iy0); iy < std::min(w.iy0 + w.ny, v.iy0 + v.ny); iy++)
+        for (int ix = std::max(w.ix0, v.ix0); ix < std::min(w.ix0 + w.nx, v.ix0 + v.nx); ix++) {
+            const int col = ix - w.ix0, row = iy - w.iy0, oc = ix - v.ix0, orow = iy - v.iy0;
+            const size_t to = lattice.index(col, row), from = o.lattice.index(oc, orow);
+            for (auto [dst, src] : {std::pair{&binLow_m, &o.binLow_m},
+                                    {&binLowSigma_m, &o.binLowSigma_m},
+                                    {&binHigh_m, &o.binHigh_m},
+                                    {&binHighSigma_m, &o.binHighSigma_m},
+                                    {&relief_m2, &o.relief_m2}})
+                (*dst)[to] = (*src)[from];
+            for (int r = 0; r < k; r++)
+                for (int c = 0; c < k; c++) {
+                    const size_t i = sampleIndex(col * k + c, row * k + r);
+                    const size_t j = o.sampleIndex(oc * k + c, orow * k + r);
+                    height_m[i] = o.height_m[j];
+                    sigma_m[i] = o.sigma_m[j];
+                }
+        }
+}
+
 TraversabilityLayers::TraversabilityLayers(const Lattice& l) : lattice(l) {
     for (auto* v : {&step_m, &stepSigma_m, &slope_deg, &slopeSigma_deg, &roughness_m,
                     &roughnessSigma_m, &untraversable, &foothold})

@@ -67,6 +67,8 @@ struct SurfaceSamples {
     int sx() const { return lattice.nx() * perCell; }  //!< sample columns
     int sy() const { return lattice.ny() * perCell; }  //!< sample rows
     size_t sampleIndex(int sc, int sr) const { return size_t(sr) * size_t(sx()) + size_t(sc); }
+    /** Copies the cells of `o` that lie inside this lattice (same cell size and k). */
+    void copyFrom(const SurfaceSamples& o);
     /** Sets all k x k samples of cell (col, row) to one height and sigma (a filled cell). */
     void setCell(int col, int row, float h_m, float sigma_m);
 };
