@@ -112,11 +112,13 @@ std::string scoresTable(const std::map<std::string, ClassifierScore>& scores,
                         const std::vector<std::string>& order) {
     std::ostringstream t;
     char line[256];
-    t << "method                 precision  recall      F1     ECE  coverage   cells\n";
+    // Indented, as the evaluation's per-area lines: tools that read the height table's rows by
+    // their method names (compare-baseline.sh) skip these.
+    t << "  method                 precision  recall      F1     ECE  coverage   cells\n";
     for (const std::string& name : order) {
         const ClassifierScore& s = scores.at(name);
-        std::snprintf(line, sizeof line, "%-22s %9.3f %7.3f %7.3f %7.3f %9.3f %7zu\n", name.c_str(),
-                      s.precision, s.recall, s.f1, s.ece, s.coverage, s.scored);
+        std::snprintf(line, sizeof line, "  %-22s %9.3f %7.3f %7.3f %7.3f %9.3f %7zu\n",
+                      name.c_str(), s.precision, s.recall, s.f1, s.ece, s.coverage, s.scored);
         t << line;
     }
     if (order.empty()) return t.str();
