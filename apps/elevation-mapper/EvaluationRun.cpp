@@ -120,8 +120,7 @@ std::string evaluateTraversability(const OutputFolder& out, const CMultiBinEleva
     thresholded.use_bins = false;
     for (const MethodEstimate& m : heightMethods) {
         trav::TraversabilityLayers t;
-        trav::computeLayers(trav::cellHeightSamples(lattice, rowMajor(m.height_m)), thresholded,
-                            t);
+        trav::computeLayers(trav::cellHeightSamples(lattice, rowMajor(m.height_m)), thresholded, t);
         scores[m.name + "_thresholded"] = trav::scoreProbabilities(t.untraversable, truth);
         order.push_back(m.name + "_thresholded");
     }
