@@ -11,8 +11,12 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
+
+#include "multibin/io/RasterExport.h"
+#include "multibin/traversability/TraversabilityEvaluation.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
@@ -76,6 +80,72 @@ CellArray sampleDem(const mrpt::maps::CHeightGridMap2D_Base& dem, const Lattice&
                 h(r, c) = float(z);
         }
     return h;
+}
+
+/** Row-major values of a lattice's cells (CellArray rows are y). */
+std::vector<float> rowMajor(const CellArray& a) {
+    std::vector<float> v(size_t(a.rows()) * size_t(a.cols()), NAN);
+    for (int r = 0; r < a.rows(); r++)
+        for (int c = 0; c < a.cols(); c++) v[size_t(r) * size_t(a.cols()) + size_t(c)] = a(r, c);
+    return v;
+}
+
+/** The traversability layer against the truth's (doc/traversability.md): classes from the
+ * ground-truth raster itself (the finer it is, the closer to the surface), scored for the map's
+ * probabilities and for the features of the filled map's and MRPT's heights thresholded.
+ * Writes traversability.json and eval_untraversable_{truth,multibin}.{asc,png}. */
+std::string evaluateTraversability(const OutputFolder& out, const CMultiBinElevationMap& map,
+                                   const Lattice& lattice, const std::string& truthPath,
+                                   const std::vector<MethodEstimate>& heightMethods) {
+    namespace trav = multibin::traversability;
+    const trav::TraversabilityOptions& o = map.traversabilityOptions;
+    const std::vector<int8_t> truth =
+        trav::truthClasses(multibin::EsriAsciiGrid::load(truthPath), lattice, o);
+    // The map's layer, looked up at each evaluated cell's centre.
+    const trav::TraversabilityLayers layers = map.traversabilityLayers();
+    const mrpt::math::TPoint2D origin = map.mapOrigin();
+    std::vector<float> p(lattice.cellCount(), NAN);
+    for (int r = 0; r < lattice.ny(); r++)
+        for (int c = 0; c < lattice.nx(); c++) {
+            int lc, lr;
+            if (layers.lattice.cellOf(lattice.cellCenterX_m(c) - origin.x,
+                                      lattice.cellCenterY_m(r) - origin.y, lc, lr))
+                p[lattice.index(c, r)] = layers.untraversable[layers.lattice.index(lc, lr)];
+        }
+    std::map<std::string, trav::ClassifierScore> scores{
+        {"multibin", trav::scoreProbabilities(p, truth)}};
+    std::vector<std::string> order{"multibin"};
+    trav::TraversabilityOptions thresholded = o;
+    thresholded.monte_carlo_draws = 0;
+    thresholded.use_bins = false;
+    for (const MethodEstimate& m : heightMethods) {
+        trav::TraversabilityLayers t;
+        trav::computeLayers(trav::cellHeightSamples(lattice, rowMajor(m.height_m)), thresholded, t);
+        scores[m.name + "_thresholded"] = trav::scoreProbabilities(t.untraversable, truth);
+        order.push_back(m.name + "_thresholded");
+    }
+    out.write("traversability.json", trav::scoresJson(scores, order, o));
+    multibin::PreviewStyle style;
+    style.title = "P(untraversable)";
+    style.colormap = cv::COLORMAP_INFERNO;
+    style.valueFormat = "%.2f";
+    for (const auto& [name, values] :
+         {std::pair<std::string, std::vector<float>>{"truth", {truth.begin(), truth.end()}},
+          {"multibin", p}}) {
+        multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(lattice);
+        for (int r = 0; r < lattice.ny(); r++)
+            for (int c = 0; c < lattice.nx(); c++) {
+                const float v = values[lattice.index(c, r)];
+                g.heights_m(r, c) = v < 0 ? NAN : v;  // the truth's -1: unknown
+            }
+        out.writeWith("eval_untraversable_" + name + ".asc", [&](const std::string& path) {
+            g.save(path);
+            return true;
+        });
+        out.write("eval_untraversable_" + name + ".png", multibin::encodePreviewPng(g, style));
+    }
+    return "Traversability against the truth's features (traversability.json):\n" +
+           trav::scoresTable(scores, order);
 }
 
 }  // namespace
@@ -262,6 +332,10 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
             multibin::eval::scoreArea("mrf_crop", m_truth, methods, m_lattice, m_mrfLattice));
 
     out.write("report.json", multibin::eval::reportJson(scores, order, m_lattice, areas));
+    // The truth's own cell means: what thresholded heights at the map's resolution reach at best.
+    MethodEstimate truthCells;
+    truthCells.name = "truth_cell_means";
+    truthCells.height_m = m_truth;
     auto saveRaster = [&](const std::string& name, const CellArray& values) {
         out.writeWith(name, [&](const std::string& path) {
             rasterOf(m_lattice, values).save(path);
@@ -271,7 +345,9 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     saveRaster("eval_truth.asc", m_truth);
     for (const auto& m : methods) saveRaster("eval_" + m.name + ".asc", m.height_m);
     out.write("profile.csv", profileCsv(m_truth, methods));
-    return multibin::eval::reportTable(scores, order, areas);
+    return multibin::eval::reportTable(scores, order, areas) +
+           evaluateTraversability(out, m_evaluated, m_lattice, m_options.groundTruthPath,
+                                  {filled, heightGrid, truthCells});
 }
 
 std::string EvaluationRun::profileCsv(const CellArray& truth,

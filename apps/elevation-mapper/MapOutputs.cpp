@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <mrpt/io/CMemoryStream.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/serialization/CArchive.h>
@@ -41,9 +42,27 @@ const Group kGroups[] = {
      "elevation_{height,sigma,source}.png (previews: axes [m], scale, legend)"},
     {"asc", &OutputSelection::asc, "elevation_{height,sigma,certainty,source}.asc (ESRI ASCII)"},
     {"ply", &OutputSelection::ply, "elevation.ply (triangle mesh [m])"},
+    {"gridmap", &OutputSelection::gridmap,
+     "elevation_traversability.gridmap.gz (MRPT occupancy grid: P(untraversable), unknown 0.5)"
+     " and elevation_untraversable.png"},
 };
 
 const char* const kLayerNames[] = {"height", "sigma", "certainty", "source"};
+/** The traversability layers `asc` writes (doc/traversability.md), in TraversabilityLayer order. */
+const char* const kTraversabilityNames[] = {"untraversable", "step", "slope", "roughness",
+                                            "foothold"};
+
+/** The map's traversability layer over the same cells as `like` (a cropped map raster). */
+multibin::EsriAsciiGrid traversabilityLike(const CMultiBinElevationMap& map, int layer,
+                                           const multibin::EsriAsciiGrid& like) {
+    const multibin::EsriAsciiGrid t =
+        map.traversabilityRaster(static_cast<CMultiBinElevationMap::TraversabilityLayer>(layer));
+    multibin::RasterBox box;
+    box.col0 = int(std::lround((like.xllcenter_m - t.xllcenter_m) / t.cellsize_m));
+    box.row0 = int(std::lround((like.yllcenter_m - t.yllcenter_m) / t.cellsize_m));
+    box.cols = like.cols(), box.rows = like.rows();
+    return multibin::cropRaster(t, box);
+}
 
 /** The serialized form of an object, gzip-compressed in memory (what CFileGZOutputStream writes
  * and CFileGZInputStream reads), so the file is written whole by writeFileAtomically(). MRPT's
@@ -114,6 +133,11 @@ std::vector<std::string> OutputSelection::fileNames() const {
             f.push_back(std::string("elevation_") + l + ".png");
     if (asc)
         for (const char* l : kLayerNames) f.push_back(std::string("elevation_") + l + ".asc");
+    if (asc)
+        for (const char* l : kTraversabilityNames)
+            f.push_back(std::string("elevation_") + l + ".asc");
+    if (gridmap)
+        f.insert(f.end(), {"elevation_traversability.gridmap.gz", "elevation_untraversable.png"});
     if (ply) f.push_back("elevation.ply");
     return f;
 }
@@ -308,6 +332,27 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
         });
     }
     if (sel.asc) steps.emplace_back("elevation_*.asc", [&] { layers.saveAsc(folder); });
+    if (sel.asc)
+        steps.emplace_back("traversability *.asc", [&] {
+            for (int i = 0; i < 5; i++)
+                folder.writeWith(std::string("elevation_") + kTraversabilityNames[i] + ".asc",
+                                 [&](const std::string& path) {
+                                     traversabilityLike(map, i, layers.height).save(path);
+                                     return true;
+                                 });
+        });
+    if (sel.gridmap)
+        steps.emplace_back("elevation_traversability.gridmap.gz", [&] {
+            mrpt::maps::COccupancyGridMap2D grid;
+            map.getAsOccupancyGrid(grid);
+            folder.write("elevation_traversability.gridmap.gz", gzSerialized(grid));
+            multibin::PreviewStyle u;
+            u.title = "P(untraversable)";
+            u.colormap = cv::COLORMAP_INFERNO;
+            u.valueFormat = "%.2f";
+            folder.write("elevation_untraversable.png",
+                         multibin::encodePreviewPng(traversabilityLike(map, 0, layers.height), u));
+        });
     if (sel.ply)
         steps.emplace_back("elevation.ply", [&] {
             folder.write("elevation.ply", multibin::meshPlyText(layers.height));

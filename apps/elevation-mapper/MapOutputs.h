@@ -21,6 +21,9 @@ struct OutputSelection {
     bool png = true;    //!< elevation_{height,sigma,source}.png: previews with legends
     bool asc = false;   //!< elevation_{height,sigma,certainty,source}.asc: ESRI ASCII rasters
     bool ply = false;   //!< elevation.ply: triangle mesh [m]
+    /** elevation_traversability.gridmap.gz: MRPT COccupancyGridMap2D, occupancy =
+     * P(untraversable), unknown 0.5; and elevation_untraversable.png */
+    bool gridmap = false;
     /** What colours the scene (--scene-colour). */
     multibin::SceneColouring sceneColouring = multibin::SceneColouring::Height;
 

@@ -213,7 +213,9 @@ TEST(ElevationMapperOutputs, OutputsChoosesWhatIsWritten) {
     EXPECT_EQ(filesIn(d / "asc"),
               (std::set<std::string>{"elevation_height.asc", "elevation_sigma.asc",
                                      "elevation_certainty.asc", "elevation_source.asc",
-                                     "elevation.ply"}));
+                                     "elevation_untraversable.asc", "elevation_step.asc",
+                                     "elevation_slope.asc", "elevation_roughness.asc",
+                                     "elevation_foothold.asc", "elevation.ply"}));
     const RunResult bad =
         runMapper(d, common + " --outputs map,geotiff --out " + (d / "bad").string());
     EXPECT_EQ(bad.exitCode, 1);

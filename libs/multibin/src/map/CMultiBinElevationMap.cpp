@@ -105,14 +105,15 @@ void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::st
         for (long i = 0; i < count && !known; i++) {
             char nn[8];
             std::snprintf(nn, sizeof nn, "%02ld", i);
-            for (const char* part : {"_creationOpts", "_insertOpts"})
+            for (const char* part : {"_creationOpts", "_insertOpts", "_traversabilityOpts"})
                 known = known || sec == parent + tag + nn + part;
         }
         if (!known)
             throw std::invalid_argument(
                 iniName(source) + ", section '" + sec + "': unknown section (this map reads '" +
-                parent + tag + "NN_creationOpts' and '" + parent + tag +
-                "NN_insertOpts', NN from 00 to " + std::to_string(count - 1) + ")");
+                parent + tag + "NN_creationOpts', '" + parent + tag + "NN_insertOpts' and '" +
+                parent + tag + "NN_traversabilityOpts', NN from 00 to " +
+                std::to_string(count - 1) + ")");
     }
 }
 
@@ -321,11 +322,14 @@ void CMultiBinElevationMap::TMapDefinition::loadFromConfigFile_map_specific(
     checkMapSections(source, sectionNamePrefix);
     creationOpts.loadFromConfigFile(source, sectionNamePrefix + "_creationOpts");
     insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
+    if (source.sectionExists(sectionNamePrefix + "_traversabilityOpts"))
+        traversabilityOpts.loadFromConfigFile(source, sectionNamePrefix + "_traversabilityOpts");
 }
 
 void CMultiBinElevationMap::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const {
     creationOpts.dumpToTextStream(out);
     insertionOpts.dumpToTextStream(out);
+    out << "traversability: " << traversabilityOpts.text() << "\n";
 }
 
 mrpt::maps::CMetricMap* CMultiBinElevationMap::internal_CreateFromMapDefinition(
@@ -333,6 +337,7 @@ mrpt::maps::CMetricMap* CMultiBinElevationMap::internal_CreateFromMapDefinition(
     const auto& def = dynamic_cast<const CMultiBinElevationMap::TMapDefinition&>(_def);
     auto* obj = new CMultiBinElevationMap(def.creationOpts);
     obj->insertionOptions = def.insertionOpts;
+    obj->traversabilityOptions = def.traversabilityOpts;
     return obj;
 }
 
@@ -353,6 +358,7 @@ CMultiBinElevationMap::CMultiBinElevationMap(const CMultiBinElevationMap& other)
       CHeightGridMap2D_Base(other),
       creationOptions(other.creationOptions),
       insertionOptions(other.insertionOptions),
+      traversabilityOptions(other.traversabilityOptions),
       m_impl(std::make_unique<Impl>(*other.m_impl)) {}
 
 CMultiBinElevationMap& CMultiBinElevationMap::operator=(const CMultiBinElevationMap& other) {
@@ -361,6 +367,7 @@ CMultiBinElevationMap& CMultiBinElevationMap::operator=(const CMultiBinElevation
     CHeightGridMap2D_Base::operator=(other);
     creationOptions = other.creationOptions;
     insertionOptions = other.insertionOptions;
+    traversabilityOptions = other.traversabilityOptions;
     *m_impl = *other.m_impl;
     return *this;
 }

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "MapLock.h"
+#include "TraversabilityCache.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/geometry/Lattice.h"
 #include "multibin/map/BinGrid.h"
@@ -38,6 +39,8 @@ struct CMultiBinElevationMap::Impl {
     bool fillStale = true;
     /** One writer or concurrent readers: every public entry point takes it (MapLock.h). */
     multibin::MapLock lock;
+    /** The traversability layers (CMultiBinElevationMap_traversability.cpp). */
+    multibin::TraversabilityCache traversability;
 };
 
 }  // namespace mrpt::maps

@@ -22,6 +22,7 @@
 #include "multibin/geometry/PointsWithCovariance.h"
 #include "multibin/map/MapTypes.h"
 #include "multibin/sensors/SensorModelOptions.h"
+#include "multibin/traversability/TraversabilityOptions.h"
 
 // The library's internals stay out of this header: these are only named here. Include
 // multibin/map/BinGrid.h to read grid(), multibin/io/EsriAsciiGrid.h to use toRaster(),
@@ -38,7 +39,14 @@ struct FillResult;
 namespace sensors {
 struct SensorModelStats;
 }
+namespace traversability {
+struct TraversabilityLayers;
+}
 }  // namespace multibin
+namespace mrpt::maps {
+class COccupancyGridMap2D;
+class CSimplePointsMap;
+}  // namespace mrpt::maps
 
 namespace mrpt::maps {
 
@@ -322,6 +330,46 @@ public:
     /** Colour image of the heights (or sigmas) with insertionOptions.colormap, north up; black
      * where unknown. */
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
+    /** @name Traversability (multibin/traversability/TerrainFeatures.h, doc/traversability.md)
+     * @{ */
+    /** The robot's limits and how the layers are computed (ini section `..._traversabilityOpts`).
+     */
+    multibin::traversability::TraversabilityOptions traversabilityOptions;
+    /** Step, slope, roughness with their sigmas, P(untraversable) and the foothold probability of
+     * every cell of the grid window (NaN where unknown), from the sub-cell surface, the bins and
+     * the last gap filling (dem_update_map()). Recomputed only where the map changed since the
+     * last call (all of it after a change of traversabilityOptions or of the window). */
+    multibin::traversability::TraversabilityLayers traversabilityLayers() const;
+    /** Brings the layers up to date (as traversabilityLayers()) without copying them: for a
+     * live loop that reads them through the queries below. */
+    void updateTraversability() const;
+    /** Layers of traversabilityRaster(). */
+    enum class TraversabilityLayer {
+        Untraversable,  //!< P(untraversable) [-]
+        Step,           //!< [m]
+        Slope,          //!< [deg]
+        Roughness,      //!< [m]
+        Foothold        //!< P(good foothold) [-]
+    };
+    /** One traversability layer as a raster in the pose frame, NaN where unknown. */
+    multibin::EsriAsciiGrid traversabilityRaster(TraversabilityLayer layer) const;
+    /** An MRPT occupancy grid on the map's lattice (pose frame) whose occupancy is
+     * P(untraversable), 0.5 where unknown: what mrpt::nav::PlannerSimple2D plans on. */
+    void getAsOccupancyGrid(mrpt::maps::COccupancyGridMap2D& grid) const;
+    /** Fills `points` with the centres (x, y, height) [m] of the cells whose P(untraversable) is
+     * at least minProbability: the obstacles of MRPT's point-based planners. */
+    void getUntraversablePoints(mrpt::maps::CSimplePointsMap& points,
+                                double minProbability = 0.5) const;
+    /** A foothold: the centre of a cell, its height and the probability it is good. */
+    struct TFoothold {
+        bool found = false;
+        double x_m = 0, y_m = 0, z_m = 0;
+        double probability = 0;
+    };
+    /** The known cell within searchRadius_m of (x, y) with the highest foothold probability (the
+     * nearest of equals). */
+    TFoothold bestFoothold(double x_m, double y_m, double searchRadius_m) const;
+    /** @} */
     /** Sums of what every insertion did with its points. */
     const multibin::InsertStats& insertStats() const;
     /** Sums of what the visibility constraint did. */
@@ -379,6 +427,7 @@ public:
     MAP_DEFINITION_START(CMultiBinElevationMap)
     TCreationOptions creationOpts;
     TInsertionOptions insertionOpts;
+    multibin::traversability::TraversabilityOptions traversabilityOpts;
     MAP_DEFINITION_END(CMultiBinElevationMap)
 
 private:

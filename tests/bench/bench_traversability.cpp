@@ -1,0 +1,85 @@
+/* The traversability layers' live update against the insertion it follows (doc/traversability.md,
+ * "Live use"). Run from a Release build: build/tests/bench/bench_traversability. */
+#include <benchmark/benchmark.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+
+#include <string>
+
+namespace {
+/** The shipped mock-up's keyframes (rawlogs/mockup.simplemap); false if missing. */
+bool loadMockup(mrpt::maps::CSimpleMap& simplemap) {
+    return simplemap.loadFromFile(std::string(MULTIBIN_REFERENCE_DATA_DIR) + "/mockup.simplemap");
+}
+bool isLaser(const mrpt::obs::CObservation& obs) {
+    return dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&obs) != nullptr;
+}
+
+mrpt::maps::CMultiBinElevationMap mockupMap() {
+    const mrpt::config::CConfigFile ini(std::string(MULTIBIN_REFERENCE_DATA_DIR) +
+                                        "/../ini/mockup.ini");
+    const std::string section = "MappingApplication_multiBinElevationMap_00_";
+    mrpt::maps::CMultiBinElevationMap::TCreationOptions creation;
+    creation.loadFromConfigFile(ini, section + "creationOpts");
+    mrpt::maps::CMultiBinElevationMap map(creation);
+    map.insertionOptions.loadFromConfigFile(ini, section + "insertOpts");
+    return map;
+}
+}  // namespace
+
+// Every laser scan (arg 1) or stereo frame (arg 0) of the shipped mock-up into a fresh map as
+// ini/mockup.ini configures it, with (arg 2 = 1) the traversability layers brought up to date
+// after each one (the hexapod defaults) or not (0). The update's cost per observation is the
+// difference of the two, divided by `observations`.
+static void BM_MockupWithTraversability(benchmark::State& state) {
+    mrpt::maps::CSimpleMap simplemap;
+    if (!loadMockup(simplemap)) {
+        state.SkipWithError("rawlogs/mockup.simplemap not found");
+        return;
+    }
+    const bool lasers = state.range(0) != 0, update = state.range(1) != 0;
+    state.SetLabel(std::string(lasers ? "laser" : "stereo") +
+                   (update ? ", layers updated after each" : ", insertion only"));
+    size_t observations = 0;
+    for (auto _ : state) {
+        mrpt::maps::CMultiBinElevationMap map = mockupMap();
+        observations = 0;
+        mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
+            simplemap,
+            [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
+                if (isLaser(obs) != lasers) return;
+                map.insertObservation(obs, pdf);
+                if (update) map.updateTraversability();
+                observations++;
+            });
+        benchmark::DoNotOptimize(map);
+    }
+    state.counters["observations"] = double(observations);
+}
+BENCHMARK(BM_MockupWithTraversability)
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Args({0, 0})
+    ->Args({0, 1})
+    ->Unit(benchmark::kMillisecond);
+
+// The layers of the whole mock-up map computed once from nothing (what a batch run's export
+// costs).
+static void BM_MockupLayersFromScratch(benchmark::State& state) {
+    mrpt::maps::CSimpleMap simplemap;
+    if (!loadMockup(simplemap)) {
+        state.SkipWithError("rawlogs/mockup.simplemap not found");
+        return;
+    }
+    mrpt::maps::CMultiBinElevationMap map = mockupMap();
+    map.insertSimpleMapWithPosePdfs(simplemap);
+    for (auto _ : state) {
+        const mrpt::maps::CMultiBinElevationMap copy = map;  // a copy recomputes everything
+        copy.updateTraversability();
+    }
+}
+BENCHMARK(BM_MockupLayersFromScratch)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
