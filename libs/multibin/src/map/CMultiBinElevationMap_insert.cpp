@@ -375,7 +375,7 @@ void CMultiBinElevationMap::growToCoverPoints(const PointsWithCov& mapPoints,
                                               const Eigen::Vector3d& sensor_m) {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     validateOptions(*this);
-    growToCover(mapPoints, sensor_m);
+    growToCover(mapPoints, sensor_m, binUpdateParams());
 }
 
 multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
