@@ -208,13 +208,23 @@ bool gradientOf(const PlaneMoments& m, double points, Gradient& g) {
     const double a = m.sxx, b = m.sxy, c = m.syy;
     const double det = a * c - b * b, trace = a + c;
     if (points < 4 || !(det > 1e-3 * trace * trace)) return false;
-    g.gx = (c * m.sxz - b * m.syz) / det;
-    g.gy = (a * m.syz - b * m.sxz) / det;
-    const double rss = m.szz - g.gx * m.sxz - g.gy * m.syz;
+    const double fitGx = (c * m.sxz - b * m.syz) / det;
+    const double fitGy = (a * m.syz - b * m.sxz) / det;
+    const double rss = m.szz - fitGx * m.sxz - fitGy * m.syz;
     g.chi2 = std::max(1.0, rss / (points - 3));
-    g.cxx = g.chi2 * c / det;
-    g.cxy = -g.chi2 * b / det;
-    g.cyy = g.chi2 * a / det;
+    // The fit combined with the prior every gradient has (0 +- kUnknownSlope per axis): points
+    // nearly on a line leave the slope across the line undetermined, and the fit alone would
+    // extrapolate it to metres at a cell's edge; the prior keeps it near 0 there and changes a
+    // well-spread fit by a fraction of its own sigma.
+    const double prior = 1.0 / (kUnknownSlope * kUnknownSlope);
+    const double ia = a / g.chi2 + prior, ib = b / g.chi2, ic = c / g.chi2 + prior;
+    const double idet = ia * ic - ib * ib;
+    const double rx = m.sxz / g.chi2, ry = m.syz / g.chi2;
+    g.gx = (ic * rx - ib * ry) / idet;
+    g.gy = (ia * ry - ib * rx) / idet;
+    g.cxx = ic / idet;
+    g.cxy = -ib / idet;
+    g.cyy = ia / idet;
     return true;
 }
 
