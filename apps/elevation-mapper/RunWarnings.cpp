@@ -22,7 +22,8 @@ std::vector<Gate> gatesOf(const mrpt::maps::CMultiBinElevationMap& map) {
     return {
         {"range gate", range, "min_range_m and max_range_m"},
         {"outside map", s.outsideMap,
-         "max_size_m (the growth limit; grow, min_x .. max_y for a fixed window)"},
+         "grow and min_x_m .. max_y_m for a fixed window; local_size_m, global_size_m for the "
+         "dual grid; max_range_m bounds how far from its sensor a point grows the map"},
         {"eq 13 gate (too uncertain: 3 sigma_z > the limit)", s.tooUncertain,
          "max_elevation_uncertainty_m or the sensor's *_max_elevation_uncertainty_m; the pose "
          "covariance (default_pose_sigmas when the input gives none) sets sigma_z at range "

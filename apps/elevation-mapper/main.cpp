@@ -330,8 +330,8 @@ int run(const Arguments& args, std::string& stage) {
     if (fused.accepted == 0 && fused.outsideMap > 0)
         throw std::runtime_error(inputName + ": the map's window (" + windowText(*elevation) +
                                  ") does not hold the data: " + std::to_string(fused.outsideMap) +
-                                 " points fell outside it, none inside (check grow, max_size_m, "
-                                 "min_x_m..max_y_m, resolution_m); " +
+                                 " points fell outside it, none inside (check grow, "
+                                 "min_x_m..max_y_m, resolution_m, max_range_m); " +
                                  tally.whyNothingFused(fused));
     if (fused.accepted == 0)
         throw std::runtime_error(inputName + ": " + tally.whyNothingFused(fused));

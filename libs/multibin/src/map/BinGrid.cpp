@@ -21,20 +21,27 @@ InsertStats& InsertStats::operator+=(const InsertStats& o) {
         &InsertStats::tooUncertain, &InsertStats::continuityRejected, &InsertStats::seenBelow);
 }
 
-BinGrid::BinGrid(double cellSize_m) : m_store(cellSize_m) { m_index.reset(window()); }
+BinGrid::BinGrid(double cellSize_m) : m_store(cellSize_m) { m_index.reset(); }
 
 void BinGrid::reset(double cellSize_m, const CellWindow& window) {
     m_store.reset(cellSize_m, window);
-    m_index.reset(window);
+    m_index.reset();
 }
 
-void BinGrid::growToInclude(const CellWindow& w) {
-    if (m_store.growToInclude(w)) m_index.regrow(m_store);
+size_t BinGrid::writableSlot(int ix, int iy) {
+    bool tileAdded;
+    const size_t s = m_store.writableSlot(ix, iy, tileAdded);
+    if (tileAdded)
+        m_index.tileAdded(uint32_t(s / BinStore::kTileSlots), m_store.slotCount());
+    return s;
 }
 
 void BinGrid::appendBin(int ix, int iy, const BinEstimate& bin) {
-    m_store.appendBin(ix, iy, bin);
-    m_index.noteHeight(m_store.slot(ix, iy), ix, iy, bin.height_m);
+    if (!window().contains(ix, iy))
+        throw std::out_of_range("BinGrid::appendBin: cell outside the window");
+    const size_t s = writableSlot(ix, iy);
+    m_store.appendBin(s, bin);
+    m_index.noteHeight(s, ix, iy, bin.height_m);
 }
 
 void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateParams& params) {
@@ -43,7 +50,7 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
     int16_t n;
     if (!binIndexOf(other.height_m, params.binHeight_m, n)) return;
     bool added;
-    const size_t s = m_store.slot(ix, iy);
+    const size_t s = writableSlot(ix, iy);
     Bin& bin = m_store.bin(m_store.findOrAddBin(s, n, added));
     if (added) {
         static_cast<BinEstimate&>(bin) = other;
@@ -81,7 +88,7 @@ bool BinGrid::insertHeight(int ix, int iy, double height_m, double variance_m2,
         stats.outsideBinRange++;
         return false;
     }
-    return fuseMeasurement(m_store.slot(ix, iy), ix, iy, n, height_m, variance_m2,
+    return fuseMeasurement(writableSlot(ix, iy), ix, iy, n, height_m, variance_m2,
                            1.0 / variance_m2, params, continuityBound_m, stats, std::nanf(""),
                            std::nanf(""), 0, 0);
 }
@@ -127,7 +134,6 @@ enum PointStatus : uint8_t {
 struct ClassifiedBlock {
     alignas(64) double weight[kPointBlock];  //!< 1 / fused variance [1/m^2]
     alignas(64) int32_t ix[kPointBlock], iy[kPointBlock];
-    alignas(64) uint32_t slot[kPointBlock];  // as BinStore::slot, below 2^32 cells
     alignas(64) int32_t bin[kPointBlock];
     alignas(64) uint8_t status[kPointBlock];
     /** The status the gates after the covariance's give (window, eq 13, bin range): the
@@ -141,7 +147,6 @@ struct ClassifiedBlock {
 struct ClassifyGeometry {
     double invCellSize;  //!< [1/m]
     CellWindow window;
-    int originSlotX, originSlotY;
     BinUpdateParams params;
     /** kMinFusedVariance_m2, passed at run time: with the constant, GCC folds 1 / constant into
      * one arm of the select and the loop no longer vectorises. */
@@ -193,9 +198,6 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
         const int ix = BinStore::floorToInt(cellX[i]), iy = BinStore::floorToInt(cellY[i]);
         const int dx = ix - g.window.ix0, dy = iy - g.window.iy0;
         const int inWindow = int(dx >= 0) & int(dx < nx) & int(dy >= 0) & int(dy < ny);
-        int sx = dx + g.originSlotX, sy = dy + g.originSlotY;
-        sx -= nx * int(sx >= nx);
-        sy -= ny * int(sy >= ny);
         const int f = flags[i];
         const int finite = f & 1, positiveDefinite = f >> 1 & 1, eq13 = f >> 2 & 1,
                   binFits = f >> 3 & 1;
@@ -212,7 +214,6 @@ void classifyBlock(const ClassifyGeometry& g, const PointBlock& pts, size_t m,
         cb.ix[i] = ix;
         cb.iy[i] = iy;
         cb.bin[i] = BinStore::floorToInt(binQ[i]);
-        cb.slot[i] = (uint32_t(sx) + uint32_t(sy) * uint32_t(nx)) * uint32_t(inWindow);
     }
     for (int part = 0; part < 2; part++) {
         const float* __restrict variance = pts.poseVariance_m2[part];
@@ -314,8 +315,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
     // (HeightInformation): the same estimate as the sequential filter up to rounding, without a
     // division chained through every point.
     const bool perPoint = continuityBound_m < std::numeric_limits<double>::infinity();
-    const ClassifyGeometry geometry{m_store.inverseCellSize(), window(), m_store.originSlotX(),
-                                    m_store.originSlotY(),     params,   kMinFusedVariance_m2};
+    const ClassifyGeometry geometry{m_store.inverseCellSize(), window(), params,
+                                    kMinFusedVariance_m2};
 
     // The open run: consecutive accepted points in one bin. Its update (BinAccumulator) stays in
     // registers and is written back when the run closes.
@@ -345,7 +346,8 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         if (perPoint) {  // fuseMeasurement counts what it accepts or refuses (eq 14)
             forAccepted(
                 stage, rejected, [&](size_t i) __attribute__((always_inline)) {
-                    fuseMeasurement(cb.slot[i], cb.ix[i], cb.iy[i], static_cast<int16_t>(cb.bin[i]),
+                    fuseMeasurement(writableSlot(cb.ix[i], cb.iy[i]), cb.ix[i], cb.iy[i],
+                                    static_cast<int16_t>(cb.bin[i]),
                                     pts.v[2][i],
                                     std::max<double>(pts.v[8][i], kMinFusedVariance_m2),
                                     cb.weight[i], params, continuityBound_m, stats, pts.v[0][i],
@@ -355,15 +357,15 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
         }
         stats.accepted += forAccepted(
             stage, rejected, [&](size_t i) __attribute__((always_inline)) {
-                const size_t s = size_t(cb.slot[i]);
+                const int ix = cb.ix[i], iy = cb.iy[i];
                 const int16_t n = static_cast<int16_t>(cb.bin[i]);
-                if (run.bin == kNoBin || run.slot != s || run.n != n) {
+                if (run.bin == kNoBin || run.ix != ix || run.iy != iy || run.n != n) {
                     closeRun();
-                    run.bin = m_store.findOrAddBin(s, n);
-                    run.slot = s;
+                    run.slot = writableSlot(ix, iy);
+                    run.bin = m_store.findOrAddBin(run.slot, n);
                     run.n = n;
-                    run.ix = cb.ix[i];
-                    run.iy = cb.iy[i];
+                    run.ix = ix;
+                    run.iy = iy;
                     run.update.open(m_store.bin(run.bin), cellCenter_m(run.ix),
                                     cellCenter_m(run.iy));
                     // The first point's pose codes: the run's points are neighbours of one frame,

@@ -17,8 +17,12 @@ void BinStore::reset(double cellSize_m, const CellWindow& window) {
         throw std::invalid_argument("BinGrid: negative window size");
     m_cellSize_m = cellSize_m;
     m_invCellSize = 1.0 / cellSize_m;
-    setWindow(window);
-    m_heads.assign(window.cellCount(), kNoBin);
+    m_window = window;
+    m_heads.assign(kTileSlots, kNoBin);  // the empty tile
+    m_tileXY.assign(1, TileKey{});
+    m_freeTiles.clear();
+    m_directory.clear();
+    m_dirX0 = m_dirY0 = m_dirNx = m_dirNy = 0;
     m_pool.clear();
     m_freeHead = kNoBin;
     m_freeCount = 0;
@@ -36,23 +40,56 @@ bool BinStore::growToInclude(const CellWindow& w) {
         nw.ny = std::max(m_window.iy0 + m_window.ny, w.iy0 + w.ny) - nw.iy0;
     }
     if (nw == m_window) return false;
-    std::vector<BinId> heads(nw.cellCount(), kNoBin);
-    const CellWindow old = m_window;
-    for (int iy = old.iy0; iy < old.iy0 + old.ny; iy++)
-        for (int ix = old.ix0; ix < old.ix0 + old.nx; ix++) {
-            const BinId h = m_heads[slot(ix, iy)];
-            if (h == kNoBin) continue;
-            heads[size_t(floorMod(ix, nw.nx)) + size_t(floorMod(iy, nw.ny)) * size_t(nw.nx)] = h;
-        }
-    m_heads.swap(heads);
-    setWindow(nw);
+    m_window = nw;
     return true;
 }
 
-void BinStore::setWindow(const CellWindow& w) {
-    m_window = w;
-    m_originSlotX = floorMod(w.ix0, w.nx);
-    m_originSlotY = floorMod(w.iy0, w.ny);
+void BinStore::growDirectory(int tx, int ty) {
+    int x0 = m_dirX0, y0 = m_dirY0, x1 = m_dirX0 + m_dirNx, y1 = m_dirY0 + m_dirNy;
+    if (m_dirNx == 0) {  // the first tile: a directory of 8 x 8 tiles around it
+        x0 = tx - 4, y0 = ty - 4, x1 = tx + 4, y1 = ty + 4;
+    } else {
+        // At least half the current size on each side that must grow: amortised constant cost
+        // per tile added, whatever the route's length.
+        const int growX = std::max(4, m_dirNx / 2), growY = std::max(4, m_dirNy / 2);
+        if (tx < x0) x0 = std::min(tx, x0 - growX);
+        if (tx >= x1) x1 = std::max(tx + 1, x1 + growX);
+        if (ty < y0) y0 = std::min(ty, y0 - growY);
+        if (ty >= y1) y1 = std::max(ty + 1, y1 + growY);
+    }
+    std::vector<uint32_t> dir(size_t(x1 - x0) * size_t(y1 - y0), 0);
+    for (int dy = 0; dy < m_dirNy; dy++)
+        for (int dx = 0; dx < m_dirNx; dx++)
+            dir[size_t(m_dirX0 + dx - x0) + size_t(m_dirY0 + dy - y0) * size_t(x1 - x0)] =
+                m_directory[size_t(dx) + size_t(dy) * size_t(m_dirNx)];
+    m_directory.swap(dir);
+    m_dirX0 = x0, m_dirY0 = y0, m_dirNx = x1 - x0, m_dirNy = y1 - y0;
+}
+
+uint32_t BinStore::addTile(int tx, int ty) {
+    if (unsigned(tx - m_dirX0) >= unsigned(m_dirNx) || unsigned(ty - m_dirY0) >= unsigned(m_dirNy))
+        growDirectory(tx, ty);
+    uint32_t t;
+    if (!m_freeTiles.empty()) {
+        t = m_freeTiles.back();
+        m_freeTiles.pop_back();
+    } else {
+        if (m_heads.size() + kTileSlots > size_t(std::numeric_limits<uint32_t>::max()))
+            throw std::length_error("BinGrid: more tiles than slots can number");
+        t = static_cast<uint32_t>(m_tileXY.size());
+        m_tileXY.emplace_back();
+        m_heads.resize(m_heads.size() + kTileSlots, kNoBin);
+    }
+    m_tileXY[t] = TileKey{tx, ty, true};
+    m_directory[size_t(tx - m_dirX0) + size_t(ty - m_dirY0) * size_t(m_dirNx)] = t;
+    return t;
+}
+
+void BinStore::freeTile(uint32_t t) {
+    TileKey& k = m_tileXY[t];
+    m_directory[size_t(k.tx - m_dirX0) + size_t(k.ty - m_dirY0) * size_t(m_dirNx)] = 0;
+    k.allocated = false;
+    m_freeTiles.push_back(t);
 }
 
 BinStore::BinId BinStore::allocateBin() {
@@ -78,18 +115,15 @@ void BinStore::releaseChain(BinId head) {
 
 void BinStore::clearCell(int ix, int iy) {
     if (!m_window.contains(ix, iy)) return;
-    BinId& head = m_heads[slot(ix, iy)];
+    BinId& head = m_heads[slot(ix, iy)];  // the empty tile's heads are all kNoBin already
     releaseChain(head);
     head = kNoBin;
 }
 
-BinStore::BinId BinStore::appendBin(int ix, int iy, const BinEstimate& estimate) {
-    if (!m_window.contains(ix, iy))
-        throw std::out_of_range("BinGrid::appendBin: cell outside the window");
+BinStore::BinId BinStore::appendBin(size_t s, const BinEstimate& estimate) {
     const BinId b = allocateBin();  // may reallocate the pool: hold indices, not pointers
     static_cast<BinEstimate&>(m_pool[b]) = estimate;
     m_pool[b].next = kNoBin;
-    const size_t s = slot(ix, iy);
     BinId last = m_heads[s];
     if (last == kNoBin) {
         m_heads[s] = b;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iostream>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -52,6 +53,9 @@ namespace {
 // Keys MRPT itself puts in every `_creationOpts` section (TMapGenericParams).
 const std::vector<std::string> kGenericMapKeys = {
     "enableSaveAs3DObject", "enableObservationLikelihood", "enableObservationInsertion"};
+/** Creation keys of earlier versions, accepted with a message: `max_size_m` capped the growing
+ * window before the storage was tiled. */
+constexpr const char* kRetiredCreationKeys[] = {"max_size_m"};
 
 /** Reads options from one section strictly: `readKeys(StrictConfigSection&)` reads their keys,
  * any other key of the section (but `allowed`) is an error, then options.validate(); every error
@@ -134,7 +138,6 @@ void visitCreationKeys(Options& o, Visit&& visit) {
     visit({"resolution_m", "resolution"}, o.resolution_m, positive("m"));
     visit({"bin_height_m", "bin_height"}, o.bin_height_m, positive("m"));
     visit("grow", o.grow);
-    visit("max_size_m", o.max_size_m, positive("m"));
     visit({"min_x_m", "min_x"}, o.min_x, finite("m"));
     visit({"max_x_m", "max_x"}, o.max_x, finite("m"));
     visit({"min_y_m", "min_y"}, o.min_y, finite("m"));
@@ -204,12 +207,21 @@ mrpt::math::TPoint2D CMultiBinElevationMap::TCreationOptions::originNear(double 
 
 void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
+    std::vector<std::string> allowed = kGenericMapKeys;
+    for (const char* key : kRetiredCreationKeys)
+        if (source.keyExists(section, key)) {
+            std::cerr << "CMultiBinElevationMap: " << iniName(source) << ", section [" << section
+                      << "]: key '" << key
+                      << "' is no longer used and is ignored: the map is stored in tiles and "
+                         "grows with the data, with no size limit. Remove the key.\n";
+            allowed.push_back(key);
+        }
     loadStrictly(
         source, section, *this,
         [&](multibin::StrictConfigSection& s) {
             visitCreationKeys(*this, multibin::OptionReader{s});
         },
-        kGenericMapKeys);
+        allowed);
 }
 
 void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
@@ -252,8 +264,8 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
         bad("min_x_m/max_x_m/min_y_m/max_y_m", "max must not be below min");
     if (!grow && (max_x <= min_x || max_y <= min_y))
         bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
-    // Refuse before allocating: every cell of a grid's window takes a slot of BinGrid (16 bytes:
-    // first bin, cycle stamp, update index, height bound) before any bin is stored.
+    // The local grid's window is filled densely as the robot sees it (16 bytes per cell: first
+    // bin, cycle stamp, update index, height bound, then the bins): refuse one beyond memory.
     constexpr double kCellBytes = 16, kMaxCells = 2.0e8;  // 3.2 GB of cell slots
     auto checkArea = [&](const std::string& key, double side_m, double cell_m) {
         const double side_cells = side_m / cell_m;
@@ -264,12 +276,7 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
            << " GB for its cells alone; use a coarser resolution or a smaller size";
         bad(key, os.str());
     };
-    if (dual_grid) {
-        checkArea("local_size_m", local_size_m, local_resolution_m);
-        checkArea("global_size_m", global_size_m, global_resolution_m);
-    } else {
-        checkArea("max_size_m", std::max({max_size_m, max_x - min_x, max_y - min_y}), resolution_m);
-    }
+    if (dual_grid) checkArea("local_size_m", local_size_m, local_resolution_m);
 }
 
 void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
@@ -399,6 +406,11 @@ void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation)
     internal_clear();
 }
 
+int CMultiBinElevationMap::globalSideCells() const {
+    const auto& c = creationOptions;
+    return std::max(1, static_cast<int>(std::lround(c.global_size_m / c.global_resolution_m)));
+}
+
 void CMultiBinElevationMap::internal_clear() {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     const auto& c = creationOptions;
@@ -420,7 +432,7 @@ void CMultiBinElevationMap::internal_clear() {
             return std::max(1, static_cast<int>(std::lround(size_m / res_m)));
         };
         const int nl = side(c.local_size_m, c.local_resolution_m);
-        const int ng = side(c.global_size_m, c.global_resolution_m);
+        const int ng = globalSideCells();
         m_impl->local.reset(c.local_resolution_m, multibin::CellWindow{-nl / 2, -nl / 2, nl, nl});
         m_impl->grid.reset(c.global_resolution_m, multibin::CellWindow{-ng / 2, -ng / 2, ng, ng});
     } else {

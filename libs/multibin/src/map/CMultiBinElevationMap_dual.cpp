@@ -3,7 +3,8 @@
  * with the robot).
  *
  * Each observation updates exactly one grid (global: stereo and global_sensor_labels; local: all
- * other sensors), so no datum is ever in both. Local cells that scroll out are fused into the
+ * other sensors), so no datum is ever in both. The local grid is a window that moves with the
+ * robot; the global one grows along the route (tiled storage: memory follows the ground seen). Local cells that scroll out are fused into the
  * global grid, which therefore holds everything seen; a local cell that enters starts empty and
  * queries combine it with the global estimate (getHeight), so the same data are never counted
  * twice. */
@@ -50,16 +51,17 @@ void CMultiBinElevationMap::recenter(double x_m, double y_m) {
 
 void CMultiBinElevationMap::recenterRelative(double x_m, double y_m) {
     m_impl->fillStale = true;
-    // Global first, so that local cells written back land inside it.
-    for (multibin::BinGrid* g : {&m_impl->grid, &m_impl->local}) {
-        const multibin::CellWindow& w = g->window();
-        const int ix0 = g->cellIndex(x_m) - w.nx / 2, iy0 = g->cellIndex(y_m) - w.ny / 2;
-        if (ix0 == w.ix0 && iy0 == w.iy0) continue;
-        if (g == &m_impl->local)
-            g->moveWindowTo(ix0, iy0, [&](int ix, int iy) { writeBackLocalCell(ix, iy); });
-        else
-            g->moveWindowTo(ix0, iy0);
-    }
+    // The global grid first, so that local cells written back land inside it: it grows to cover
+    // global_size_m around the robot and keeps everything seen; the local one moves.
+    multibin::BinGrid& global = m_impl->grid;
+    const int ng = globalSideCells();
+    global.growToInclude(multibin::CellWindow{global.cellIndex(x_m) - ng / 2,
+                                              global.cellIndex(y_m) - ng / 2, ng, ng});
+    multibin::BinGrid& local = m_impl->local;
+    const multibin::CellWindow& w = local.window();
+    const int ix0 = local.cellIndex(x_m) - w.nx / 2, iy0 = local.cellIndex(y_m) - w.ny / 2;
+    if (ix0 != w.ix0 || iy0 != w.iy0)
+        local.moveWindowTo(ix0, iy0, [&](int ix, int iy) { writeBackLocalCell(ix, iy); });
 }
 
 void CMultiBinElevationMap::flushLocalToGlobal() {

@@ -25,9 +25,9 @@ using multibin::PointsWithCov;
 using multibin::PointWithCov;
 
 namespace {
-/** The points growToCover() sizes the window by: within `half_m` of the sensor on each axis (a
- * stray far return must not stretch the map) and passing the eq 13 gate (nor may a stereo point
- * 20 m away with sigma_z of metres). */
+/** The points growToCover() sizes the window by: within `half_m` (the sensors' range,
+ * max_range_m) of the sensor on each axis (a stray far return must not stretch the map) and
+ * passing the eq 13 gate (nor may a stereo point 20 m away with sigma_z of metres). */
 bool canGrowTheMap(const PointWithCov& p, const Eigen::Vector3d& sensor_m, double half_m,
                    const multibin::BinUpdateParams& params) {
     return std::abs(p.point_m.x() - sensor_m.x()) <= half_m &&
@@ -40,7 +40,7 @@ struct GrowthScreen {
     double rot[2][3];               //!< the first two rows of the sensor-to-map rotation
     double sensorX_m, sensorY_m;    //!< the sensor origin in the map
     double x0_m, x1_m, y0_m, y1_m;  //!< the window's edges
-    double half_m;                  //!< max_size_m / 2
+    double half_m;                  //!< the growth reach: max_range_m
     double originNorm_m;            //!< |x| + |y| + |z| of the sensor origin
 };
 
@@ -308,9 +308,9 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
     // growToCover() changes the window iff a point that canGrowTheMap() lies in a cell outside
     // it. The map-frame positions in double, from the same pose, differ from the propagator's
     // (single precision) by far less than `slack`: a point clearly inside the window, or clearly
-    // farther than max_size_m / 2 from the sensor, cannot grow the map. The few others are
+    // farther than the reach from the sensor, cannot grow the map. The few others are
     // propagated exactly and tested as growToCover() would.
-    const double cell = m_impl->grid.cellSize_m(), half = 0.5 * c.max_size_m;
+    const double cell = m_impl->grid.cellSize_m(), half = growthReach_m();
     const double x0 = w.ix0 * cell, x1 = (w.ix0 + w.nx) * cell;
     const double y0 = w.iy0 * cell, y1 = (w.iy0 + w.ny) * cell;
     const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
@@ -398,12 +398,14 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     return s;
 }
 
+double CMultiBinElevationMap::growthReach_m() const { return insertionOptions.max_range_m; }
+
 void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
                                         const Eigen::Vector3d& sensor_m,
                                         const multibin::BinUpdateParams& params) {
     const auto& c = creationOptions;
     if (!c.grow || c.dual_grid || mapPoints.empty()) return;
-    const double half = 0.5 * c.max_size_m;
+    const double half = growthReach_m();
     double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
     for (const PointWithCov& p : mapPoints) {
         const double x = p.point_m.x(), y = p.point_m.y();
@@ -415,38 +417,13 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
     }
     if (!(xmin <= xmax)) return;
     const multibin::CellWindow& cur = m_impl->grid.window();
-    int ixLo = m_impl->grid.cellIndex(xmin), ixHi = m_impl->grid.cellIndex(xmax);
-    int iyLo = m_impl->grid.cellIndex(ymin), iyHi = m_impl->grid.cellIndex(ymax);
-    const bool haveWindow = cur.nx > 0 && cur.ny > 0;
-    if (haveWindow && cur.contains(ixLo, iyLo) && cur.contains(ixHi, iyHi)) return;
-
-    // Grow with a margin, so a moving sensor does not re-slot the grid at every scan.
+    const int ixLo = m_impl->grid.cellIndex(xmin), ixHi = m_impl->grid.cellIndex(xmax);
+    const int iyLo = m_impl->grid.cellIndex(ymin), iyHi = m_impl->grid.cellIndex(ymax);
+    if (cur.nx > 0 && cur.ny > 0 && cur.contains(ixLo, iyLo) && cur.contains(ixHi, iyHi)) return;
+    // Grow with a 1 m margin, so a moving sensor does not grow the window at every scan. Growing
+    // costs nothing (the storage is tiled); the window bounds what queries and rasters cover.
     const int margin = std::max(1, static_cast<int>(std::ceil(1.0 / m_impl->grid.cellSize_m())));
-    const int maxCells =
-        std::max(1, static_cast<int>(std::floor(c.max_size_m / m_impl->grid.cellSize_m())));
-    auto clampAxis = [&](int curLo, int curN, int lo, int hi, int& outLo, int& outN) {
-        // The margin only where the size limit leaves room: a window of max_size_m that is
-        // mostly margin lay beside the data (max_size_m = 1 m, or one 30 m cell).
-        const int room = maxCells - (hi - lo + 1);
-        const int m = std::clamp(room / 2, 0, margin);
-        lo -= m;
-        hi += m;
-        if (haveWindow) {
-            lo = std::min(lo, curLo);
-            hi = std::max(hi, curLo + curN - 1);
-        }
-        if (hi - lo + 1 > maxCells) {
-            // Keep the current window and extend towards the new data only up to the limit.
-            const int keepLo = haveWindow ? curLo : lo, keepHi = haveWindow ? curLo + curN - 1 : hi;
-            if (lo < keepLo) lo = std::max(lo, keepHi - maxCells + 1);
-            if (hi > keepHi) hi = std::min(hi, lo + maxCells - 1);
-            if (hi - lo + 1 > maxCells) hi = lo + maxCells - 1;
-        }
-        outLo = lo;
-        outN = hi - lo + 1;
-    };
-    multibin::CellWindow want;
-    clampAxis(cur.ix0, cur.nx, ixLo, ixHi, want.ix0, want.nx);
-    clampAxis(cur.iy0, cur.ny, iyLo, iyHi, want.iy0, want.ny);
-    m_impl->grid.growToInclude(want);
+    m_impl->grid.growToInclude(multibin::CellWindow{ixLo - margin, iyLo - margin,
+                                                    ixHi - ixLo + 1 + 2 * margin,
+                                                    iyHi - iyLo + 1 + 2 * margin});
 }

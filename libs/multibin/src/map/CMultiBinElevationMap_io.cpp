@@ -43,26 +43,26 @@ void forEachMoment(Moments& m, Visit&& visit) {
 void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid) {
     const multibin::CellWindow& w = grid.window();
     out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
-    uint64_t nonEmpty = 0;
-    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
-            bool any = false;
-            grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
-            nonEmpty += any;
-        }
-    out << nonEmpty;
-    for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-        for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
-            uint16_t n = 0;
-            grid.forEachBin(ix, iy, [&](const multibin::Bin&) { n++; });
-            if (!n) continue;
-            out << int32_t(ix) << int32_t(iy) << n;
-            grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
-                out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
-                forEachMoment(b.plane, [&](const float& v) { out << v; });
-                out << b.poseHeightSigmaCode << b.poseHorizontalSigmaCode;
-            });
-        }
+    // The non-empty cells, found tile by tile (not over the window: a route's window is mostly
+    // empty), written row by row as the reader expects.
+    std::vector<std::pair<int32_t, int32_t>> cells;  // (iy, ix)
+    int32_t lastIx = 0, lastIy = 0;
+    grid.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
+        if (cells.empty() || ix != lastIx || iy != lastIy) cells.emplace_back(iy, ix);
+        lastIx = ix, lastIy = iy;
+    });
+    std::sort(cells.begin(), cells.end());
+    out << uint64_t(cells.size());
+    for (const auto& [iy, ix] : cells) {
+        uint16_t n = 0;
+        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { n++; });
+        out << int32_t(ix) << int32_t(iy) << n;
+        grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
+            out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
+            forEachMoment(b.plane, [&](const float& v) { out << v; });
+            out << b.poseHeightSigmaCode << b.poseHorizontalSigmaCode;
+        });
+    }
 }
 
 [[noreturn]] void corrupt(const std::string& what) {
@@ -223,18 +223,19 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
     m.creation.loadFromConfigFile(ini, kCreationSection);
     m.insertion.loadFromConfigFile(ini, kInsertionSection);
     multibin::BinGrid &grid = m.grid, &local = m.local;
-    // A window never exceeds what the options allow (growth stops at max_size_m; the margin
-    // covers rounding at the window's edges).
+    // A window never exceeds what the options allow: a growing grid (the single one, the dual
+    // grid's global one) any size the cell indices allow (checkWindow), a fixed extent or the
+    // local grid their size (the margin covers rounding at the window's edges).
     const auto& c = m.creation;
-    const double singleSide_m = std::max({c.max_size_m, c.max_x - c.min_x, c.max_y - c.min_y});
+    constexpr double kAnySize = std::numeric_limits<double>::infinity();
     if (c.dual_grid) {
-        readGrid(in, grid, c.global_resolution_m, c.global_size_m / c.global_resolution_m + 2,
-                 c.bin_height_m, withPlane, withPose);
+        readGrid(in, grid, c.global_resolution_m, kAnySize, c.bin_height_m, withPlane, withPose);
         readGrid(in, local, c.local_resolution_m, c.local_size_m / c.local_resolution_m + 2,
                  c.bin_height_m, withPlane, withPose);
     } else {
-        readGrid(in, grid, c.resolution_m, singleSide_m / c.resolution_m + 2, c.bin_height_m,
-                 withPlane, withPose);
+        const double fixedSide_m = std::max(c.max_x - c.min_x, c.max_y - c.min_y);
+        readGrid(in, grid, c.resolution_m, c.grow ? kAnySize : fixedSide_m / c.resolution_m + 2,
+                 c.bin_height_m, withPlane, withPose);
     }
     if (version >= 1) {
         uint32_t tag = 0;

@@ -191,25 +191,19 @@ const float* FanTest::unitsOf(unsigned blockSlot, int bx, int by) {
     t = int32_t(m_s.unitLimits.size());
     float units[kUnits * kUnits];
     std::fill(units, units + kUnits * kUnits, -std::numeric_limits<float>::infinity());
-    // The block's cells inside the window, a row at a time: its slots are one or two
-    // contiguous runs.
+    // The block's cells inside the window, a row at a time: a block lies in one tile of the
+    // store, so a row's slots are contiguous.
     const CellWindow& w = m_grid.window();
     const VisibilityIndex& index = m_grid.visibilityIndex();
     const int ixLo = std::max(bx * BinGrid::kBlockCells, w.ix0);
     const int ixHi = std::min((bx + 1) * BinGrid::kBlockCells, w.ix0 + w.nx);
     const int iyLo = std::max(by * BinGrid::kBlockCells, w.iy0);
     const int iyHi = std::min((by + 1) * BinGrid::kBlockCells, w.iy0 + w.ny);
-    int sx0 = ixLo - w.ix0 + m_grid.store().originSlotX();
-    if (sx0 >= w.nx) sx0 -= w.nx;
-    const int firstRun = std::min(ixHi - ixLo, w.nx - sx0);  // cells before the wrap
-    const int originY = m_grid.store().originSlotY();
     const int column0 = ixLo - bx * BinGrid::kBlockCells;  // of the first cell read
-    // Usually the block's rows lie whole in one run: a unit's row is 4 adjacent slots.
-    const bool wholeRows = column0 == 0 && firstRun == BinGrid::kBlockCells;
+    // Usually the block's rows lie whole in the window: a unit's row is 4 adjacent slots.
+    const bool wholeRows = column0 == 0 && ixHi - ixLo == BinGrid::kBlockCells;
     for (int iy = iyLo; iy < iyHi; iy++) {
-        int sy = iy - w.iy0 + originY;
-        if (sy >= w.ny) sy -= w.ny;
-        const size_t base = size_t(sy) * size_t(w.nx), first = base + size_t(sx0);
+        const size_t first = m_grid.store().slot(ixLo, iy);
         float* unitRow = units + ((iy - by * BinGrid::kBlockCells) >> kUnitShift) * kUnits;
         if (wholeRows) {
             for (int c = 0; c < kUnits; c++) {
@@ -221,9 +215,8 @@ const float* FanTest::unitsOf(unsigned blockSlot, int bx, int by) {
             continue;
         }
         for (int k = 0; k < ixHi - ixLo; k++) {
-            const size_t slot = k < firstRun ? first + size_t(k) : base + size_t(k - firstRun);
             float& u = unitRow[(column0 + k) >> kUnitShift];
-            u = std::max(u, index.cellMaxHeight_m(slot));
+            u = std::max(u, index.cellMaxHeight_m(first + size_t(k)));
         }
     }
     auto roundUp = [](double v) {  // to within 1e-6 of v, far above float rounding

@@ -74,9 +74,11 @@ namespace mrpt::maps {
  * insertObservation(obs, pose) uses the latest CObservationRobotPose's covariance, or else
  * TInsertionOptions::default_pose_sigmas (and counts a warning, see poseFallbackCount()).
  *
- * Extent: by default one grid that grows to cover the data it receives, up to
- * TCreationOptions::max_size_m per axis; points beyond are counted and dropped. With
- * `grow = false` the extent is fixed by min_x .. max_y.
+ * Extent: by default one grid that grows to cover the data it receives (every point within
+ * TInsertionOptions::max_range_m of its sensor that passes the eq 13 gate), with no size limit:
+ * cells are stored in tiles of 64 x 64 allocated when first written, so memory follows the
+ * ground seen, not the window. With `grow = false` the extent is fixed by min_x .. max_y and
+ * points outside it are counted and dropped.
  *
  * Coordinates: every x, y the map takes or returns is in the frame of the robot poses, which may
  * be georeferenced (UTM: |x|, |y| up to 1e7 m). Inside, the map keeps them relative to an origin
@@ -111,18 +113,20 @@ public:
         double resolution_m = 0.02;  //!< cell size [m] (key `resolution`)
         double bin_height_m = 0.05;  //!< vertical bin size [m] (key `bin_height`)
         bool grow = true;            //!< grow to cover the data (key `grow`)
-        double max_size_m = 40.0;    //!< growth limit per axis [m] (key `max_size_m`)
         /** Initial extent [m] (keys `min_x`, `max_x`, `min_y`, `max_y`); the fixed extent when
          * grow = false. An empty range starts with no cells. */
         double min_x = 0, max_x = 0, min_y = 0, max_y = 0;
 
         /** Dual grid (key `dual_grid`): a precise local grid and a large global grid, both
-         * centred on the robot and moved with it. When on, the keys below replace `resolution`,
-         * `grow`, `max_size_m` and the extent. */
+         * centred on the robot: the local one moves with it, the global one grows along the
+         * route (it keeps everything seen). When on, the keys below replace `resolution`,
+         * `grow` and the extent. */
         bool dual_grid = false;
         double local_size_m = 2.0;          //!< side of the local grid [m] (key `local_size_m`)
         double local_resolution_m = 0.015;  //!< local cell size [m] (key `local_resolution`)
-        double global_size_m = 10.0;        //!< side of the global grid [m] (key `global_size_m`)
+        /** Side of the square around the robot the global grid covers at least [m] (key
+         * `global_size_m`): the grid grows to the union of these squares along the route. */
+        double global_size_m = 10.0;
         double global_resolution_m = 0.05;  //!< global cell size [m] (key `global_resolution`)
 
         /** The map origin (keys `origin_auto`, `origin_x_m`, `origin_y_m`): the point of the pose
@@ -243,9 +247,9 @@ public:
         double continuityBound_m = std::numeric_limits<double>::infinity(),
         const std::optional<Eigen::Vector3d>& sensorOrigin_m = std::nullopt,
         const multibin::PoseVariances* pose = nullptr);
-    /** Grows the window as an observation's insertion does (TCreationOptions::grow,
-     * max_size_m) to cover those of `mapPoints` within max_size_m / 2 of `sensor_m` that pass
-     * the eq 13 gate; both relative to mapOrigin(). For callers of insertPoints(), which does not
+    /** Grows the window as an observation's insertion does (TCreationOptions::grow) to cover
+     * those of `mapPoints` within TInsertionOptions::max_range_m of `sensor_m` that pass the
+     * eq 13 gate; both relative to mapOrigin(). For callers of insertPoints(), which does not
      * grow (the Python module's insert_points). */
     void growToCoverPoints(const multibin::PointsWithCov& mapPoints,
                            const Eigen::Vector3d& sensor_m);
@@ -464,6 +468,11 @@ private:
     void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
                      const multibin::BinUpdateParams& params);
 
+    /** Side of the square the global grid covers around the robot [cells]: global_size_m. */
+    int globalSideCells() const;
+    /** How far from its sensor a point may grow the window [m]: the sensors' range,
+     * TInsertionOptions::max_range_m (a stray far return must not stretch it). */
+    double growthReach_m() const;
     /** True if growToCover() would change the window for these sensor-frame points seen from
      * `sensorInMap` (the robot pose's mean composed with the sensor pose), without propagating
      * more than the few points near the window's edge. */

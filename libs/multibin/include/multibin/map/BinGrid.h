@@ -19,13 +19,13 @@ namespace multibin {
 class PosePropagator;
 struct PoseVariances;
 
-/** The 2.5D grid of multi-bin cells: the storage (a BinStore member: cells, bins, the moving
+/** The 2.5D grid of multi-bin cells: the storage (a BinStore member: cells in tiles, bins, the
  * window), the update rule applied to points (the gates of eqs 13-14 from BinUpdate.h, each
  * bin's update through BinAccumulator.h) and the visibility index kept in step with both
  * (VisibilityIndex: update cycles, block height bounds), as OctoMap's OccupancyOcTreeBase adds its
  * update rule to the storage of OcTreeBaseImpl. The insertion on two cores runs through
- * src/map/InsertionPipeline.h. Memory: 16 B per cell of the window (4 B store, 12 B index), 12 B
- * per block of 256 cells and 64 B per bin (Bin.h). */
+ * src/map/InsertionPipeline.h. Memory: 16 B per cell of an allocated tile (4 B store, 12 B index:
+ * 64 KB per tile of 64 x 64 cells), 4 B per block of 256 cells and 64 B per bin (Bin.h). */
 class BinGrid {
 public:
     using BinId = BinStore::BinId;
@@ -65,15 +65,15 @@ public:
 
     /** Drops all bins and sets an empty window; the cell size may change. */
     void reset(double cellSize_m, const CellWindow& window);
-    /** Enlarges the window to include `w` (union), keeping every bin. */
-    void growToInclude(const CellWindow& w);
+    /** Enlarges the window to include `w` (union), keeping every bin; costs nothing (tiles are
+     * allocated when written). */
+    void growToInclude(const CellWindow& w) { m_store.growToInclude(w); }
     /** Translates the window to a new origin, same size. Cells that leave are passed to
      * `onLeave(ix, iy)` (while still readable) and then cleared; cells still inside are untouched.
-     * Cost: proportional to the cells that enter. */
+     * Tiles left outside the window are freed. Cost: proportional to the allocated tiles. */
     template <typename OnLeave>
     void moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
         m_store.moveWindowTo(ix0, iy0, onLeave, [this](size_t s) { m_index.forgetSlot(s); });
-        m_index.moveWindow(window());
     }
     void moveWindowTo(int ix0, int iy0) {
         moveWindowTo(ix0, iy0, [](int, int) {});
@@ -144,7 +144,10 @@ public:
     double maxHeight_m() const { return m_index.maxHeight_m(); }
     static int blockOf(int cellIndex) { return VisibilityIndex::blockOf(cellIndex); }
     /** See VisibilityIndex::blockMaxHeight_m. */
-    float blockMaxHeight_m(int bx, int by) const { return m_index.blockMaxHeight_m(bx, by); }
+    float blockMaxHeight_m(int bx, int by) const {
+        constexpr int kShift = BinStore::kTileShift - kBlockShift;  // blocks to tiles
+        return m_index.blockMaxHeight_m(m_store.tileNumber(bx >> kShift, by >> kShift), bx, by);
+    }
     /** @} */
 
     /** Memory held by the grid [bytes]: the store and the visibility index. Independent of the
@@ -159,6 +162,8 @@ public:
 private:
     /** The insertion core over `count` map-frame points, a block at a time:
      * `fillBlock(begin, n, block)` writes points begin .. begin + n - 1 into `block`. */
+    /** The slot of cell (ix, iy) for a write: its tile allocated (and indexed) if it had none. */
+    size_t writableSlot(int ix, int iy);
     template <typename BlockSource>
     InsertStats insertBlocks(size_t count, BlockSource&& fillBlock, const BinUpdateParams& params,
                              double continuityBound_m);

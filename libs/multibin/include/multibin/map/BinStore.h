@@ -12,20 +12,26 @@
 
 namespace multibin {
 
-/** The storage of a 2.5D multi-bin grid: cells, their bins and the moving window, and nothing
- * about how bins are updated (BinUpdate.h) or indexed for the visibility constraint
- * (VisibilityIndex.h).
+/** The storage of a 2.5D multi-bin grid: cells, their bins and the window, and nothing about how
+ * bins are updated (BinUpdate.h) or indexed for the visibility constraint (VisibilityIndex.h).
  *
- * Cells: a circular buffer over the cell window (grid_map style): cell (ix, iy) lives in slot
- * (ix mod nx) + (iy mod ny) nx, so moving the window only clears the slots of the cells that
- * enter, and growing it re-slots the cell heads without touching any bin. Bins: one pool shared
- * by all cells, chained per cell in insertion order and addressed by a BinId, so callers hold
- * ids, never pointers (the pool may reallocate). Memory: 4 B per cell of the window and 64 B per
+ * Window: the cells the grid may store (a fixed extent, the moving window of the dual grid's local
+ * grid, or the growing cover of the data). It is bookkeeping only: growing it costs nothing.
+ * Cells: tiles of kTileCells x kTileCells cells, allocated on the first write into them and found
+ * through a directory (one 4-byte entry per tile of the tiles' bounding box, grown geometrically),
+ * so memory follows the ground seen, not the window. A cell's slot is its tile's number times
+ * kTileSlots plus its place in the tile (row-major); tile 0 is the empty tile, never written, that
+ * every cell of an unallocated tile reads. Bins: one pool shared by all cells, chained per cell in
+ * insertion order and addressed by a BinId, so callers hold ids, never pointers (the pool may
+ * reallocate). Memory: 16 KB per tile (4 B per cell), 4 B per tile of the directory and 64 B per
  * bin. */
 class BinStore {
 public:
     using BinId = uint32_t;
     static constexpr BinId kNoBin = std::numeric_limits<uint32_t>::max();
+    static constexpr int kTileShift = 6;
+    static constexpr int kTileCells = 1 << kTileShift;  //!< tile side [cells]
+    static constexpr size_t kTileSlots = size_t(kTileCells) * kTileCells;
 
     explicit BinStore(double cellSize_m = 0.02);
 
@@ -69,33 +75,57 @@ public:
     double cellCenter_m(int index) const { return (index + 0.5) * m_cellSize_m; }
     /** 1 / cell size, the factor cellIndex applies [1/m]. */
     double inverseCellSize() const { return m_invCellSize; }
-    /** The slot coordinates of the window's first cell (ix0 mod nx, iy0 mod ny): slot() in
-     * closed form for code that computes slots in bulk. */
-    int originSlotX() const { return m_originSlotX; }
-    int originSlotY() const { return m_originSlotY; }
-    /** i mod n in [0, n) (0 for an empty axis): the slot coordinate of index i on an axis of n. */
-    static int floorMod(int i, int n) { return n > 0 ? ((i % n) + n) % n : 0; }
+    /** Tile index of a cell index (floor division by kTileCells). */
+    static int tileOf(int cellIndex) { return cellIndex >> kTileShift; }  // arithmetic shift
     /** @} */
 
     /** @name The window
      * @{ */
-    /** Drops all bins and sets an empty window; the cell size may change. */
+    /** Drops all bins and tiles and sets the window; the cell size may change. */
     void reset(double cellSize_m, const CellWindow& window);
     /** Enlarges the window to the union with `w`, keeping every bin; false if it already held
-     * `w` (nothing changed). Every cell moves to a new slot. */
+     * `w`. Costs nothing: tiles are allocated when written. */
     bool growToInclude(const CellWindow& w);
-    /** Translates the window to a new origin, same size. Cells that leave are passed to
-     * `onLeave(ix, iy)` (while still readable) and then cleared; the slot of every cell that
-     * enters is passed to `onEnter(slot)`; cells still inside are untouched. Cost: proportional
-     * to the cells that enter. */
-    template <typename OnLeave, typename OnEnter>
-    void moveWindowTo(int ix0, int iy0, OnLeave&& onLeave, OnEnter&& onEnter);
-    /** Slots: one per cell of the window, numbered 0 .. window().cellCount() - 1. */
+    /** Translates the window to a new origin, same size. Each cell that leaves and holds bins is
+     * passed to `onLeave(ix, iy)` (while still readable), tile by tile, row by row in a tile;
+     * then its bins are released and `onCleared(slot)` is called for every slot of a leaving
+     * cell of an allocated tile. Tiles left with no cell in the window are freed. Cost:
+     * proportional to the allocated tiles. */
+    template <typename OnLeave, typename OnCleared>
+    void moveWindowTo(int ix0, int iy0, OnLeave&& onLeave, OnCleared&& onCleared);
+    /** @} */
+
+    /** @name Tiles and slots
+     * @{ */
+    /** The slot of cell (ix, iy): in the empty tile (slots 0 .. kTileSlots - 1, read only) if
+     * its tile holds nothing. Any cell, in the window or not. */
     size_t slot(int ix, int iy) const {
-        int sx = ix - m_window.ix0 + m_originSlotX, sy = iy - m_window.iy0 + m_originSlotY;
-        if (sx >= m_window.nx) sx -= m_window.nx;
-        if (sy >= m_window.ny) sy -= m_window.ny;
-        return size_t(sx) + size_t(sy) * size_t(m_window.nx);
+        return (size_t(tileNumber(tileOf(ix), tileOf(iy))) << (2 * kTileShift)) +
+               slotInTile(ix, iy);
+    }
+    /** The slot of cell (ix, iy) in its tile, allocated if it had none (`tileAdded` tells), for
+     * a write. */
+    size_t writableSlot(int ix, int iy, bool& tileAdded);
+    /** Cell (ix, iy)'s place in its tile, row-major. */
+    static size_t slotInTile(int ix, int iy) {
+        return (size_t(iy & (kTileCells - 1)) << kTileShift) + size_t(ix & (kTileCells - 1));
+    }
+    /** The number of the tile (tx, ty): 0 (the empty tile) if it is not allocated. */
+    uint32_t tileNumber(int tx, int ty) const {
+        const unsigned dx = unsigned(tx - m_dirX0), dy = unsigned(ty - m_dirY0);
+        if (dx >= unsigned(m_dirNx) || dy >= unsigned(m_dirNy)) return 0;
+        return m_directory[size_t(dx) + size_t(dy) * size_t(m_dirNx)];
+    }
+    /** Slots in use or free, the empty tile's included: per-slot arrays kept beside the store
+     * (VisibilityIndex) have this size. */
+    size_t slotCount() const { return m_heads.size(); }
+    /** Number of allocated tiles. */
+    size_t tileCount() const { return m_tileXY.size() - 1 - m_freeTiles.size(); }
+    /** Calls f(tx, ty) for every allocated tile, in allocation order. */
+    template <typename F>
+    void forEachTile(F&& f) const {
+        for (size_t t = 1; t < m_tileXY.size(); t++)
+            if (m_tileXY[t].allocated) f(m_tileXY[t].tx, m_tileXY[t].ty);
     }
     /** @} */
 
@@ -103,15 +133,15 @@ public:
      * @{ */
     Bin& bin(BinId b) { return m_pool[b]; }
     const Bin& bin(BinId b) const { return m_pool[b]; }
-    /** The bin of index n in the cell at `slot`, appended to its chain (all estimates zero) if
-     * missing; `added` tells which. */
+    /** The bin of index n in the cell at `slot` (a writable one), appended to its chain (all
+     * estimates zero) if missing; `added` tells which. */
     BinId findOrAddBin(size_t slot, int16_t n, bool& added);
     BinId findOrAddBin(size_t slot, int16_t n) {
         bool added;
         return findOrAddBin(slot, n, added);
     }
-    /** Appends a bin with this estimate to the chain of cell (ix, iy), inside the window. */
-    BinId appendBin(int ix, int iy, const BinEstimate& estimate);
+    /** Appends a bin with this estimate to the chain of the cell at `slot` (a writable one). */
+    BinId appendBin(size_t slot, const BinEstimate& estimate);
     /** Calls f(const Bin&) for every bin of the cell, in chain order; nothing outside the
      * window. */
     template <typename F>
@@ -119,15 +149,9 @@ public:
         if (!m_window.contains(ix, iy)) return;
         for (BinId b = m_heads[slot(ix, iy)]; b != kNoBin; b = m_pool[b].next) f(m_pool[b]);
     }
-    /** Calls f(ix, iy, const Bin&) for every bin of the window. */
+    /** Calls f(ix, iy, const Bin&) for every bin, tile by tile, row by row in a tile. */
     template <typename F>
-    void forEachStoredBin(F&& f) const {
-        const CellWindow& w = m_window;
-        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
-                for (BinId b = m_heads[slot(ix, iy)]; b != kNoBin; b = m_pool[b].next)
-                    f(ix, iy, m_pool[b]);
-    }
+    void forEachStoredBin(F&& f) const;
     /** Calls f(Bin&) for every bin of the cell; a bin for which f returns false is removed.
      * Returns the number of bins removed. */
     template <typename F>
@@ -137,26 +161,25 @@ public:
     /** Number of bins in use, over all cells. */
     size_t binCount() const { return m_pool.size() - m_freeCount; }
     bool empty() const { return binCount() == 0; }
-    /** Memory held [bytes]: the cell heads and the bin pool with its spare capacity. */
+    /** Memory held [bytes]: the tiles' cell heads, the directory and the bin pool with its spare
+     * capacity. */
     size_t memoryBytes() const {
-        return m_heads.capacity() * sizeof(BinId) + m_pool.capacity() * sizeof(Bin);
+        return m_heads.capacity() * sizeof(BinId) + m_directory.capacity() * sizeof(uint32_t) +
+               m_tileXY.capacity() * sizeof(TileKey) + m_pool.capacity() * sizeof(Bin);
     }
     /** @} */
 
 private:
-    void setWindow(const CellWindow& w);
-    static size_t slotIn(const CellWindow& w, int originSlotX, int originSlotY, int ix, int iy) {
-        int sx = ix - w.ix0 + originSlotX, sy = iy - w.iy0 + originSlotY;
-        if (sx >= w.nx) sx -= w.nx;
-        if (sy >= w.ny) sy -= w.ny;
-        return size_t(sx) + size_t(sy) * size_t(w.nx);
-    }
-    /** d mod n in [0, n) for n > 0; no division for |d| < 2n (every overlapping move). */
-    static int wrap(int d, int n) {
-        if (d >= n) d -= n;
-        if (d < 0) d += n;
-        return d >= 0 && d < n ? d : ((d % n) + n) % n;
-    }
+    struct TileKey {
+        int32_t tx = 0, ty = 0;
+        bool allocated = false;
+    };
+    /** Allocates tile (tx, ty) (reusing a freed one if any); returns its number. */
+    uint32_t addTile(int tx, int ty);
+    /** Frees an allocated tile whose cells hold no bin. */
+    void freeTile(uint32_t t);
+    /** Grows the directory to hold tile (tx, ty), by at least half its size on that side. */
+    void growDirectory(int tx, int ty);
     BinId allocateBin();
     void releaseChain(BinId head);
     void release(BinId b) {
@@ -168,12 +191,23 @@ private:
     double m_cellSize_m;
     double m_invCellSize = 1.0;  //!< 1 / cell size [1/m]
     CellWindow m_window;
-    int m_originSlotX = 0, m_originSlotY = 0;  //!< ix0 mod nx, iy0 mod ny
-    std::vector<BinId> m_heads;                //!< per slot: the cell's first bin, or kNoBin
-    std::vector<Bin> m_pool;                   //!< all bins; free ones chained from m_freeHead
+    std::vector<BinId> m_heads;         //!< per slot: the cell's first bin, or kNoBin
+    std::vector<TileKey> m_tileXY;      //!< per tile number: its tile coordinates (0: empty tile)
+    std::vector<uint32_t> m_freeTiles;  //!< tile numbers freed, reused first
+    std::vector<uint32_t> m_directory;  //!< tile number of (m_dirX0 + dx, m_dirY0 + dy), or 0
+    int m_dirX0 = 0, m_dirY0 = 0, m_dirNx = 0, m_dirNy = 0;
+    std::vector<Bin> m_pool;  //!< all bins; free ones chained from m_freeHead
     BinId m_freeHead = kNoBin;
     size_t m_freeCount = 0;
 };
+
+inline size_t BinStore::writableSlot(int ix, int iy, bool& tileAdded) {
+    const int tx = tileOf(ix), ty = tileOf(iy);
+    uint32_t t = tileNumber(tx, ty);
+    tileAdded = t == 0;
+    if (tileAdded) t = addTile(tx, ty);
+    return (size_t(t) << (2 * kTileShift)) + slotInTile(ix, iy);
+}
 
 inline BinStore::BinId BinStore::findOrAddBin(size_t s, int16_t n, bool& added) {
     BinId prev = kNoBin, b = m_heads[s];
@@ -191,48 +225,52 @@ inline BinStore::BinId BinStore::findOrAddBin(size_t s, int16_t n, bool& added) 
     return b;
 }
 
-template <typename OnLeave, typename OnEnter>
-void BinStore::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave, OnEnter&& onEnter) {
-    const CellWindow oldW = m_window;
+template <typename OnLeave, typename OnCleared>
+void BinStore::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave, OnCleared&& onCleared) {
+    const CellWindow oldW = m_window;  // kept while leavers are read: onLeave may read them
     CellWindow newW = oldW;
     newW.ix0 = ix0;
     newW.iy0 = iy0;
-    if (oldW.nx == 0 || oldW.ny == 0) {
-        setWindow(newW);
-        return;
-    }
-    // Slots are keyed by (ix mod nx, iy mod ny): a cell that stays keeps its slot. Each entering
-    // cell reuses the slot of exactly one leaving cell, so visiting the entering cells (in the new
-    // window, not in the old one) and clearing the leaver stored there does all the work.
-    const bool disjoint = ix0 >= oldW.ix0 + oldW.nx || ix0 + oldW.nx <= oldW.ix0 ||
-                          iy0 >= oldW.iy0 + oldW.ny || iy0 + oldW.ny <= oldW.iy0;
-    const int newOriginX = floorMod(ix0, newW.nx), newOriginY = floorMod(iy0, newW.ny);
-    auto handleEntering = [&](int ix, int iy) {
-        // The entering cell's slot in the new window is the leaver's slot in the old one.
-        const size_t s = slotIn(newW, newOriginX, newOriginY, ix, iy);
-        onEnter(s);
-        if (m_heads[s] == kNoBin) return;
-        // The old-window cell sharing this slot.
-        onLeave(oldW.ix0 + wrap(ix - oldW.ix0, oldW.nx), oldW.iy0 + wrap(iy - oldW.iy0, oldW.ny));
-        releaseChain(m_heads[s]);
-        m_heads[s] = kNoBin;
+    auto inside = [](const CellWindow& w, int x0, int y0) {  // a whole tile
+        return x0 >= w.ix0 && y0 >= w.iy0 && x0 + kTileCells <= w.ix0 + w.nx &&
+               y0 + kTileCells <= w.iy0 + w.ny;
     };
-    if (disjoint) {
-        for (int iy = iy0; iy < iy0 + oldW.ny; iy++)
-            for (int ix = ix0; ix < ix0 + oldW.nx; ix++) handleEntering(ix, iy);
-    } else {
-        for (int iy = iy0; iy < iy0 + oldW.ny; iy++) {
-            const bool rowInOld = iy >= oldW.iy0 && iy < oldW.iy0 + oldW.ny;
-            for (int ix = ix0; ix < ix0 + oldW.nx; ix++) {
-                if (rowInOld && ix >= oldW.ix0 && ix < oldW.ix0 + oldW.nx) {
-                    ix = std::min(ix0 + oldW.nx, oldW.ix0 + oldW.nx) - 1;  // skip kept run
+    for (uint32_t t = 1; t < m_tileXY.size(); t++) {
+        if (!m_tileXY[t].allocated) continue;
+        const int cx0 = m_tileXY[t].tx * kTileCells, cy0 = m_tileXY[t].ty * kTileCells;
+        if (inside(newW, cx0, cy0)) continue;
+        bool keepsACell = false;
+        for (int iy = cy0; iy < cy0 + kTileCells; iy++)
+            for (int ix = cx0; ix < cx0 + kTileCells; ix++) {
+                if (newW.contains(ix, iy)) {
+                    keepsACell = true;
                     continue;
                 }
-                handleEntering(ix, iy);
+                if (!oldW.contains(ix, iy)) continue;
+                const size_t s = (size_t(t) << (2 * kTileShift)) + slotInTile(ix, iy);
+                if (m_heads[s] != kNoBin) {
+                    onLeave(ix, iy);
+                    releaseChain(m_heads[s]);
+                    m_heads[s] = kNoBin;
+                }
+                onCleared(s);
             }
-        }
+        if (!keepsACell) freeTile(t);
     }
-    setWindow(newW);
+    m_window = newW;
+}
+
+template <typename F>
+void BinStore::forEachStoredBin(F&& f) const {
+    for (size_t t = 1; t < m_tileXY.size(); t++) {
+        if (!m_tileXY[t].allocated) continue;
+        const int cx0 = m_tileXY[t].tx * kTileCells, cy0 = m_tileXY[t].ty * kTileCells;
+        const BinId* heads = m_heads.data() + (t << (2 * kTileShift));
+        for (int r = 0; r < kTileCells; r++)
+            for (int c = 0; c < kTileCells; c++)
+                for (BinId b = heads[r * kTileCells + c]; b != kNoBin; b = m_pool[b].next)
+                    f(cx0 + c, cy0 + r, m_pool[b]);
+    }
 }
 
 template <typename F>

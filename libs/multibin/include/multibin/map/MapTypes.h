@@ -34,8 +34,9 @@ struct InsertStats {
     size_t outOfRange = 0;     //!< sensor reading invalid or outside the accepted range
     size_t notFinite = 0;      //!< NaN/inf coordinates or covariance
     size_t badCovariance = 0;  //!< covariance indefinite (zero and singular ones are exact)
-    /** (x, y) outside the grid window (after any growth; max_size_m, grow, the extent keys
-     * govern it), the point passing eq 13 */
+    /** (x, y) outside the grid window (after any growth: grow and the extent keys, the dual
+     * grid's sizes, and max_range_m, how far from its sensor a point grows the map, govern it),
+     * the point passing eq 13 */
     size_t outsideMap = 0;
     size_t outsideBinRange = 0;  //!< height beyond the representable bin indices
     /** eq 13 gate: 3 sigma_z > Delta_max (max_elevation_uncertainty_m or the sensor model's
