@@ -586,7 +586,7 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
             propagator.apply(sensed.points, mapPoints, &pose);
             twoSteps->insertPoints(mapPoints, sensed.continuityBound_m,
                                    propagator.sensorOriginInMap_m(), &pose);
-            // Growing map: every point that may grow the map (within max_size_m / 2 of the
+            // Growing map: every point that may grow the map (within max_range_m of the
             // sensor, passing the eq 13 gate) lies inside its window afterwards, i.e. the fused
             // path was never taken when the window had to grow.
             multibin::sensors::SensorPoints again;
@@ -595,7 +595,7 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
             propagator.apply(again.points, mapPoints);
             const BinGrid& g = growing->grid();
             const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
-            const double half = 0.5 * growing->creationOptions.max_size_m;
+            const double half = growing->insertionOptions.max_range_m;
             const BinUpdateParams gate{0.05, 1.0f, io.max_elevation_uncertainty_m};
             for (const PointWithCov& p : mapPoints) {
                 if (!(std::abs(p.point_m.x() - s.x()) <= half &&

@@ -356,7 +356,10 @@ TEST(CMultiBinElevationMap, IniOptionsRoundTripAndMalformedValuesAreRefused) {
     expectRefused("[c]\nresoltion = 0.05\n", "resoltion");  // unknown key (typo)
     expectRefused("[c]\nresolution = -0.05\n", "resolution");
     expectRefused("[c]\ngrow = maybe\n", "grow");
-    expectRefused("[c]\nresolution = 0.0001\nmax_size_m = 100\n", "max_size_m");  // too big
+    expectRefused("[c]\nresolution = 0.00001\n", "resolution");  // below 0.1 mm
+    // The retired size limit is accepted (with a message on stderr) and changes nothing.
+    mrpt::config::CConfigFileMemory retired("[c]\nmax_size_m = 40\n");
+    EXPECT_NO_THROW(c2.loadFromConfigFile(retired, "c"));
     // MRPT's generic keys are accepted.
     mrpt::config::CConfigFileMemory generic("[c]\nenableSaveAs3DObject = false\n");
     EXPECT_NO_THROW(c2.loadFromConfigFile(generic, "c"));
@@ -391,9 +394,7 @@ TEST(CMultiBinElevationMap, CMultiMetricMapFromIniTextContainsTheMap) {
 }
 
 TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
-    CMultiBinElevationMap::TCreationOptions c;
-    c.max_size_m = 4.0;
-    CMultiBinElevationMap map(c);
+    CMultiBinElevationMap map;
     auto obs = mrpt::obs::CObservationPointCloud::Create();
     auto pts = mrpt::maps::CSimplePointsMap::Create();
     // A plane z = -1 in the sensor frame, 3 x 3 m, plus far points.
@@ -407,9 +408,10 @@ TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
     double h, s;
     ASSERT_TRUE(map.getHeight(10.0, 5.0, h, s));
     EXPECT_NEAR(h, 0.0, 1e-4);
-    EXPECT_LE(map.getXMax() - map.getXMin(), 4.0 + 1e-9);
-    // 15 m away: beyond the growth limit, and with the default pose covariance too uncertain
-    // (3 sigma_z ~ 0.2 m > 0.1 m), which is what it is counted as, wherever it lies.
+    // The window: the 3 m plane and the 1 m growth margin on each side, not the 15 m point.
+    EXPECT_NEAR(map.getXMax() - map.getXMin(), 5.0, 0.1);
+    // 15 m away: with the default pose covariance too uncertain (3 sigma_z ~ 0.2 m > 0.1 m),
+    // which is what it is counted as, wherever it lies; it does not grow the window.
     EXPECT_EQ(map.insertStats().tooUncertain, 1u);
     EXPECT_EQ(map.insertStats().outsideMap, 0u);
     EXPECT_EQ(map.insertStats().outOfRange, 1u);  // 50 m away: beyond max_range
@@ -418,10 +420,10 @@ TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
 TEST(CMultiBinElevationMap, GrowsForOnePointJustOutsideAmongManyInside) {
     // The growth check screens points (vectorised) and tests only those near the window's edge
     // exactly: one point a millimetre beyond the edge, in any of 600 positions of a block of
-    // points well inside, must still grow the window, and a point beyond max_size_m / 2 must not.
-    CMultiBinElevationMap::TCreationOptions c;
-    c.max_size_m = 60.0;
-    CMultiBinElevationMap map(c);
+    // points well inside, must still grow the window, and a point beyond max_range_m (the growth
+    // reach) must not.
+    CMultiBinElevationMap map;
+    map.insertionOptions.max_elevation_uncertainty_m = 1.0;  // the far point passes eq 13
     auto cloud = [](const std::vector<Eigen::Vector3f>& points) {
         auto obs = mrpt::obs::CObservationPointCloud::Create();
         auto pts = mrpt::maps::CSimplePointsMap::Create();
@@ -440,7 +442,7 @@ TEST(CMultiBinElevationMap, GrowsForOnePointJustOutsideAmongManyInside) {
         std::vector<Eigen::Vector3f> points(600, Eigen::Vector3f(0.f, 0.f, -1.f));
         for (size_t i = 0; i < points.size(); i++) points[i].y() = -0.4f + 0.001f * float(i);
         const size_t at = size_t(k) * 50 + 7;
-        const double robotX_m = xMax - 1.0;  // the edge 1 m ahead, well within max_size_m / 2
+        const double robotX_m = xMax - 1.0;  // the edge 1 m ahead, well within the reach
         points[at].x() = float(xMax + 0.001 - robotX_m);  // just beyond the east edge
         const size_t outsideBefore = map.insertStats().outsideMap;
         ASSERT_TRUE(map.insertObservation(*cloud(points), CPose3D(robotX_m, 0, 0, 0, 0, 0)));
@@ -449,9 +451,13 @@ TEST(CMultiBinElevationMap, GrowsForOnePointJustOutsideAmongManyInside) {
     }
     const double xMax = map.getXMax();
     std::vector<Eigen::Vector3f> far(300, Eigen::Vector3f(0.f, 0.f, -1.f));
-    far[150].x() = 30.5f;  // beyond max_size_m / 2 from the sensor
+    far[150].x() = 30.5f;  // beyond max_range_m (20 m) from the sensor
     ASSERT_TRUE(map.insertObservation(*cloud(far), CPose3D(xMax - 1.0, 0, 0, 0, 0, 0)));
     EXPECT_EQ(map.getXMax(), xMax);
+    // Within the reach, 19 m ahead: it grows the window, with no size limit.
+    far[150].x() = 19.0f;
+    ASSERT_TRUE(map.insertObservation(*cloud(far), CPose3D(xMax - 1.0, 0, 0, 0, 0, 0)));
+    EXPECT_GT(map.getXMax(), xMax + 17.0);
 }
 
 TEST(StrictConfigSection, ReadChoiceTakesOnlyTheListedWords) {

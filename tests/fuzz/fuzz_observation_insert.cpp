@@ -127,7 +127,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     fuzz::ByteReader in(data, size);
     const uint8_t setup = in.take<uint8_t>();
     Map::TCreationOptions c;
-    c.max_size_m = 8;
     if (setup & 1) {
         c.dual_grid = true;
         c.local_size_m = 1.0;

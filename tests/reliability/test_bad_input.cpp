@@ -337,21 +337,21 @@ TEST(BadInputExtent, PointsFarOutsideAFixedMapAreCounted) {
     EXPECT_EQ(serialize(map), before);
 }
 
-// A window that cannot hold the data is never a silent empty map. A growth limit smaller than
-// the growth margin put the window beside the data (max_size_m = 1 m: 0 fused), one 30 m cell
-// likewise; a fixed window far away fuses nothing and counts every point as outsideMap.
-TEST(BadInputExtent, AWindowSmallerThanItsMarginHoldsTheDataItCan) {
-    for (const auto& [maxSize_m, resolution_m] :
-         {std::pair{1.0, 0.02}, {2.0, 0.02}, {40.0, 30.0}}) {
-        SCOPED_TRACE(std::to_string(maxSize_m) + " m at " + std::to_string(resolution_m) + " m");
+// A window that cannot hold the data is never a silent empty map. A growing map holds every
+// point within range, at any cell size (before the tiled storage, a growth limit smaller than its
+// margin put the window beside the data); a fixed window far away fuses nothing and counts every
+// point as outsideMap.
+TEST(BadInputExtent, AGrowingMapHoldsEveryPointAndAFixedWindowCountsTheRest) {
+    for (const double resolution_m : {0.02, 30.0}) {
+        SCOPED_TRACE(std::to_string(resolution_m) + " m");
         Map::TCreationOptions c;
-        c.max_size_m = maxSize_m;
         c.resolution_m = resolution_m;
         Map map(c);
         map.insertObservation(*floorScan(), posePdf());
         const multibin::InsertStats& s = map.insertStats();
-        EXPECT_GT(s.accepted, 0u) << "outside " << s.outsideMap;  // on the data, not beside it
-        EXPECT_EQ(s.accepted + s.outsideMap, map.sensorModelStats().laser.kept);
+        EXPECT_GT(s.accepted, 0u);
+        EXPECT_EQ(s.outsideMap, 0u);
+        EXPECT_EQ(s.accepted, map.sensorModelStats().laser.kept);
     }
     Map::TCreationOptions far = fixedTwoMetreMap();
     far.resolution_m = 30;
@@ -363,23 +363,35 @@ TEST(BadInputExtent, AWindowSmallerThanItsMarginHoldsTheDataItCan) {
     EXPECT_GT(map.insertStats().outsideMap, 0u);
 }
 
-TEST(BadInputExtent, AStrayFarPointDoesNotStretchAGrowingMap) {
+// A stray return 1000 km ahead: beyond max_range_m it is counted out of range and the window
+// stays; with a range that admits it, it is fused, and the storage grows by a tile and the
+// directory's entries, not by the 1000 km (a dense grid of that window: 5e10 cells).
+TEST(BadInputExtent, AStrayFarPointCostsATileNotItsDistance) {
     Map map = mapWithData();
     const multibin::CellWindow w = map.grid().window();
+    const size_t bytes0 = map.grid().memoryBytes();
     auto obs = mrpt::obs::CObservationPointCloud::Create();
     obs->sensorLabel = "CLOUD";
     auto pts = mrpt::maps::CSimplePointsMap::Create();
-    pts->insertPoint(1e6f, 0, -0.3f);  // 1000 km ahead: beyond max_size_m / 2 of the sensor
+    pts->insertPoint(1e6f, 0, -0.3f);
     obs->pointcloud = pts;
-    map.insertionOptions.max_range_m = 1e7;  // the point passes the sensor model
+    const size_t outOfRange0 = map.insertStats().outOfRange;
     map.insertObservation(*obs, posePdf());
     EXPECT_TRUE(map.grid().window() == w);
-    EXPECT_EQ(map.insertStats().outsideMap + map.insertStats().tooUncertain, 1u);
+    EXPECT_EQ(map.insertStats().outOfRange - outOfRange0, 1u);
+    map.insertionOptions.max_range_m = 1e7;  // the point passes the sensor model
+    map.insertionOptions.max_elevation_uncertainty_m = 1e3;  // and eq 13
+    const size_t accepted0 = map.insertStats().accepted;
+    map.insertObservation(*obs, posePdf());
+    EXPECT_EQ(map.insertStats().accepted - accepted0, 1u);
+    EXPECT_GT(map.grid().window().ix0 + map.grid().window().nx, w.ix0 + w.nx + 1000000);
+    EXPECT_LT(map.grid().memoryBytes() - bytes0, size_t(1) << 20);
 }
 
 TEST(BadInputExtent, ARobotPoseFarAwayKeepsTheDataAlreadyMapped) {
-    // A finite but absurd pose (10^12 m): the grid may not follow it beyond max_size_m, and the
-    // floor mapped near the origin must stay.
+    // A finite but absurd pose (10^12 m): the grid may not follow it beyond its growth limit
+    // (BinStore::kGrowthLimitCells from the map origin), and the floor mapped near the origin
+    // must stay.
     Map map = mapWithData();
     const auto before = serialize(map);
     const size_t outside0 = map.insertStats().outsideMap;
@@ -551,7 +563,7 @@ TEST(BadInputIni, AValueEndingInABackslashIsAnErrorNamingTheKey) {
 }
 
 TEST(BadInputIni, NegativeOrZeroSizesAreErrors) {
-    for (const std::string key : {"resolution", "bin_height", "max_size_m"})
+    for (const std::string key : {"resolution", "bin_height"})
         for (const std::string v : {"-0.02", "0", "nan", "inf"})
             expectErrorMentioning([&] { mapsFromIni(iniWith(key + " = " + v)); }, {key});
     for (const std::string key :
@@ -565,17 +577,15 @@ TEST(BadInputIni, NegativeOrZeroSizesAreErrors) {
                           {"height_sigma_floor"});
 }
 
-TEST(BadInputIni, AMapTooLargeForMemoryIsRefusedBeforeAllocating) {
-    // 10 km at 1 mm: 10^14 cells. The error comes from validate(), before any grid exists.
-    expectErrorMentioning([] { mapsFromIni(iniWith("resolution = 0.001\nmax_size_m = 10000")); },
-                          {"max_size_m", "GB"});
-    expectErrorMentioning(
-        [] {
-            mapsFromIni(
-                iniWith("grow = false\nresolution = 0.001\nmin_x = 0\nmax_x = 1e5\n"
-                        "min_y = 0\nmax_y = 1e5"));
-        },
-        {"GB"});
+// Cells below 0.1 mm are refused: the growth limit (2^28 cells) would then reach less than 26 km
+// from the map origin. A vast map at a sane cell size is not refused: it is stored in tiles.
+TEST(BadInputIni, ACellTooSmallIsRefusedAndAVastExtentIsNot) {
+    expectErrorMentioning([] { mapsFromIni(iniWith("resolution = 0.00001")); }, {"resolution"});
+    expectErrorMentioning([] { mapsFromIni(iniWith("dual_grid = true\nglobal_resolution = 1e-6")); },
+                          {"global_resolution"});
+    EXPECT_NO_THROW(
+        mapsFromIni(iniWith("grow = false\nresolution = 0.01\nmin_x = 0\nmax_x = 1e4\n"
+                            "min_y = 0\nmax_y = 1e4")));
 }
 
 // A 300 m local grid at 15 mm (4e8 cells, 4.8 GB of cell slots) is refused by validate(), before
@@ -588,15 +598,3 @@ TEST(BadInputIni, ADualGridTooLargeForMemoryIsRefusedBeforeAllocating) {
     expectErrorMentioning([&] { c.validate(); }, {"local_size_m"});
 }
 
-TEST(BadInputIni, TheCellCountLimitIsTwoHundredMillion) {
-    // validate() refuses more than 2e8 cells (side^2 of the largest extent). A fixed 141 m square
-    // at 1 cm (1.99e8 cells) passes, 142 m (2.02e8) is refused. Note: the message prices a cell
-    // at 4 B; BinGrid::memoryBytes() counts 8 B per window cell (reported to the lead).
-    Map::TCreationOptions c;
-    c.grow = false;
-    c.resolution_m = 0.01;
-    c.min_x = 0, c.max_x = 141.0, c.min_y = 0, c.max_y = 141.0;
-    EXPECT_NO_THROW(c.validate());
-    c.max_x = c.max_y = 142.0;
-    expectErrorMentioning([&] { c.validate(); }, {"max_size_m", "14200 x 14200"});
-}

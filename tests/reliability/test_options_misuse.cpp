@@ -147,7 +147,7 @@ TEST(OptionsMisuse, ExtentsBeyondTheIntRangeOfCellIndicesAreErrors) {
     c.min_x = kNaN;
     expectErrorMentioning([&] { Map m(c); }, {"min_x"});
     c = Map::TCreationOptions();
-    c.resolution_m = 1e-12;  // max_size_m / resolution beyond int
+    c.resolution_m = 1e-12;  // cell indices beyond int within metres
     expectErrorMentioning([&] { Map m(c); }, {"resolution"});
 }
 

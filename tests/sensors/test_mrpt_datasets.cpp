@@ -73,7 +73,6 @@ TEST(MrptDatasets, Vlp16ScanFloorIsMrptsPlaneAndEveryReturnIsAccountedFor) {
 
     mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
     c.resolution_m = 0.25;
-    c.max_size_m = 80.0;
     mrpt::maps::CMultiBinElevationMap map(c);
     map.insertionOptions.max_range_m = 130.0;
     map.insertionOptions.fill.enabled = false;

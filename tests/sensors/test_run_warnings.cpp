@@ -45,10 +45,9 @@ bool mentions(const std::vector<std::string>& lines, const std::string& what) {
     return false;
 }
 
-Map vlp16Map(double maxSize_m) {
+Map vlp16Map(double resolution_m) {
     Map::TCreationOptions c;
-    c.resolution_m = 0.1;
-    c.max_size_m = maxSize_m;
+    c.resolution_m = resolution_m;
     Map map(c);
     map.insertionOptions.max_range_m = 130;
     map.insertionOptions.fill.enabled = false;
@@ -59,15 +58,16 @@ Map vlp16Map(double maxSize_m) {
 }  // namespace
 
 // MRPT's VLP-16 scan with the map's default eq 13 limit (0.1 m) and the default pose covariance:
-// most points are too uncertain. They are counted as such whatever the growth limit (before,
-// 6 854 of them were counted "outside map" with max_size_m = 40 and as many with 200, a count
-// that sent the user to an option that changes nothing), and the report names the option.
+// most points are too uncertain. They are counted as such, not "outside map" (a count that sent
+// the user to an option that changes nothing), whatever the grid, and the report names the
+// option.
 TEST(RunWarnings, TooUncertainPointsAreCountedAsSuchAndTheReportNamesTheOption) {
-    const Map small = vlp16Map(40), large = vlp16Map(200);
-    const multibin::InsertStats &a = small.insertStats(), &b = large.insertStats();
+    const Map small = vlp16Map(0.1), fine = vlp16Map(0.05);
+    const multibin::InsertStats &a = small.insertStats(), &b = fine.insertStats();
     EXPECT_EQ(a.accepted, b.accepted);
     EXPECT_EQ(a.tooUncertain, b.tooUncertain);
     EXPECT_EQ(a.outsideMap, 0u);
+    EXPECT_EQ(b.outsideMap, 0u);
     EXPECT_GT(a.tooUncertain, a.accepted);
     const std::string gate = dominantRejection(small);
     EXPECT_NE(gate.find("eq 13"), std::string::npos) << gate;
@@ -77,7 +77,7 @@ TEST(RunWarnings, TooUncertainPointsAreCountedAsSuchAndTheReportNamesTheOption) 
 }
 
 // A fixed window beside the data: every point is outside the map, the report says so and
-// names max_size_m's neighbours (the extent keys).
+// names the extent keys.
 TEST(RunWarnings, PointsOutsideAFixedWindowNameTheExtentOptions) {
     Map::TCreationOptions c;
     c.grow = false;

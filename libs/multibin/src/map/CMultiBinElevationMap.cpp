@@ -131,11 +131,15 @@ namespace {
  * m); a double still resolves 15 nm there. */
 constexpr double kMaxOrigin_m = 1e8;
 
+/** Cell sizes: from 0.1 mm (the growth limit, BinStore::kGrowthLimitCells cells, then still
+ * reaches 26 km from the map origin) to 1 km. */
+multibin::OptionRule cellSizeRule() { return multibin::between(1e-4, 1e3, "m"); }
+
 /** The creation keys of `o` (a TCreationOptions or a const one), in the order they are written,
  * for the options protocol (multibin/io/OptionKeys.h). */
 template <class Options, class Visit>
 void visitCreationKeys(Options& o, Visit&& visit) {
-    visit({"resolution_m", "resolution"}, o.resolution_m, positive("m"));
+    visit({"resolution_m", "resolution"}, o.resolution_m, cellSizeRule());
     visit({"bin_height_m", "bin_height"}, o.bin_height_m, positive("m"));
     visit("grow", o.grow);
     visit({"min_x_m", "min_x"}, o.min_x, finite("m"));
@@ -144,9 +148,9 @@ void visitCreationKeys(Options& o, Visit&& visit) {
     visit({"max_y_m", "max_y"}, o.max_y, finite("m"));
     visit("dual_grid", o.dual_grid);
     visit("local_size_m", o.local_size_m, positive("m"));
-    visit({"local_resolution_m", "local_resolution"}, o.local_resolution_m, positive("m"));
+    visit({"local_resolution_m", "local_resolution"}, o.local_resolution_m, cellSizeRule());
     visit("global_size_m", o.global_size_m, positive("m"));
-    visit({"global_resolution_m", "global_resolution"}, o.global_resolution_m, positive("m"));
+    visit({"global_resolution_m", "global_resolution"}, o.global_resolution_m, cellSizeRule());
     visit("origin_auto", o.origin_auto);
     visit("origin_x_m", o.origin_x_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
     visit("origin_y_m", o.origin_y_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));

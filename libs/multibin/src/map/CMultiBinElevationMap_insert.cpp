@@ -26,11 +26,13 @@ using multibin::PointWithCov;
 
 namespace {
 /** The points growToCover() sizes the window by: within `half_m` (the sensors' range,
- * max_range_m) of the sensor on each axis (a stray far return must not stretch the map) and
- * passing the eq 13 gate (nor may a stereo point 20 m away with sigma_z of metres). */
+ * max_range_m) of the sensor on each axis (a stray far return must not stretch the map), within
+ * `growthLimit_m` of the map origin (BinStore::kGrowthLimitCells) and passing the eq 13 gate
+ * (nor may a stereo point 20 m away with sigma_z of metres). */
 bool canGrowTheMap(const PointWithCov& p, const Eigen::Vector3d& sensor_m, double half_m,
-                   const multibin::BinUpdateParams& params) {
-    return std::abs(p.point_m.x() - sensor_m.x()) <= half_m &&
+                   double growthLimit_m, const multibin::BinUpdateParams& params) {
+    return std::abs(p.point_m.x()) <= growthLimit_m && std::abs(p.point_m.y()) <= growthLimit_m &&
+           std::abs(p.point_m.x() - sensor_m.x()) <= half_m &&
            std::abs(p.point_m.y() - sensor_m.y()) <= half_m && !std::isnan(p.cov_m2.zz) &&
            params.passesEq13(p.cov_m2.zz);
 }
@@ -334,7 +336,7 @@ bool CMultiBinElevationMap::growthNeeded(const PointsWithCov& sensorPoints,
         bool grows = false;
         for (size_t i = 0; i < pending; i++) {
             const PointWithCov& p = exact[i];
-            grows = grows || (canGrowTheMap(p, s, half, params) &&
+            grows = grows || (canGrowTheMap(p, s, half, growthLimit_m(), params) &&
                               !w.contains(m_impl->grid.cellIndex(p.point_m.x()),
                                           m_impl->grid.cellIndex(p.point_m.y())));
         }
@@ -400,6 +402,10 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
 
 double CMultiBinElevationMap::growthReach_m() const { return insertionOptions.max_range_m; }
 
+double CMultiBinElevationMap::growthLimit_m() const {
+    return multibin::BinStore::kGrowthLimitCells * m_impl->grid.cellSize_m();
+}
+
 void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
                                         const Eigen::Vector3d& sensor_m,
                                         const multibin::BinUpdateParams& params) {
@@ -409,7 +415,7 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
     double xmin = std::numeric_limits<double>::infinity(), ymin = xmin, xmax = -xmin, ymax = -xmin;
     for (const PointWithCov& p : mapPoints) {
         const double x = p.point_m.x(), y = p.point_m.y();
-        if (!canGrowTheMap(p, sensor_m, half, params)) continue;
+        if (!canGrowTheMap(p, sensor_m, half, growthLimit_m(), params)) continue;
         xmin = std::min(xmin, x);
         xmax = std::max(xmax, x);
         ymin = std::min(ymin, y);

@@ -65,6 +65,22 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
     }
 }
 
+/** `text` without its lines that start with `key` followed by a space or '='. */
+std::string withoutLines(const std::string& text, const std::string& key) {
+    std::string out;
+    size_t begin = 0;
+    while (begin < text.size()) {
+        size_t end = text.find('\n', begin);
+        end = end == std::string::npos ? text.size() : end + 1;
+        const bool drop = text.compare(begin, key.size(), key) == 0 &&
+                          begin + key.size() < text.size() &&
+                          (text[begin + key.size()] == ' ' || text[begin + key.size()] == '=');
+        if (!drop) out.append(text, begin, end - begin);
+        begin = end;
+    }
+    return out;
+}
+
 [[noreturn]] void corrupt(const std::string& what) {
     throw std::runtime_error("CMultiBinElevationMap: corrupt serialized map (" + what + ")");
 }
@@ -218,7 +234,9 @@ StoredMap readBody(mrpt::serialization::CArchive& in, uint8_t version) {
     std::string iniText(textBytes, '\0');
     if (textBytes > 0 && in.ReadBuffer(iniText.data(), textBytes) != textBytes)
         corrupt("options text cut short");
-    mrpt::config::CConfigFileMemory ini(iniText);
+    // Maps written before the storage was tiled hold `max_size_m`: not a user's ini, so no
+    // message about the retired key, which is dropped.
+    mrpt::config::CConfigFileMemory ini(withoutLines(iniText, "max_size_m"));
     m.originAtZero = !ini.keyExists(kCreationSection, "origin_auto");
     m.creation.loadFromConfigFile(ini, kCreationSection);
     m.insertion.loadFromConfigFile(ini, kInsertionSection);

@@ -473,6 +473,8 @@ private:
     /** How far from its sensor a point may grow the window [m]: the sensors' range,
      * TInsertionOptions::max_range_m (a stray far return must not stretch it). */
     double growthReach_m() const;
+    /** How far from the map origin the window may grow [m] (BinStore::kGrowthLimitCells). */
+    double growthLimit_m() const;
     /** True if growToCover() would change the window for these sensor-frame points seen from
      * `sensorInMap` (the robot pose's mean composed with the sensor pose), without propagating
      * more than the few points near the window's edge. */

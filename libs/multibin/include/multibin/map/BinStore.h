@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -18,13 +19,14 @@ namespace multibin {
  * Window: the cells the grid may store (a fixed extent, the moving window of the dual grid's local
  * grid, or the growing cover of the data). It is bookkeeping only: growing it costs nothing.
  * Cells: tiles of kTileCells x kTileCells cells, allocated on the first write into them and found
- * through a directory (one 4-byte entry per tile of the tiles' bounding box, grown geometrically),
- * so memory follows the ground seen, not the window. A cell's slot is its tile's number times
+ * through a two-level directory (groups of kGroupTiles x kGroupTiles tiles, 4 KB each, allocated
+ * when a tile of theirs is; one 4-byte entry per group of the groups' bounding box, grown
+ * geometrically), so memory follows the ground seen, not the window. A cell's slot is its tile's number times
  * kTileSlots plus its place in the tile (row-major); tile 0 is the empty tile, never written, that
  * every cell of an unallocated tile reads. Bins: one pool shared by all cells, chained per cell in
  * insertion order and addressed by a BinId, so callers hold ids, never pointers (the pool may
- * reallocate). Memory: 16 KB per tile (4 B per cell), 4 B per tile of the directory and 64 B per
- * bin. */
+ * reallocate). Memory: 16 KB per tile (4 B per cell), 4 KB per group of tiles touched, 4 B per
+ * 2048 x 2048 cells of the bounding box and 64 B per bin. */
 class BinStore {
 public:
     using BinId = uint32_t;
@@ -32,6 +34,8 @@ public:
     static constexpr int kTileShift = 6;
     static constexpr int kTileCells = 1 << kTileShift;  //!< tile side [cells]
     static constexpr size_t kTileSlots = size_t(kTileCells) * kTileCells;
+    static constexpr int kGroupShift = 5;
+    static constexpr int kGroupTiles = 1 << kGroupShift;  //!< directory group side [tiles]
 
     explicit BinStore(double cellSize_m = 0.02);
 
@@ -46,6 +50,9 @@ public:
     int cellIndex(double coord_m) const {
         return floorToInt(clampedCellCoordinate(coord_m * m_invCellSize));
     }
+    /** How far from the map origin a growing window may reach [cells]: half the clamp of
+     * clampedCellCoordinate, so a clamped coordinate never lands in a cell of the window. */
+    static constexpr int kGrowthLimitCells = 1 << 28;
     /** A coordinate in cells [-], clamped to +-2^29 (NaN to the upper limit): far outside any
      * window, and its floor fits an int. Selects only, so loops over points vectorise. */
     static double clampedCellCoordinate(double f) {
@@ -112,9 +119,12 @@ public:
     }
     /** The number of the tile (tx, ty): 0 (the empty tile) if it is not allocated. */
     uint32_t tileNumber(int tx, int ty) const {
-        const unsigned dx = unsigned(tx - m_dirX0), dy = unsigned(ty - m_dirY0);
+        const unsigned dx = unsigned((tx >> kGroupShift) - m_dirX0),
+                       dy = unsigned((ty >> kGroupShift) - m_dirY0);
         if (dx >= unsigned(m_dirNx) || dy >= unsigned(m_dirNy)) return 0;
-        return m_directory[size_t(dx) + size_t(dy) * size_t(m_dirNx)];
+        const uint32_t group = m_directory[size_t(dx) + size_t(dy) * size_t(m_dirNx)];
+        return m_groups[group][size_t(ty & (kGroupTiles - 1)) * kGroupTiles +
+                               size_t(tx & (kGroupTiles - 1))];
     }
     /** Slots in use or free, the empty tile's included: per-slot arrays kept beside the store
      * (VisibilityIndex) have this size. */
@@ -165,7 +175,8 @@ public:
      * capacity. */
     size_t memoryBytes() const {
         return m_heads.capacity() * sizeof(BinId) + m_directory.capacity() * sizeof(uint32_t) +
-               m_tileXY.capacity() * sizeof(TileKey) + m_pool.capacity() * sizeof(Bin);
+               m_groups.capacity() * sizeof(TileGroup) + m_tileXY.capacity() * sizeof(TileKey) +
+               m_pool.capacity() * sizeof(Bin);
     }
     /** @} */
 
@@ -178,8 +189,13 @@ private:
     uint32_t addTile(int tx, int ty);
     /** Frees an allocated tile whose cells hold no bin. */
     void freeTile(uint32_t t);
-    /** Grows the directory to hold tile (tx, ty), by at least half its size on that side. */
-    void growDirectory(int tx, int ty);
+    /** The slot of the directory's entry for group (gx, gy), growing the directory (by at least
+     * half its size on that side) to hold it. */
+    uint32_t& groupEntry(int gx, int gy);
+    /** The entry of tile (tx, ty) in its group, which must exist. */
+    uint32_t& tileEntry(int tx, int ty);
+    /** Tile numbers of a group of tiles, row-major; group 0 is all zero (no tile). */
+    using TileGroup = std::array<uint32_t, size_t(kGroupTiles) * kGroupTiles>;
     BinId allocateBin();
     void releaseChain(BinId head);
     void release(BinId b) {
@@ -194,8 +210,9 @@ private:
     std::vector<BinId> m_heads;         //!< per slot: the cell's first bin, or kNoBin
     std::vector<TileKey> m_tileXY;      //!< per tile number: its tile coordinates (0: empty tile)
     std::vector<uint32_t> m_freeTiles;  //!< tile numbers freed, reused first
-    std::vector<uint32_t> m_directory;  //!< tile number of (m_dirX0 + dx, m_dirY0 + dy), or 0
-    int m_dirX0 = 0, m_dirY0 = 0, m_dirNx = 0, m_dirNy = 0;
+    std::vector<uint32_t> m_directory;  //!< group number of (m_dirX0 + dx, m_dirY0 + dy), or 0
+    int m_dirX0 = 0, m_dirY0 = 0, m_dirNx = 0, m_dirNy = 0;  //!< in groups
+    std::vector<TileGroup> m_groups;                         //!< [0]: the empty group
     std::vector<Bin> m_pool;  //!< all bins; free ones chained from m_freeHead
     BinId m_freeHead = kNoBin;
     size_t m_freeCount = 0;
