@@ -42,7 +42,7 @@ def test_unknown_option_is_a_value_error_naming_it():
 
 
 def test_bad_option_value_carries_the_library_message():
-    with pytest.raises(ValueError, match="'resolution_m': must be positive"):
+    with pytest.raises(ValueError, match="'resolution_m': must be from 0.0001 to 1000"):
         multibin.ElevationMap(resolution_m=-1)
     with pytest.raises(ValueError, match="grow"):
         multibin.ElevationMap(grow="maybe")

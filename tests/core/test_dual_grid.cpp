@@ -142,14 +142,17 @@ TEST(DualGrid, GridsFollowTheRobot) {
     laser->sensorPose = mrpt::poses::CPose3D(0, 0, 1.0, 0, 0, 0);
     for (double x = 0.0123; x <= 20.0; x += 0.5)
         map.insertObservation(*laser, exactPose(x, 0.0123));
-    // The local grid is 2 m around the robot, the global one 10 m: both centred on its last
-    // position, x = 19.5123.
+    // The local grid is 2 m around the robot, centred on its last position, x = 19.5123; the
+    // global one covers 10 m around every position along the route.
     EXPECT_NEAR(0.5 * (map.localGrid().window().ix0 * 0.015 +
                        (map.localGrid().window().ix0 + map.localGrid().window().nx) * 0.015),
                 19.5123, 0.02);
     double h, s;
     EXPECT_TRUE(map.cellHeight(16.0123, 0.0123, h, s));   // written back, in the global grid
-    EXPECT_FALSE(map.cellHeight(10.0123, 0.0123, h, s));  // beyond the global grid: forgotten
+    EXPECT_TRUE(map.cellHeight(0.5123, 0.0123, h, s));  // the start: the global grid keeps it
+    EXPECT_FALSE(map.cellHeight(0.5123, 3.0, h, s));   // never seen
+    EXPECT_LE(map.grid().window().ix0 * 0.05, -5.0 + 0.1);
+    EXPECT_GE((map.grid().window().ix0 + map.grid().window().nx) * 0.05, 19.5 + 5.0 - 0.1);
     EXPECT_TRUE(map.cellHeight(19.5123, 0.0123, h, s));   // in the local grid
     EXPECT_LE(map.localGrid().binCount(), 3u);
 }

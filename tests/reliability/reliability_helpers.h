@@ -77,13 +77,11 @@ inline std::vector<BinRecord> content(const Map& map) {
     std::vector<BinRecord> out;
     int gi = 0;
     for (const multibin::BinGrid* g : {&map.grid(), &map.localGrid()}) {
-        const multibin::CellWindow& w = g->window();
-        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
-            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
-                g->forEachBin(ix, iy, [&](const multibin::Bin& b) {
-                    out.emplace_back(gi, ix, iy, b.index, b.height_m, b.variance_m2, b.certainty,
-                                     b.pointCount);
-                });
+        // Tile by tile: a window grown by a far pose is mostly empty.
+        g->store().forEachStoredBin([&](int ix, int iy, const multibin::Bin& b) {
+            out.emplace_back(gi, ix, iy, b.index, b.height_m, b.variance_m2, b.certainty,
+                             b.pointCount);
+        });
         gi++;
     }
     std::sort(out.begin(), out.end());

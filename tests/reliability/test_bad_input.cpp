@@ -379,11 +379,16 @@ TEST(BadInputExtent, AStrayFarPointCostsATileNotItsDistance) {
     map.insertObservation(*obs, posePdf());
     EXPECT_TRUE(map.grid().window() == w);
     EXPECT_EQ(map.insertStats().outOfRange - outOfRange0, 1u);
-    map.insertionOptions.max_range_m = 1e7;  // the point passes the sensor model
-    map.insertionOptions.max_elevation_uncertainty_m = 1e3;  // and eq 13
+    map.insertionOptions.max_range_m = 1e7;                  // the point passes the sensor model
+    map.insertionOptions.max_elevation_uncertainty_m = 1e5;  // and eq 13: sigma_z is ~1 km
+    map.insertionOptions.default_pose_sigmas = {0, 0, 0, 0, 0, 0};
     const size_t accepted0 = map.insertStats().accepted;
-    map.insertObservation(*obs, posePdf());
-    EXPECT_EQ(map.insertStats().accepted - accepted0, 1u);
+    map.insertObservation(*obs, mrpt::poses::CPose3D());
+    EXPECT_EQ(map.insertStats().accepted - accepted0, 1u)
+        << "too uncertain " << map.insertStats().tooUncertain << ", outside map "
+        << map.insertStats().outsideMap << ", not finite " << map.insertStats().notFinite
+        << ", bad covariance " << map.insertStats().badCovariance << ", out of range "
+        << map.insertStats().outOfRange;
     EXPECT_GT(map.grid().window().ix0 + map.grid().window().nx, w.ix0 + w.nx + 1000000);
     EXPECT_LT(map.grid().memoryBytes() - bytes0, size_t(1) << 20);
 }
@@ -581,8 +586,9 @@ TEST(BadInputIni, NegativeOrZeroSizesAreErrors) {
 // from the map origin. A vast map at a sane cell size is not refused: it is stored in tiles.
 TEST(BadInputIni, ACellTooSmallIsRefusedAndAVastExtentIsNot) {
     expectErrorMentioning([] { mapsFromIni(iniWith("resolution = 0.00001")); }, {"resolution"});
-    expectErrorMentioning([] { mapsFromIni(iniWith("dual_grid = true\nglobal_resolution = 1e-6")); },
-                          {"global_resolution"});
+    expectErrorMentioning(
+        [] { mapsFromIni(iniWith("dual_grid = true\nglobal_resolution = 1e-6")); },
+        {"global_resolution"});
     EXPECT_NO_THROW(
         mapsFromIni(iniWith("grow = false\nresolution = 0.01\nmin_x = 0\nmax_x = 1e4\n"
                             "min_y = 0\nmax_y = 1e4")));
@@ -597,4 +603,3 @@ TEST(BadInputIni, ADualGridTooLargeForMemoryIsRefusedBeforeAllocating) {
     c.local_resolution_m = 0.015;
     expectErrorMentioning([&] { c.validate(); }, {"local_size_m"});
 }
-

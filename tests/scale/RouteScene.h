@@ -29,8 +29,9 @@ struct RouteOptions {
 
 /** The rough ground [m]: waves of 0.5 .. 7 m, about 0.1 m high. */
 inline double routeGround_m(double x_m, double y_m) {
-    return 0.06 * std::sin(0.9 * x_m) * std::cos(0.7 * y_m) + 0.03 * std::sin(3.1 * x_m + 1.7 * y_m) +
-           0.015 * std::cos(9.0 * x_m - 5.0 * y_m) + 0.1 * std::sin(0.05 * (x_m + y_m));
+    return 0.06 * std::sin(0.9 * x_m) * std::cos(0.7 * y_m) +
+           0.03 * std::sin(3.1 * x_m + 1.7 * y_m) + 0.015 * std::cos(9.0 * x_m - 5.0 * y_m) +
+           0.1 * std::sin(0.05 * (x_m + y_m));
 }
 
 /** Number of clouds along the route. */

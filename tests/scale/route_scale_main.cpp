@@ -9,8 +9,8 @@
  * scripts/evaluate-route-scale.sh runs it for 50, 200 and 1000 m (doc/route-scale.md). */
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
-#include "multibin/map/BinGrid.h"
 #include <mrpt/serialization/CArchive.h>
+#include "multibin/map/BinGrid.h"
 
 #include <chrono>
 #include <cstdio>
@@ -45,15 +45,14 @@ int main(int argc, char** argv) {
         mrpt::maps::CMultiBinElevationMap map(c);
         size_t seen = 0;
         double insert_s = 0;
-        multibin::test::forEachRouteCloud(
-            o, [&](const mrpt::obs::CObservationPointCloud& cloud, const mrpt::poses::CPose3D& pose,
-                   size_t points) {
-                const auto t0 = std::chrono::steady_clock::now();
-                map.insertObservation(cloud, pose);
-                insert_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0)
-                                .count();
-                seen += points;
-            });
+        multibin::test::forEachRouteCloud(o, [&](const mrpt::obs::CObservationPointCloud& cloud,
+                                                 const mrpt::poses::CPose3D& pose, size_t points) {
+            const auto t0 = std::chrono::steady_clock::now();
+            map.insertObservation(cloud, pose);
+            insert_s +=
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            seen += points;
+        });
         const multibin::InsertStats& s = map.insertStats();
         const std::string file = "route-scale-" + std::string(argv[1]) + "m.mbmap.gz";
         {
@@ -67,7 +66,8 @@ int main(int argc, char** argv) {
             "out of range %zu\n",
             o.length_m, multibin::test::routeCloudCount(o), seen, size_t(s.accepted),
             size_t(s.outsideMap), size_t(s.tooUncertain), size_t(s.outOfRange));
-        std::printf("insertion %.3f s, %.1f ns per point\n", insert_s, 1e9 * insert_s / double(seen));
+        std::printf("insertion %.3f s, %.1f ns per point\n", insert_s,
+                    1e9 * insert_s / double(seen));
         std::printf(
             "window %d x %d cells (%.0f M), %zu tiles (%.1f M cells), %zu bins; map %.1f MB, "
             "process peak %.1f MB; file %.1f MB (%s)\n",

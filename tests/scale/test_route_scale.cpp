@@ -8,11 +8,15 @@
 #include "multibin/map/BinGrid.h"
 
 #include "RouteScene.h"
+#include "multibin/fill/GapFilling.h"
+#include "multibin/traversability/TerrainFeatures.h"
 
 namespace {
 struct RouteResult {
     size_t points = 0, fused = 0, outsideMap = 0, tooUncertain = 0, tiles = 0, bytes = 0;
     size_t windowCells = 0;
+    bool filled = false;              //!< dem_update_map() filled some cell
+    std::string traversabilityError;  //!< what traversabilityLayers() threw, if it did
 };
 
 RouteResult mapRoute(double length_m) {
@@ -25,18 +29,25 @@ RouteResult mapRoute(double length_m) {
     mrpt::maps::CMultiBinElevationMap map(c);
     map.insertionOptions.fill.enabled = false;
     RouteResult r;
-    multibin::test::forEachRouteCloud(
-        o, [&](const mrpt::obs::CObservationPointCloud& cloud, const mrpt::poses::CPose3D& pose,
-               size_t points) {
-            map.insertObservation(cloud, pose);
-            r.points += points;
-        });
+    multibin::test::forEachRouteCloud(o, [&](const mrpt::obs::CObservationPointCloud& cloud,
+                                             const mrpt::poses::CPose3D& pose, size_t points) {
+        map.insertObservation(cloud, pose);
+        r.points += points;
+    });
     r.fused = map.insertStats().accepted;
     r.outsideMap = map.insertStats().outsideMap;
     r.tooUncertain = map.insertStats().tooUncertain;
     r.tiles = map.grid().store().tileCount();
     r.bytes = map.grid().memoryBytes();
     r.windowCells = map.grid().window().cellCount();
+    map.insertionOptions.fill.enabled = true;
+    map.dem_update_map();
+    r.filled = !map.lastFill().source.empty();
+    try {
+        map.traversabilityLayers();
+    } catch (const std::exception& e) {
+        r.traversabilityError = e.what();
+    }
     return r;
 }
 }  // namespace
@@ -58,6 +69,12 @@ TEST(RouteScale, EveryPointIsFusedAndMemoryFollowsTheGroundSeen) {
     EXPECT_LT(tiles, 5.5);
     EXPECT_LT(bytes, 6.0);
     EXPECT_LT(double(r1000.bytes), 1.5e9);
+    // Filling and the traversability layers are one raster over the window: done up to 8192 x
+    // 8192 cells, beyond it (the 1000 m route) filling is skipped and the layers refuse, by name.
+    EXPECT_TRUE(r200.filled);
+    EXPECT_TRUE(r200.traversabilityError.empty()) << r200.traversabilityError;
+    EXPECT_FALSE(r1000.filled);
+    EXPECT_NE(r1000.traversabilityError.find("14"), std::string::npos) << r1000.traversabilityError;
     // The 50 m route: a quarter of the 200 m one, give or take the ends.
     EXPECT_LT(double(r200.tiles) / double(r50.tiles), 4.6);
 }

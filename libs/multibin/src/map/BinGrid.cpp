@@ -31,8 +31,7 @@ void BinGrid::reset(double cellSize_m, const CellWindow& window) {
 size_t BinGrid::writableSlot(int ix, int iy) {
     bool tileAdded;
     const size_t s = m_store.writableSlot(ix, iy, tileAdded);
-    if (tileAdded)
-        m_index.tileAdded(uint32_t(s / BinStore::kTileSlots), m_store.slotCount());
+    if (tileAdded) m_index.tileAdded(uint32_t(s / BinStore::kTileSlots), m_store.slotCount());
     return s;
 }
 
@@ -347,8 +346,7 @@ InsertStats BinGrid::insertBlocks(size_t count, BlockSource&& fillBlock,
             forAccepted(
                 stage, rejected, [&](size_t i) __attribute__((always_inline)) {
                     fuseMeasurement(writableSlot(cb.ix[i], cb.iy[i]), cb.ix[i], cb.iy[i],
-                                    static_cast<int16_t>(cb.bin[i]),
-                                    pts.v[2][i],
+                                    static_cast<int16_t>(cb.bin[i]), pts.v[2][i],
                                     std::max<double>(pts.v[8][i], kMinFusedVariance_m2),
                                     cb.weight[i], params, continuityBound_m, stats, pts.v[0][i],
                                     pts.v[1][i], cb.poseCode[0][i], cb.poseCode[1][i]);

@@ -46,8 +46,8 @@ bool BinStore::growToInclude(const CellWindow& w) {
 }
 
 uint32_t& BinStore::groupEntry(int gx, int gy) {
-    const bool inside = unsigned(gx - m_dirX0) < unsigned(m_dirNx) &&
-                        unsigned(gy - m_dirY0) < unsigned(m_dirNy);
+    const bool inside =
+        unsigned(gx - m_dirX0) < unsigned(m_dirNx) && unsigned(gy - m_dirY0) < unsigned(m_dirNy);
     if (!inside) {
         int x0 = m_dirX0, y0 = m_dirY0, x1 = m_dirX0 + m_dirNx, y1 = m_dirY0 + m_dirNy;
         if (m_dirNx == 0) {  // the first group: a directory of 4 x 4 groups around it

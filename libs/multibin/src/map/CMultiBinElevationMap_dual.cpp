@@ -4,10 +4,10 @@
  *
  * Each observation updates exactly one grid (global: stereo and global_sensor_labels; local: all
  * other sensors), so no datum is ever in both. The local grid is a window that moves with the
- * robot; the global one grows along the route (tiled storage: memory follows the ground seen). Local cells that scroll out are fused into the
- * global grid, which therefore holds everything seen; a local cell that enters starts empty and
- * queries combine it with the global estimate (getHeight), so the same data are never counted
- * twice. */
+ * robot; the global one grows along the route (tiled storage: memory follows the ground seen).
+ * Local cells that scroll out are fused into the global grid, which therefore holds everything
+ * seen; a local cell that enters starts empty and queries combine it with the global estimate
+ * (getHeight), so the same data are never counted twice. */
 #include <mrpt/obs/CObservationStereoImages.h>
 #include "CMultiBinElevationMap_impl.h"
 

@@ -8,6 +8,7 @@
 #include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
+#include <iostream>
 
 #include "multibin/fill/GapFilling.h"
 
@@ -20,6 +21,17 @@ void CMultiBinElevationMap::dem_update_map() {
 
 void CMultiBinElevationMap::fillNow() const {
     const multibin::CellWindow w = m_impl->grid.window();
+    if (w.cellCount() > kMaxWholeWindowCells) {
+        // One raster of the whole window: beyond this, GBs for a route's mostly empty box.
+        std::cerr << "CMultiBinElevationMap: gap filling skipped: the window of " << w.nx << " x "
+                  << w.ny << " cells is beyond the " << kMaxWholeWindowCells
+                  << " cells filled as one raster (long routes); set fill_enabled = false to "
+                     "skip it without this message\n";
+        m_impl->fill = {};
+        m_impl->fillWindow = {};
+        m_impl->fillStale = false;
+        return;
+    }
     multibin::fill::HeightRaster raster(multibin::Lattice{m_impl->grid.cellSize_m(), w});
     const Eigen::Vector2d& o = m_impl->origin_m;  // getHeight() takes pose-frame coordinates
     for (int r = 0; r < w.ny; r++)

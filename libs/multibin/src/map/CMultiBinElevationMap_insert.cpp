@@ -429,7 +429,6 @@ void CMultiBinElevationMap::growToCover(const PointsWithCov& mapPoints,
     // Grow with a 1 m margin, so a moving sensor does not grow the window at every scan. Growing
     // costs nothing (the storage is tiled); the window bounds what queries and rasters cover.
     const int margin = std::max(1, static_cast<int>(std::ceil(1.0 / m_impl->grid.cellSize_m())));
-    m_impl->grid.growToInclude(multibin::CellWindow{ixLo - margin, iyLo - margin,
-                                                    ixHi - ixLo + 1 + 2 * margin,
-                                                    iyHi - iyLo + 1 + 2 * margin});
+    m_impl->grid.growToInclude(multibin::CellWindow{
+        ixLo - margin, iyLo - margin, ixHi - ixLo + 1 + 2 * margin, iyHi - iyLo + 1 + 2 * margin});
 }

@@ -123,6 +123,12 @@ void CMultiBinElevationMap::updateTraversability() const {
     o.validate();
     const multibin::BinGrid& grid = m_impl->grid;
     const multibin::Lattice lattice = grid.lattice();
+    if (lattice.cellCount() > kMaxWholeWindowCells)
+        throw std::runtime_error(
+            "CMultiBinElevationMap: the traversability layers cover the whole window as one "
+            "raster; this map's window of " +
+            std::to_string(lattice.nx()) + " x " + std::to_string(lattice.ny()) +
+            " cells is beyond the " + std::to_string(kMaxWholeWindowCells) + " cells allowed");
     const bool full = !cache.valid || cache.samples.lattice.cellSize_m != lattice.cellSize_m ||
                       cache.samples.perCell != o.samples_per_cell ||
                       cache.options.text() != o.text() || isDualGrid();

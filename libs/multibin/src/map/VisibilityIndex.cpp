@@ -4,8 +4,8 @@
 namespace multibin {
 
 namespace {
-constexpr size_t kBlocksInTile = size_t(VisibilityIndex::kBlocksPerTile) *
-                                 VisibilityIndex::kBlocksPerTile;
+constexpr size_t kBlocksInTile =
+    size_t(VisibilityIndex::kBlocksPerTile) * VisibilityIndex::kBlocksPerTile;
 }
 
 void VisibilityIndex::reset() {
@@ -24,7 +24,8 @@ void VisibilityIndex::tileAdded(uint32_t tile, size_t slotCount) {
     const size_t first = size_t(tile) * BinStore::kTileSlots;
     std::fill(m_stamps.begin() + first, m_stamps.begin() + first + BinStore::kTileSlots,
               CellStamp{});
-    std::fill(m_blocks.begin() + tile * kBlocksInTile, m_blocks.begin() + (tile + 1) * kBlocksInTile,
+    std::fill(m_blocks.begin() + tile * kBlocksInTile,
+              m_blocks.begin() + (tile + 1) * kBlocksInTile,
               -std::numeric_limits<float>::infinity());
 }
 

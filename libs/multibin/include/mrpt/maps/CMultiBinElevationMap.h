@@ -468,6 +468,10 @@ private:
     void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
                      const multibin::BinUpdateParams& params);
 
+    /** Largest window gap filling and the traversability layers compute over as one raster
+     * [cells] (8192 x 8192): beyond it (a long route's box), filling is skipped with a message
+     * and the layers refuse, instead of allocating GBs. */
+    static constexpr size_t kMaxWholeWindowCells = size_t(1) << 26;
     /** Side of the square the global grid covers around the robot [cells]: global_size_m. */
     int globalSideCells() const;
     /** How far from its sensor a point may grow the window [m]: the sensors' range,

@@ -21,12 +21,12 @@ namespace multibin {
  * Cells: tiles of kTileCells x kTileCells cells, allocated on the first write into them and found
  * through a two-level directory (groups of kGroupTiles x kGroupTiles tiles, 4 KB each, allocated
  * when a tile of theirs is; one 4-byte entry per group of the groups' bounding box, grown
- * geometrically), so memory follows the ground seen, not the window. A cell's slot is its tile's number times
- * kTileSlots plus its place in the tile (row-major); tile 0 is the empty tile, never written, that
- * every cell of an unallocated tile reads. Bins: one pool shared by all cells, chained per cell in
- * insertion order and addressed by a BinId, so callers hold ids, never pointers (the pool may
- * reallocate). Memory: 16 KB per tile (4 B per cell), 4 KB per group of tiles touched, 4 B per
- * 2048 x 2048 cells of the bounding box and 64 B per bin. */
+ * geometrically), so memory follows the ground seen, not the window. A cell's slot is its tile's
+ * number times kTileSlots plus its place in the tile (row-major); tile 0 is the empty tile, never
+ * written, that every cell of an unallocated tile reads. Bins: one pool shared by all cells,
+ * chained per cell in insertion order and addressed by a BinId, so callers hold ids, never pointers
+ * (the pool may reallocate). Memory: 16 KB per tile (4 B per cell), 4 KB per group of tiles
+ * touched, 4 B per 2048 x 2048 cells of the bounding box and 64 B per bin. */
 class BinStore {
 public:
     using BinId = uint32_t;

@@ -11,7 +11,6 @@
 
 namespace multibin {
 
-
 /** What the visibility constraint needs to know about a grid beyond its bins: which cells the
  * current observation updated (update cycles) and upper bounds on the bins' heights, per cell
  * and per block of cells. Kept beside a BinStore with its slot numbering (per tile); BinGrid
