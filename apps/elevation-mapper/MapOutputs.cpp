@@ -20,6 +20,8 @@
 
 #include "ProgressBar.h"
 #include "multibin/io/ErrorMessage.h"
+#include "multibin/io/MapLayerFiles.h"
+#include "multibin/io/NumberText.h"
 #include "multibin/io/OutputFile.h"
 #include "multibin/io/RasterExport.h"
 
@@ -36,18 +38,26 @@ struct Group {
 const Group kGroups[] = {
     {"map", &OutputSelection::map, "elevation_map.bin (the serialized map, gz)"},
     {"tif", &OutputSelection::tif,
-     "elevation_height.tif + .tfw (float32 heights [m], NaN unknown, world file)"},
+     "elevation_height.tif + .tfw (GeoTIFF: float32 heights [m], NaN unknown, tiled,\n"
+     "        compressed, only the tiles with data; world file)"},
+    {"tif-layers", &OutputSelection::tifLayers,
+     "elevation_{sigma,certainty,source}.tif (the other layers as GeoTIFF)"},
     {"scene", &OutputSelection::scene, "elevation.3Dscene (3D view, opens in SceneViewer3D)"},
     {"png", &OutputSelection::png,
-     "elevation_{height,sigma,source}.png (previews: axes [m], scale, legend)"},
-    {"asc", &OutputSelection::asc, "elevation_{height,sigma,certainty,source}.asc (ESRI ASCII)"},
-    {"ply", &OutputSelection::ply, "elevation.ply (triangle mesh [m])"},
+     "elevation_{height,sigma,source}.png (previews: axes [m], scale, legend;\n"
+     "        downsampled beyond 2048 cells a side)"},
+    {"asc", &OutputSelection::asc,
+     "elevation_{height,sigma,certainty,source}.asc (ESRI ASCII; dense: up to 4096 x 4096\n"
+     "        known cells)"},
+    {"ply", &OutputSelection::ply, "elevation.ply (triangle mesh [m]; up to 4096 x 4096 cells)"},
     {"gridmap", &OutputSelection::gridmap,
      "elevation_traversability.gridmap.gz (MRPT occupancy grid: P(untraversable), unknown 0.5)"
      " and elevation_untraversable.png"},
 };
 
 const char* const kLayerNames[] = {"height", "sigma", "certainty", "source"};
+using Layer = CMultiBinElevationMap::RasterLayer;
+const Layer kLayers[] = {Layer::Height, Layer::Sigma, Layer::Certainty, Layer::Source};
 /** The traversability layers `asc` writes (doc/traversability.md), in TraversabilityLayer order. */
 const char* const kTraversabilityNames[] = {"untraversable", "step", "slope", "roughness",
                                             "foothold"};
@@ -123,10 +133,22 @@ OutputSelection OutputSelection::parse(const std::string& list) {
     return sel;
 }
 
+int OutputSelection::parseEpsg(const std::string& text) {
+    if (text.empty()) return 0;
+    double v = 0;
+    if (!multibin::parseFiniteNumber(text, v) || v != std::floor(v) || std::abs(v) > 1e6)
+        throw std::invalid_argument("--epsg: '" + text + "' is not an EPSG code");
+    multibin::checkGeoTiffEpsg(int(v), "--epsg");
+    return int(v);
+}
+
 std::vector<std::string> OutputSelection::fileNames() const {
     std::vector<std::string> f;
     if (map) f.push_back("elevation_map.bin");
     if (tif) f.insert(f.end(), {"elevation_height.tif", "elevation_height.tfw"});
+    if (tifLayers)
+        for (const char* l : {"sigma", "certainty", "source"})
+            f.push_back(std::string("elevation_") + l + ".tif");
     if (scene) f.push_back("elevation.3Dscene");
     if (png)
         for (const char* l : {"height", "sigma", "source"})
@@ -213,18 +235,29 @@ void OutputFolder::moveIn(const std::string& name, const std::string& file) cons
 }
 
 MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
-    using L = CMultiBinElevationMap::RasterLayer;
     MapLayers m;
-    m.height = map.toRaster(L::Height);
-    const multibin::RasterBox box = multibin::knownBox(m.height, kMargin_cells);
-    m.height = multibin::cropRaster(m.height, box);
-    m.sigma = multibin::cropRaster(map.toRaster(L::Sigma), box);
-    m.certainty = multibin::cropRaster(map.toRaster(L::Certainty), box);
-    m.source = multibin::cropRaster(map.toRaster(L::Source), box);
+    m.tiled[0] = multibin::tiledLayer(map, Layer::Height);
+    for (int i = 1; i < 4; i++)
+        m.tiled[i] = multibin::tiledLayer(map, kLayers[i], &m.tiled[0].tiles);
+    m.cells = multibin::knownWindow(m.tiled[0], kMargin_cells);
+    m.dense = m.cells.nx > 0 && m.cells.cellCount() <= multibin::kMaxDenseOutputCells;
+    if (m.dense) {
+        multibin::EsriAsciiGrid* grids[] = {&m.height, &m.sigma, &m.certainty, &m.source};
+        for (int i = 0; i < 4; i++) *grids[i] = map.toRaster(kLayers[i], m.cells);
+    }
     return m;
 }
 
+void MapLayers::requireDense(const std::string& output) const {
+    if (dense) return;
+    multibin::checkDenseOutputFits(cells, tiled[0].cellSize_m, output,
+                                   "choose --outputs tif,tif-layers,png (GeoTIFF and previews "
+                                   "read tile by tile, any size)");
+    throw std::invalid_argument(output + ": the map knows no cell");
+}
+
 void MapLayers::saveAsc(const OutputFolder& folder) const {
+    requireDense("--outputs asc");
     const multibin::EsriAsciiGrid* grids[] = {&height, &sigma, &certainty, &source};
     for (int i = 0; i < 4; i++)
         folder.writeWith(std::string("elevation_") + kLayerNames[i] + ".asc",
@@ -236,6 +269,7 @@ void MapLayers::saveAsc(const OutputFolder& folder) const {
 
 SupersampledLayers SupersampledLayers::of(const CMultiBinElevationMap& map, const MapLayers& layers,
                                           double cell_m) {
+    layers.requireDense("--export-resolution");
     SupersampledLayers out;
     const multibin::EsriAsciiGrid& box = layers.height;
     // The same area as the map-resolution rasters: their cells' outer edges.
@@ -283,15 +317,34 @@ void SupersampledLayers::saveAsc(const OutputFolder& folder) const {
 
 std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const MapLayers& layers,
                                          const OutputSelection& sel, const OutputFolder& folder) {
+    // The dense outputs refuse a long route's box before any file is written.
+    if (sel.asc) layers.requireDense("--outputs asc");
+    if (sel.ply) layers.requireDense("--outputs ply");
+    if (sel.gridmap) layers.requireDense("--outputs gridmap");
     // Each step writes one or more files; the bar counts steps.
     std::vector<std::pair<std::string, std::function<void()>>> steps;
+    multibin::GeoTiffOptions geo;
+    geo.epsg = sel.epsg;
+    const auto geoTiff = [&folder, &layers, geo](int layer) {
+        multibin::GeoTiffOptions o = geo;
+        o.description = multibin::layerPreviewStyle(kLayers[layer]).title;
+        folder.writeWith(std::string("elevation_") + kLayerNames[layer] + ".tif",
+                         [&](const std::string& path) {
+                             multibin::saveSparseGeoTiff(layers.tiled[layer], path, o);
+                             return true;
+                         });
+    };
     if (sel.map)
         steps.emplace_back("elevation_map.bin",
                            [&] { folder.write("elevation_map.bin", gzSerialized(map)); });
     if (sel.tif)
         steps.emplace_back("elevation_height.tif", [&] {
-            folder.write("elevation_height.tif", multibin::encodeFloatTiff(layers.height));
-            folder.write("elevation_height.tfw", multibin::worldFileText(layers.height));
+            geoTiff(0);
+            folder.write("elevation_height.tfw", multibin::geoTiffWorldFileText(layers.tiled[0]));
+        });
+    if (sel.tifLayers)
+        steps.emplace_back("elevation_{sigma,certainty,source}.tif", [&] {
+            for (int i = 1; i < 4; i++) geoTiff(i);
         });
     if (sel.scene)
         steps.emplace_back("elevation.3Dscene", [&] {
@@ -300,37 +353,26 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
             multibin::buildTerrainView(map, sel.sceneColouring, *obj);
             scene.insert(obj);
             // The first view: the whole map from above at an angle.
-            const auto& h = layers.height;
+            const multibin::TiledRaster& h = layers.tiled[0];
+            const multibin::CellWindow& w = layers.cells;
             auto& camera = scene.getViewport("main")->getCamera();
-            camera.setPointingAt(0.5 * (h.xllcenter_m + h.xMax_m()),
-                                 0.5 * (h.yllcenter_m + h.yMax_m()), 0.0);
+            camera.setPointingAt(0.5 * (h.cellCenterX_m(w.ix0) + h.cellCenterX_m(w.ix0 + w.nx - 1)),
+                                 0.5 * (h.cellCenterY_m(w.iy0) + h.cellCenterY_m(w.iy0 + w.ny - 1)),
+                                 0.0);
             camera.setZoomDistance(
-                1.2 * std::max({h.xMax_m() - h.xllcenter_m, h.yMax_m() - h.yllcenter_m, 1.0}));
+                1.2 * std::max({(w.nx - 1) * h.cellSize_m, (w.ny - 1) * h.cellSize_m, 1.0}));
             camera.setAzimuthDegrees(-60);
             camera.setElevationDegrees(45);
             folder.write("elevation.3Dscene", gzSerialized(scene));
         });
-    if (sel.png) {
-        multibin::PreviewStyle h;
-        h.title = "height [m]";
-        h.colormap = cv::COLORMAP_VIRIDIS;
-        steps.emplace_back("elevation_height.png", [&folder, &layers, h] {
-            folder.write("elevation_height.png", multibin::encodePreviewPng(layers.height, h));
-        });
-        multibin::PreviewStyle s;
-        s.title = "sigma [m]";
-        s.colormap = cv::COLORMAP_INFERNO;
-        s.valueFormat = "%.4f";
-        steps.emplace_back("elevation_sigma.png", [&folder, &layers, s] {
-            folder.write("elevation_sigma.png", multibin::encodePreviewPng(layers.sigma, s));
-        });
-        multibin::PreviewStyle src;
-        src.title = "source of the height";
-        src.categories = multibin::heightSourceCategories();
-        steps.emplace_back("elevation_source.png", [&folder, &layers, src] {
-            folder.write("elevation_source.png", multibin::encodePreviewPng(layers.source, src));
-        });
-    }
+    if (sel.png)
+        for (const int i : {0, 1, 3}) {
+            const std::string name = std::string("elevation_") + kLayerNames[i] + ".png";
+            steps.emplace_back(name, [&folder, &layers, name, i] {
+                folder.write(name,
+                             multibin::layerPreviewPng(layers.tiled[i], kLayers[i], layers.cells));
+            });
+        }
     if (sel.asc) steps.emplace_back("elevation_*.asc", [&] { layers.saveAsc(folder); });
     if (sel.asc)
         steps.emplace_back("traversability *.asc", [&] {

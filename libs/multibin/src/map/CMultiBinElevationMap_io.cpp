@@ -11,10 +11,12 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
-#include "multibin/io/RasterExport.h"
+#include "multibin/io/MapLayerFiles.h"
+#include "multibin/io/OutputFile.h"
 #include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
@@ -342,10 +344,15 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 }
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
+    return toRaster(layer, m_impl->grid.window());
+}
+
+multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer,
+                                                        const multibin::CellWindow& w) const {
     fillIfLoaded();  // a loaded map's rasters hold its filled cells, as the writer's did
     const multibin::MapLock::Shared lock(m_impl->lock);
-    const multibin::CellWindow& w = m_impl->grid.window();
-    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
+    multibin::EsriAsciiGrid g =
+        multibin::EsriAsciiGrid::onLattice(multibin::Lattice{m_impl->grid.cellSize_m(), w});
     const Eigen::Vector2d& o = m_impl->origin_m;  // the raster is in the pose frame
     g.xllcenter_m += o.x();
     g.yllcenter_m += o.y();
@@ -384,10 +391,52 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
     return g;
 }
 
+std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileCells) const {
+    if (tileCells < 1)
+        throw std::invalid_argument("occupiedTiles: tileCells " + std::to_string(tileCells) +
+                                    " must be at least 1");
+    fillIfLoaded();
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    std::set<std::pair<int, int>> corners;  // (iy0, ix0): ordered row by row from the south
+    const auto add = [&](int ix, int iy) {
+        const multibin::CellWindow t = multibin::tileOfCell(ix, iy, tileCells);
+        corners.emplace(t.iy0, t.ix0);
+    };
+    // One pass over the stored bins until the tiled store lists its own tiles.
+    m_impl->grid.store().forEachStoredBin(
+        [&](int ix, int iy, const multibin::Bin&) { add(ix, iy); });
+    if (isDualGrid()) {  // local cells not yet written back, at the global cell of their centre
+        const multibin::BinGrid& l = m_impl->local;
+        l.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
+            add(m_impl->grid.cellIndex(l.cellCenter_m(ix)),
+                m_impl->grid.cellIndex(l.cellCenter_m(iy)));
+        });
+    }
+    const multibin::fill::FillResult& f = m_impl->fill;
+    const multibin::CellWindow& fw = m_impl->fillWindow;
+    if (insertionOptions.dem_return_filled && f.source.size() == fw.cellCount())
+        for (int r = 0; r < fw.ny; r++)
+            for (int c = 0; c < fw.nx; c++)
+                if (f.isFilled(f.index(c, r))) add(fw.ix0 + c, fw.iy0 + r);
+    std::vector<multibin::CellWindow> tiles;
+    tiles.reserve(corners.size());
+    for (const auto& [iy0, ix0] : corners)
+        tiles.push_back(multibin::CellWindow{ix0, iy0, tileCells, tileCells});
+    return tiles;
+}
+
 void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
     fillIfLoaded();
     const multibin::MapLock::Shared lock(m_impl->lock);
-    const multibin::EsriAsciiGrid g = toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height);
+    const RasterLayer layer = sigma ? RasterLayer::Sigma : RasterLayer::Height;
+    // A long route's window is drawn in blocks, each read tile by tile.
+    constexpr int kMaxSide_px = 4096;
+    const multibin::CellWindow& w = m_impl->grid.window();
+    const int k = multibin::blockFactorFor(w, kMaxSide_px);
+    const multibin::EsriAsciiGrid g =
+        k == 1 ? toRaster(layer, w)
+               : multibin::blockReduced(multibin::tiledLayer(*this, layer), w, k,
+                                        multibin::BlockReduce::Mean);
     const int rows = g.rows(), cols = g.cols();
     img.resize(std::max(cols, 1), std::max(rows, 1), mrpt::img::CH_RGB);
     img.filledRectangle(0, 0, std::max(cols, 1) - 1, std::max(rows, 1) - 1,
@@ -415,26 +464,29 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
 
 void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     const std::string& filNamePrefix) const {
+    fillIfLoaded();
     const multibin::MapLock::Shared lock(m_impl->lock);
-    // Rasters cover the known cells plus a margin, not the whole grown window.
-    const multibin::RasterBox box = multibin::knownBox(toRaster(RasterLayer::Height), 5);
-    const auto raster = [&](RasterLayer l) { return multibin::cropRaster(toRaster(l), box); };
-    for (const bool sigma : {false, true}) {
-        const std::string layer = sigma ? "_sigma" : "_height";
-        mrpt::img::CImage img;
-        getAsImage(img, sigma);
-        if (!img.saveToFile(filNamePrefix + layer + ".png"))
-            throw std::runtime_error("CMultiBinElevationMap: cannot write " + filNamePrefix +
-                                     layer + ".png");
-        raster(sigma ? RasterLayer::Sigma : RasterLayer::Height)
-            .save(filNamePrefix + layer + ".asc");
-    }
-    raster(RasterLayer::Certainty).save(filNamePrefix + "_certainty.asc");
-    raster(RasterLayer::Source).save(filNamePrefix + "_source.asc");
-    const multibin::EsriAsciiGrid heights = raster(RasterLayer::Height);
-    if (heights.rows() > 0 && heights.cols() > 0) {
-        multibin::saveFloatTiff(heights, filNamePrefix + "_height.tif");
-        multibin::saveMeshPly(heights, filNamePrefix + ".ply");
+    // What elevation-mapper writes by default (doc/user-guide.md), read tile by tile: sparse
+    // GeoTIFF layers, downsampled previews, the 3D view. ESRI ASCII and PLY are dense over the
+    // known area: elevation-mapper --outputs asc,ply writes them for maps that fit.
+    using L = RasterLayer;
+    const multibin::TiledRaster height = multibin::tiledLayer(*this, L::Height);
+    if (!height.tiles.empty()) {
+        for (const L layer : {L::Height, L::Sigma, L::Certainty, L::Source}) {
+            const std::string path = filNamePrefix + "_" + multibin::mapLayerName(layer) + ".tif";
+            multibin::GeoTiffOptions options;
+            options.description = multibin::layerPreviewStyle(layer).title;
+            multibin::saveSparseGeoTiff(multibin::tiledLayer(*this, layer, &height.tiles), path,
+                                        options);
+        }
+        multibin::writeFileAtomically(filNamePrefix + "_height.tfw",
+                                      multibin::geoTiffWorldFileText(height));
+        const multibin::CellWindow box = multibin::knownWindow(height, 5);
+        for (const L layer : {L::Height, L::Sigma, L::Source})
+            multibin::writeFileAtomically(
+                filNamePrefix + "_" + multibin::mapLayerName(layer) + ".png",
+                multibin::layerPreviewPng(multibin::tiledLayer(*this, layer, &height.tiles), layer,
+                                          box));
     }
     mrpt::opengl::COpenGLScene scene;
     auto obj = mrpt::opengl::CSetOfObjects::Create();
