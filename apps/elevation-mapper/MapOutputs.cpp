@@ -236,33 +236,36 @@ void OutputFolder::moveIn(const std::string& name, const std::string& file) cons
 
 MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
     MapLayers m;
+    m.m_map = &map;
     m.tiled[0] = multibin::tiledLayer(map, Layer::Height);
     for (int i = 1; i < 4; i++)
         m.tiled[i] = multibin::tiledLayer(map, kLayers[i], &m.tiled[0].tiles);
     m.cells = multibin::knownWindow(m.tiled[0], kMargin_cells);
-    m.dense = m.cells.nx > 0 && m.cells.cellCount() <= multibin::kMaxDenseOutputCells;
-    if (m.dense) {
-        multibin::EsriAsciiGrid* grids[] = {&m.height, &m.sigma, &m.certainty, &m.source};
-        for (int i = 0; i < 4; i++) *grids[i] = map.toRaster(kLayers[i], m.cells);
-    }
     return m;
 }
 
 void MapLayers::requireDense(const std::string& output) const {
-    if (dense) return;
+    if (cells.nx == 0) throw std::invalid_argument(output + ": the map knows no cell");
     multibin::checkDenseOutputFits(cells, tiled[0].cellSize_m, output,
                                    "choose --outputs tif,tif-layers,png (GeoTIFF and previews "
                                    "read tile by tile, any size)");
-    throw std::invalid_argument(output + ": the map knows no cell");
+}
+
+const multibin::EsriAsciiGrid& MapLayers::dense(int i) const {
+    if (!m_computed[i]) {
+        requireDense(std::string("the ") + kLayerNames[i] + " raster");
+        m_dense[i] = m_map->toRaster(kLayers[i], cells);
+        m_computed[i] = true;
+    }
+    return m_dense[i];
 }
 
 void MapLayers::saveAsc(const OutputFolder& folder) const {
     requireDense("--outputs asc");
-    const multibin::EsriAsciiGrid* grids[] = {&height, &sigma, &certainty, &source};
     for (int i = 0; i < 4; i++)
         folder.writeWith(std::string("elevation_") + kLayerNames[i] + ".asc",
                          [&](const std::string& path) {
-                             grids[i]->save(path);
+                             dense(i).save(path);
                              return true;
                          });
 }
@@ -271,7 +274,7 @@ SupersampledLayers SupersampledLayers::of(const CMultiBinElevationMap& map, cons
                                           double cell_m) {
     layers.requireDense("--export-resolution");
     SupersampledLayers out;
-    const multibin::EsriAsciiGrid& box = layers.height;
+    const multibin::EsriAsciiGrid& box = layers.dense(0);
     // The same area as the map-resolution rasters: their cells' outer edges.
     const double x0 = box.xllcenter_m - 0.5 * box.cellsize_m;
     const double y0 = box.yllcenter_m - 0.5 * box.cellsize_m;
@@ -366,20 +369,21 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
             folder.write("elevation.3Dscene", gzSerialized(scene));
         });
     if (sel.png)
-        for (const int i : {0, 1, 3}) {
-            const std::string name = std::string("elevation_") + kLayerNames[i] + ".png";
-            steps.emplace_back(name, [&folder, &layers, name, i] {
-                folder.write(name,
-                             multibin::layerPreviewPng(layers.tiled[i], kLayers[i], layers.cells));
-            });
-        }
+        steps.emplace_back("elevation_{height,sigma,source}.png", [&] {
+            const std::vector<Layer> shown{Layer::Height, Layer::Sigma, Layer::Source};
+            const auto png = multibin::layerPreviewPngs(
+                multibin::tiledLayers(map, shown, &layers.tiled[0].tiles), shown, layers.cells);
+            for (size_t i = 0; i < shown.size(); i++)
+                folder.write(std::string("elevation_") + multibin::mapLayerName(shown[i]) + ".png",
+                             png[i]);
+        });
     if (sel.asc) steps.emplace_back("elevation_*.asc", [&] { layers.saveAsc(folder); });
     if (sel.asc)
         steps.emplace_back("traversability *.asc", [&] {
             for (int i = 0; i < 5; i++)
                 folder.writeWith(std::string("elevation_") + kTraversabilityNames[i] + ".asc",
                                  [&](const std::string& path) {
-                                     traversabilityLike(map, i, layers.height).save(path);
+                                     traversabilityLike(map, i, layers.dense(0)).save(path);
                                      return true;
                                  });
         });
@@ -392,12 +396,13 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
             u.title = "P(untraversable)";
             u.colormap = cv::COLORMAP_INFERNO;
             u.valueFormat = "%.2f";
-            folder.write("elevation_untraversable.png",
-                         multibin::encodePreviewPng(traversabilityLike(map, 0, layers.height), u));
+            folder.write(
+                "elevation_untraversable.png",
+                multibin::encodePreviewPng(traversabilityLike(map, 0, layers.dense(0)), u));
         });
     if (sel.ply)
         steps.emplace_back("elevation.ply", [&] {
-            folder.write("elevation.ply", multibin::meshPlyText(layers.height));
+            folder.write("elevation.ply", multibin::meshPlyText(layers.dense(0)));
         });
 
     ProgressBar bar("writing");

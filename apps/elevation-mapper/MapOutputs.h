@@ -76,19 +76,25 @@ private:
 
 /** The map's layers, read tile by tile (multibin::TiledRaster over the map's occupied tiles),
  * and the area of the previews and dense outputs: the bounding box of its known cells plus a
- * margin. The dense rasters over that box (for ESRI ASCII, PLY and the figures) only when it
- * holds at most multibin::kMaxDenseOutputCells cells: a long route's box is mostly empty. */
+ * margin. The dense rasters over that box (ESRI ASCII, PLY, the figures) are computed on first
+ * use, and only when the box holds at most multibin::kMaxDenseOutputCells cells: a long route's
+ * box is mostly empty. */
 struct MapLayers {
     multibin::TiledRaster tiled[4];  //!< height, sigma, certainty, source (RasterLayer order)
     multibin::CellWindow cells;      //!< known cells plus kMargin_cells; empty if none known
-    bool dense = false;              //!< the rasters below are filled
-    multibin::EsriAsciiGrid height, sigma, certainty, source;
     static constexpr int kMargin_cells = 5;
     static MapLayers of(const mrpt::maps::CMultiBinElevationMap& map);
-    /** Throws std::invalid_argument naming `output` unless the dense rasters are there. */
+    /** Throws std::invalid_argument naming `output` unless the box fits a dense raster. */
     void requireDense(const std::string& output) const;
+    /** Layer i (RasterLayer order) over `cells`, NaN where unknown; requireDense() first. */
+    const multibin::EsriAsciiGrid& dense(int i) const;
     /** Writes elevation_{height,sigma,certainty,source}.asc into `dir` (any folder). */
     void saveAsc(const OutputFolder& folder) const;
+
+private:
+    const mrpt::maps::CMultiBinElevationMap* m_map = nullptr;
+    mutable multibin::EsriAsciiGrid m_dense[4];
+    mutable bool m_computed[4] = {false, false, false, false};
 };
 
 /** The sub-cell surface (heightAt) sampled every `cell_m` over the box of `layers` (--export-

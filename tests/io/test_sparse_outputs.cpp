@@ -254,17 +254,33 @@ TEST(TiledRaster, BlockReductionAndPreviewOfALongRoute) {
     strip.known = [](int ix, int iy) { return ix >= 0 && ix < 6000 && std::abs(ix - iy) <= 40; };
     const TiledRaster route = strip.raster(0.05, 0, 0, stripTiles(6000, 40));
     const CellWindow box = multibin::knownWindow(route, 5);
-    EXPECT_EQ(box.nx, 6000 + 10);
-    std::string note;
+    // x 0 .. 5999, y -40 .. 6039, plus 5 cells; found from the tiles at the extremes.
+    EXPECT_EQ(box, (CellWindow{-5, -45, 6010, 6090}));
+    // Two layers in one loop over the tiles give what each gives alone (blocks span tiles).
+    FormulaLayer other;
+    other.known = [](int ix, int iy) { return ix >= 0 && ix < 6000 && std::abs(ix - iy) <= 20; };
+    const TiledRaster narrow = other.raster(0.05, 0, 0, route.tiles);
+    const auto both = multibin::blockReduced(
+        {route, narrow}, box, 7, {multibin::BlockReduce::Mean, multibin::BlockReduce::Mean});
+    const auto alone = multibin::blockReduced(narrow, box, 7, multibin::BlockReduce::Mean);
+    EXPECT_TRUE((both[1].heights_m.array().isNaN() == alone.heights_m.array().isNaN()).all());
+    int compared = 0;
+    for (int r = 0; r < alone.rows(); r++)
+        for (int c = 0; c < alone.cols(); c++)
+            if (std::isfinite(alone.heights_m(r, c))) {
+                EXPECT_FLOAT_EQ(both[1].heights_m(r, c), alone.heights_m(r, c)) << r << " " << c;
+                compared++;
+            }
+    EXPECT_GT(compared, 800);
     const multibin::EsriAsciiGrid p =
-        multibin::previewRaster(route, multibin::MapLayer::Height, box, &note);
+        multibin::previewRasters({route}, {multibin::MapLayer::Height}, box).front();
     EXPECT_EQ(p.cols(), (6010 + 2) / 3);  // k = 3 brings 6010 cells within 2048
     EXPECT_LE(std::max(p.rows(), p.cols()), multibin::kPreviewMaxSide_px);
-    EXPECT_EQ(note, "1 pixel = 3 x 3 cells (mean)");
     EXPECT_EQ(strip.largestRequest_cells, size_t(256 * 256));
     // The route stays visible along the whole diagonal.
     for (const int k : {10, 1000, 1990}) EXPECT_TRUE(std::isfinite(p.heights_m(k, k))) << k;
-    EXPECT_FALSE(multibin::layerPreviewPng(route, multibin::MapLayer::Height, box).empty());
+    EXPECT_FALSE(
+        multibin::layerPreviewPngs({route}, {multibin::MapLayer::Height}, box).front().empty());
 }
 
 TEST(TiledRaster, DenseOutputsRefuseALongRouteNamingTheAlternative) {

@@ -4,6 +4,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <memory>
 #include <stdexcept>
 
 #include "multibin/map/TerrainView.h"
@@ -25,8 +26,9 @@ const char* mapLayerName(MapLayer layer) {
     }
 }
 
-TiledRaster tiledLayer(const CMultiBinElevationMap& map, MapLayer layer,
-                       const std::vector<CellWindow>* tiles) {
+std::vector<TiledRaster> tiledLayers(const CMultiBinElevationMap& map,
+                                     const std::vector<MapLayer>& layers,
+                                     const std::vector<CellWindow>* tiles) {
     TiledRaster t;
     t.cellSize_m = map.dem_get_resolution();
     const mrpt::math::TPoint2D origin = map.mapOrigin();
@@ -34,9 +36,26 @@ TiledRaster tiledLayer(const CMultiBinElevationMap& map, MapLayer layer,
     t.originY_m = origin.y;
     t.tileCells = kGeoTiffTile;
     t.tiles = tiles ? *tiles : map.occupiedTiles(kGeoTiffTile);
-    const CMultiBinElevationMap* m = &map;
-    t.samples = [m, layer](const CellWindow& w) { return m->toRaster(layer, w); };
-    return t;
+    struct LastWindow {
+        CellWindow window;
+        std::vector<EsriAsciiGrid> rasters;  // empty until the first read
+    };
+    const auto last = std::make_shared<LastWindow>();
+    std::vector<TiledRaster> out(layers.size(), t);
+    for (size_t k = 0; k < layers.size(); k++)
+        out[k].samples = [m = &map, layers, last, k](const CellWindow& w) {
+            if (last->rasters.empty() || !(last->window == w)) {
+                last->rasters = m->toRasters(layers, w);
+                last->window = w;
+            }
+            return last->rasters[k];
+        };
+    return out;
+}
+
+TiledRaster tiledLayer(const CMultiBinElevationMap& map, MapLayer layer,
+                       const std::vector<CellWindow>* tiles) {
+    return std::move(tiledLayers(map, {layer}, tiles).front());
 }
 
 CellWindow knownWindow(const TiledRaster& height, int margin_cells) {
@@ -78,25 +97,30 @@ BlockReduce layerBlockReduce(MapLayer layer) {
                                                                  : BlockReduce::Mean;
 }
 
-EsriAsciiGrid previewRaster(const TiledRaster& layer, MapLayer which, const CellWindow& window,
-                            std::string* note) {
-    const int k = blockFactorFor(window, kPreviewMaxSide_px);
-    const BlockReduce how = layerBlockReduce(which);
-    if (note)
-        *note = k == 1 ? std::string()
-                       : "1 pixel = " + std::to_string(k) + " x " + std::to_string(k) + " cells (" +
-                             (how == BlockReduce::Mean ? "mean" : "max") + ")";
-    return blockReduced(layer, window, k, how);
+std::vector<EsriAsciiGrid> previewRasters(const std::vector<TiledRaster>& layers,
+                                          const std::vector<MapLayer>& which,
+                                          const CellWindow& window) {
+    std::vector<BlockReduce> how;
+    for (const MapLayer l : which) how.push_back(layerBlockReduce(l));
+    return blockReduced(layers, window, blockFactorFor(window, kPreviewMaxSide_px), how);
 }
 
-std::vector<uint8_t> layerPreviewPng(const TiledRaster& layer, MapLayer which,
-                                     const CellWindow& window) {
+std::vector<std::vector<uint8_t>> layerPreviewPngs(const std::vector<TiledRaster>& layers,
+                                                   const std::vector<MapLayer>& which,
+                                                   const CellWindow& window) {
     if (window.nx == 0 || window.ny == 0)
-        throw std::invalid_argument(std::string("the ") + mapLayerName(which) +
-                                    " preview: the map knows no cell");
-    PreviewStyle style = layerPreviewStyle(which);
-    const EsriAsciiGrid raster = previewRaster(layer, which, window, &style.note);
-    return encodePreviewPng(raster, style);
+        throw std::invalid_argument("previews: the map knows no cell");
+    const std::vector<EsriAsciiGrid> rasters = previewRasters(layers, which, window);
+    const int k = blockFactorFor(window, kPreviewMaxSide_px);
+    std::vector<std::vector<uint8_t>> png;
+    for (size_t i = 0; i < which.size(); i++) {
+        PreviewStyle style = layerPreviewStyle(which[i]);
+        if (k > 1)
+            style.note = "1 pixel = " + std::to_string(k) + " x " + std::to_string(k) + " cells (" +
+                         (layerBlockReduce(which[i]) == BlockReduce::Mean ? "mean" : "max") + ")";
+        png.push_back(encodePreviewPng(rasters[i], style));
+    }
+    return png;
 }
 
 }  // namespace multibin

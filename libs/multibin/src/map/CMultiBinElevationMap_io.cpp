@@ -349,46 +349,72 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer,
                                                         const multibin::CellWindow& w) const {
+    return std::move(toRasters({layer}, w).front());
+}
+
+std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
+    const std::vector<RasterLayer>& layers, const multibin::CellWindow& w) const {
     fillIfLoaded();  // a loaded map's rasters hold its filled cells, as the writer's did
     const multibin::MapLock::Shared lock(m_impl->lock);
+    const multibin::BinGrid& grid = m_impl->grid;
     multibin::EsriAsciiGrid g =
-        multibin::EsriAsciiGrid::onLattice(multibin::Lattice{m_impl->grid.cellSize_m(), w});
+        multibin::EsriAsciiGrid::onLattice(multibin::Lattice{grid.cellSize_m(), w});
     const Eigen::Vector2d& o = m_impl->origin_m;  // the raster is in the pose frame
     g.xllcenter_m += o.x();
     g.yllcenter_m += o.y();
+    std::vector<multibin::EsriAsciiGrid> out(layers.size(), g);
+    // A cell without a bin in either grid and without a filled value is unknown: most cells of
+    // a sparse route's tiles, skipped without a query.
+    const multibin::fill::FillResult& f = m_impl->fill;
+    const multibin::CellWindow& fw = m_impl->fillWindow;
+    const bool withFill = insertionOptions.dem_return_filled && f.source.size() == fw.cellCount();
+    const auto mayBeKnown = [&](int ix, int iy) {
+        bool any = false;
+        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
+        if (!any && isDualGrid())
+            m_impl->local.forEachBin(m_impl->local.cellIndex(grid.cellCenter_m(ix)),
+                                     m_impl->local.cellIndex(grid.cellCenter_m(iy)),
+                                     [&](const multibin::Bin&) { any = true; });
+        return any ||
+               (withFill && fw.contains(ix, iy) && f.isFilled(f.index(ix - fw.ix0, iy - fw.iy0)));
+    };
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             const int ix = w.ix0 + c, iy = w.iy0 + r;
+            if (!mayBeKnown(ix, iy)) continue;
             double h, s;
-            const HeightSource src = cellElevation(o.x() + m_impl->grid.cellCenter_m(ix),
-                                                   o.y() + m_impl->grid.cellCenter_m(iy), h, s,
-                                                   insertionOptions.dem_return_filled);
+            const HeightSource src =
+                cellElevation(o.x() + grid.cellCenter_m(ix), o.y() + grid.cellCenter_m(iy), h, s,
+                              insertionOptions.dem_return_filled);
             if (src == HeightSource::Unknown) continue;
-            float& out = g.heights_m(r, c);
-            switch (layer) {
-                case RasterLayer::Height:
-                    out = float(h);
-                    break;
-                case RasterLayer::Sigma:
-                    out = float(s);
-                    break;
-                case RasterLayer::Source:
-                    out = float(static_cast<int>(src));
-                    break;
-                case RasterLayer::Certainty: {
-                    // The certainty of the surface the height layer reports (0 where filled).
-                    multibin::CellSurface c;
-                    out = src == HeightSource::Measured &&
-                                  multibin::surfaceAt(
-                                      m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
-                                      m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy),
-                                      binUpdateParams(), false, c)
-                              ? float(c.certainty)
-                              : 0.f;
-                } break;
+            for (size_t k = 0; k < layers.size(); k++) {
+                float& v = out[k].heights_m(r, c);
+                switch (layers[k]) {
+                    case RasterLayer::Height:
+                        v = float(h);
+                        break;
+                    case RasterLayer::Sigma:
+                        v = float(s);
+                        break;
+                    case RasterLayer::Source:
+                        v = float(static_cast<int>(src));
+                        break;
+                    case RasterLayer::Certainty: {
+                        // The certainty of the surface the height layer reports (0 where
+                        // filled).
+                        multibin::CellSurface cs;
+                        v = src == HeightSource::Measured &&
+                                    multibin::surfaceAt(
+                                        grid, isDualGrid() ? &m_impl->local : nullptr,
+                                        grid.cellCenter_m(ix), grid.cellCenter_m(iy),
+                                        binUpdateParams(), false, cs)
+                                ? float(cs.certainty)
+                                : 0.f;
+                    } break;
+                }
             }
         }
-    return g;
+    return out;
 }
 
 std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileCells) const {
@@ -481,12 +507,13 @@ void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
         }
         multibin::writeFileAtomically(filNamePrefix + "_height.tfw",
                                       multibin::geoTiffWorldFileText(height));
-        const multibin::CellWindow box = multibin::knownWindow(height, 5);
-        for (const L layer : {L::Height, L::Sigma, L::Source})
+        const std::vector<L> shown{L::Height, L::Sigma, L::Source};
+        const auto png =
+            multibin::layerPreviewPngs(multibin::tiledLayers(*this, shown, &height.tiles), shown,
+                                       multibin::knownWindow(height, 5));
+        for (size_t i = 0; i < shown.size(); i++)
             multibin::writeFileAtomically(
-                filNamePrefix + "_" + multibin::mapLayerName(layer) + ".png",
-                multibin::layerPreviewPng(multibin::tiledLayer(*this, layer, &height.tiles), layer,
-                                          box));
+                filNamePrefix + "_" + multibin::mapLayerName(shown[i]) + ".png", png[i]);
     }
     mrpt::opengl::COpenGLScene scene;
     auto obj = mrpt::opengl::CSetOfObjects::Create();

@@ -79,23 +79,19 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
     // Built relative to the map origin and placed at it, so the view's floats stay small at
     // georeferenced coordinates.
     const mrpt::math::TPoint2D origin = map.mapOrigin();
-    // Read tile by tile, one vertex per cell up to 2048 a side, else per block (its mean).
-    TiledRaster whole = tiledLayer(map, Layer::Height);
-    whole.originX_m = whole.originY_m = 0;
+    // Read tile by tile, one vertex per cell up to 2048 a side, else per block.
+    std::vector<TiledRaster> layers = tiledLayers(map, {Layer::Height, layerOf(colouring)});
+    for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
     auto placed = mrpt::opengl::CSetOfObjects::Create();
     placed->setName("map origin");
     placed->setLocation(origin.x, origin.y, 0);
     const bool atZero = origin.x == 0 && origin.y == 0;
     mrpt::opengl::CSetOfObjects& into = atZero ? out : *placed;
-    const CellWindow box = knownWindow(whole, 1);
-    const int k = blockFactorFor(box, kPreviewMaxSide_px);
-    const EsriAsciiGrid heights = blockReduced(whole, box, k, BlockReduce::Mean);
-    TiledRaster layer = tiledLayer(map, layerOf(colouring), &whole.tiles);
-    layer.originX_m = layer.originY_m = 0;
-    const EsriAsciiGrid values =
-        colouring == SceneColouring::Height
-            ? heights
-            : blockReduced(layer, box, k, layerBlockReduce(layerOf(colouring)));
+    const CellWindow box = knownWindow(layers[0], 1);
+    const std::vector<EsriAsciiGrid> blocks =
+        blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px),
+                     {BlockReduce::Mean, layerBlockReduce(layerOf(colouring))});
+    const EsriAsciiGrid &heights = blocks[0], &values = blocks[1];
     const int nx = heights.cols(), ny = heights.rows();
     if (nx < 2 || ny < 2) return;
 

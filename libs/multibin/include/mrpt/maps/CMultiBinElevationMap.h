@@ -331,6 +331,9 @@ public:
     /** The layer over any window of cells (cell indices of grid(): multibin/geometry/Lattice.h),
      * NaN where unknown: a large map's outputs read it tile by tile (occupiedTiles()). */
     multibin::EsriAsciiGrid toRaster(RasterLayer layer, const multibin::CellWindow& cells) const;
+    /** Several layers over a window, one query per cell: toRaster(layers[i], cells) each. */
+    std::vector<multibin::EsriAsciiGrid> toRasters(const std::vector<RasterLayer>& layers,
+                                                   const multibin::CellWindow& cells) const;
     /** The aligned windows of tileCells x tileCells cells of grid() (multibin::tileOfCell,
      * multibin/io/TiledRaster.h) that may hold a known cell (a bin of either grid, or a filled
      * cell), row by row from the south: where the data is, whatever the window's extent. */

@@ -18,9 +18,15 @@ using MapLayer = mrpt::maps::CMultiBinElevationMap::RasterLayer;
 /** "height", "sigma", "certainty" or "source". */
 const char* mapLayerName(MapLayer layer);
 
-/** A layer of `map` as a TiledRaster in the frame of the robot poses, over `tiles` (default:
- * the map's occupiedTiles(kGeoTiffTile)); its samples are read from the map when asked (the map
- * must outlive it and stay unchanged meanwhile). */
+/** Layers of `map` as TiledRasters in the frame of the robot poses, over `tiles` (default: the
+ * map's occupiedTiles(kGeoTiffTile)); samples are read from the map when asked (the map must
+ * outlive them and stay unchanged meanwhile). The rasters share the last window read: asked for
+ * the same window one after the other (a loop over tiles that reads every layer of a tile), the
+ * map answers all of them from one query per cell. Not for use from several threads. */
+std::vector<TiledRaster> tiledLayers(const mrpt::maps::CMultiBinElevationMap& map,
+                                     const std::vector<MapLayer>& layers,
+                                     const std::vector<CellWindow>* tiles = nullptr);
+/** One layer: tiledLayers(map, {layer}, tiles)[0]. */
 TiledRaster tiledLayer(const mrpt::maps::CMultiBinElevationMap& map, MapLayer layer,
                        const std::vector<CellWindow>* tiles = nullptr);
 
@@ -33,15 +39,16 @@ CellWindow knownWindow(const TiledRaster& height, int margin_cells);
 PreviewStyle layerPreviewStyle(MapLayer layer);
 BlockReduce layerBlockReduce(MapLayer layer);
 
-/** The layer over `window` as the preview raster: one sample per cell up to kPreviewMaxSide_px
- * cells a side, else per k x k block (layerBlockReduce()); `note` gets "1 pixel = k x k cells
- * (mean)" when k > 1. Built tile by tile. */
-EsriAsciiGrid previewRaster(const TiledRaster& layer, MapLayer which, const CellWindow& window,
-                            std::string* note);
+/** The layers over `window` as preview rasters, in one loop over the tiles: one sample per cell
+ * up to kPreviewMaxSide_px cells a side, else per k x k block (layerBlockReduce()). */
+std::vector<EsriAsciiGrid> previewRasters(const std::vector<TiledRaster>& layers,
+                                          const std::vector<MapLayer>& which,
+                                          const CellWindow& window);
 
-/** encodePreviewPng() of previewRaster(), titled and noted. Throws std::invalid_argument for an
- * empty window. */
-std::vector<uint8_t> layerPreviewPng(const TiledRaster& layer, MapLayer which,
-                                     const CellWindow& window);
+/** PNG previews (encodePreviewPng()) of previewRasters(), titled, and noted "1 pixel = k x k
+ * cells (mean)" when downsampled. Throws std::invalid_argument for an empty window. */
+std::vector<std::vector<uint8_t>> layerPreviewPngs(const std::vector<TiledRaster>& layers,
+                                                   const std::vector<MapLayer>& which,
+                                                   const CellWindow& window);
 
 }  // namespace multibin

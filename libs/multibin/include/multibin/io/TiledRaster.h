@@ -29,8 +29,9 @@ struct TiledRaster {
 
     /** The smallest window holding every tile (empty without tiles). */
     CellWindow tileBounds() const;
-    /** The bounding box of the known samples, read tile by tile (one tile in memory); empty
-     * (nx = ny = 0) when no sample is known. */
+    /** The bounding box of the known samples, read tile by tile (one tile in memory; from
+     * each side inwards, so mostly the tiles at the extremes); empty (nx = ny = 0) when no
+     * sample is known. */
     CellWindow knownCells() const;
     /** Centre of cell (ix, iy) [m, output frame]. */
     double cellCenterX_m(int ix) const { return originX_m + (ix + 0.5) * cellSize_m; }
@@ -51,6 +52,11 @@ enum class BlockReduce {
  * built tile by tile (one tile and the result in memory). factor 1 is the raster itself. */
 EsriAsciiGrid blockReduced(const TiledRaster& raster, const CellWindow& window, int factor,
                            BlockReduce how);
+/** The same for several rasters over the same tiles, in one loop over the tiles (each tile read
+ * from every raster in turn). */
+std::vector<EsriAsciiGrid> blockReduced(const std::vector<TiledRaster>& rasters,
+                                        const CellWindow& window, int factor,
+                                        const std::vector<BlockReduce>& how);
 
 /** The smallest block side (>= 1) that brings `window` within maxSide_px on its long side. */
 int blockFactorFor(const CellWindow& window, int maxSide_px);
