@@ -326,28 +326,31 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
     if (sel.gridmap) layers.requireDense("--outputs gridmap");
     // Each step writes one or more files; the bar counts steps.
     std::vector<std::pair<std::string, std::function<void()>>> steps;
-    multibin::GeoTiffOptions geo;
-    geo.epsg = sel.epsg;
-    const auto geoTiff = [&folder, &layers, geo](int layer) {
-        multibin::GeoTiffOptions o = geo;
-        o.description = multibin::layerPreviewStyle(kLayers[layer]).title;
-        folder.writeWith(std::string("elevation_") + kLayerNames[layer] + ".tif",
-                         [&](const std::string& path) {
-                             multibin::saveSparseGeoTiff(layers.tiled[layer], path, o);
-                             return true;
-                         });
-    };
     if (sel.map)
         steps.emplace_back("elevation_map.bin",
                            [&] { folder.write("elevation_map.bin", gzSerialized(map)); });
-    if (sel.tif)
-        steps.emplace_back("elevation_height.tif", [&] {
-            geoTiff(0);
-            folder.write("elevation_height.tfw", multibin::geoTiffWorldFileText(layers.tiled[0]));
-        });
-    if (sel.tifLayers)
-        steps.emplace_back("elevation_{sigma,certainty,source}.tif", [&] {
-            for (int i = 1; i < 4; i++) geoTiff(i);
+    if (sel.tif || sel.tifLayers)
+        steps.emplace_back("elevation_*.tif", [&] {
+            // Every GeoTIFF asked for in one loop over the tiles (one query per cell).
+            std::vector<Layer> chosen;
+            std::vector<std::string> names;
+            std::vector<multibin::GeoTiffOptions> options;
+            for (int i = 0; i < 4; i++)
+                if (i == 0 ? sel.tif : sel.tifLayers) {
+                    chosen.push_back(kLayers[i]);
+                    names.push_back(std::string("elevation_") + kLayerNames[i] + ".tif");
+                    options.emplace_back();
+                    options.back().epsg = sel.epsg;
+                    options.back().description = multibin::layerPreviewStyle(kLayers[i]).title;
+                }
+            multibin::writeSparseGeoTiffs(
+                multibin::tiledLayers(map, chosen, &layers.tiled[0].tiles), names, options,
+                [&](size_t k, const std::function<bool(const std::string&)>& write) {
+                    folder.writeWith(names[k], write);
+                });
+            if (sel.tif)
+                folder.write("elevation_height.tfw",
+                             multibin::geoTiffWorldFileText(layers.tiled[0]));
         });
     if (sel.scene)
         steps.emplace_back("elevation.3Dscene", [&] {

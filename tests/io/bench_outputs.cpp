@@ -17,47 +17,15 @@
 #include "multibin/geometry/Lattice.h"
 #include "multibin/io/GeoTiff.h"
 #include "multibin/io/MapLayerFiles.h"
+#include "multibin/io/OutputFile.h"
+#include "route_map.h"
 
 namespace fs = std::filesystem;
 using Map = mrpt::maps::CMultiBinElevationMap;
 
 namespace {
 
-constexpr double kCell_m = 0.05, kSwath_m = 4.0, kStep_m = 0.2;
-
-double ground_m(double x, double y) { return 0.1 * std::sin(0.7 * x) * std::cos(0.5 * y); }
-
-/** One frame: the swath across the route at distance s along it, two points a cell. */
-multibin::PointsWithCov frameAt(double s) {
-    multibin::PointsWithCov pts;
-    const double ux = std::sqrt(0.5), uy = ux;  // along the route; across: (-uy, ux)
-    for (double a = 0; a < kStep_m; a += 0.5 * kCell_m)
-        for (double c = -0.5 * kSwath_m; c < 0.5 * kSwath_m; c += 0.5 * kCell_m) {
-            const double x = (s + a) * ux - c * uy, y = (s + a) * uy + c * ux;
-            multibin::PointWithCov p;
-            p.point_m = Eigen::Vector3f(float(x), float(y), float(ground_m(x, y)));
-            p.cov_m2 = {1e-6f, 0, 0, 1e-6f, 0, 1e-4f};
-            pts.push_back(p);
-        }
-    return pts;
-}
-
-std::unique_ptr<Map> routeMap(double length_m, size_t* points = nullptr) {
-    auto map = std::make_unique<Map>();
-    map->creationOptions.resolution_m = kCell_m;
-    map->creationOptions.max_size_m = length_m + 20;  // the dense window until tiles land
-    map->setCreationOptions(map->creationOptions);
-    size_t n = 0;
-    for (double s = 0; s < length_m; s += kStep_m) {
-        const multibin::PointsWithCov pts = frameAt(s);
-        const Eigen::Vector3d sensor(s * std::sqrt(0.5), s * std::sqrt(0.5), 1.0);
-        map->growToCoverPoints(pts, sensor);
-        map->insertPoints(pts);
-        n += pts.size();
-    }
-    if (points) *points = n;
-    return map;
-}
+using route_map::routeMap;
 
 /** The map of each length, built once (after BM_Insert measured building it). */
 Map& cachedMap(double length_m) {
@@ -105,16 +73,20 @@ void BM_OccupiedTiles(benchmark::State& state) {
 void BM_GeoTiffFourLayers(benchmark::State& state) {
     const Map& map = cachedMap(double(state.range(0)));
     uintmax_t bytes = 0;
-    for (auto _ : state) {
-        bytes = 0;
-        const multibin::TiledRaster h = multibin::tiledLayer(map, multibin::MapLayer::Height);
-        for (const auto layer : {multibin::MapLayer::Height, multibin::MapLayer::Sigma,
-                                 multibin::MapLayer::Certainty, multibin::MapLayer::Source}) {
-            const fs::path f = scratch() / (std::string(multibin::mapLayerName(layer)) + ".tif");
-            multibin::saveSparseGeoTiff(multibin::tiledLayer(map, layer, &h.tiles), f.string(), {});
-            bytes += fs::file_size(f);
-        }
-    }
+    const std::vector<multibin::MapLayer> all{multibin::MapLayer::Height, multibin::MapLayer::Sigma,
+                                              multibin::MapLayer::Certainty,
+                                              multibin::MapLayer::Source};
+    std::vector<std::string> paths;
+    for (const auto layer : all)
+        paths.push_back(
+            (scratch() / (std::string(multibin::mapLayerName(layer)) + ".tif")).string());
+    for (auto _ : state)
+        multibin::writeSparseGeoTiffs(
+            multibin::tiledLayers(map, all), paths, std::vector<multibin::GeoTiffOptions>(4),
+            [&](size_t k, const std::function<bool(const std::string&)>& write) {
+                multibin::writeFileAtomically(paths[k], write);
+            });
+    for (const std::string& p : paths) bytes += fs::file_size(p);
     state.counters["bytes"] = double(bytes);
 }
 

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -77,39 +78,59 @@ void setTags(TIFF* tif, const TiledRaster& raster, const CellWindow& bounds,
     if (!GTIFWriteKeys(gtif.get())) fail(path, "libgeotiff could not write the geo keys");
 }
 
-/** Writes the file at `path` (a private temporary); returns the tiles written. */
-size_t writeTiles(const TiledRaster& raster, const std::string& path,
-                  const GeoTiffOptions& options) {
-    const CellWindow bounds = raster.tileBounds();
-    std::unique_ptr<TIFF, void (*)(TIFF*)> tif(XTIFFOpen(path.c_str(), "w"), XTIFFClose);
-    if (!tif) fail(path, "cannot open for writing");
-    setTags(tif.get(), raster, bounds, options, path);
+using TiffHandle = std::unique_ptr<TIFF, void (*)(TIFF*)>;
+
+/** Writes rasters[k] (all over the same tiles) to paths[k] (private temporaries) in one loop over
+ * the tiles, so rasters that share a tile read (tiledLayers()) query the map once; one tile of
+ * each in memory. Returns the tiles written of rasters[0]. */
+size_t writeTiles(const std::vector<TiledRaster>& rasters, const std::vector<std::string>& paths,
+                  const std::vector<GeoTiffOptions>& options) {
+    const CellWindow bounds = rasters.front().tileBounds();
+    std::vector<TiffHandle> tifs;
+    for (size_t k = 0; k < rasters.size(); k++) {
+        tifs.emplace_back(XTIFFOpen(paths[k].c_str(), "w"), XTIFFClose);
+        if (!tifs.back()) fail(paths[k], "cannot open for writing");
+        setTags(tifs.back().get(), rasters[k], bounds, options[k], paths[k]);
+    }
     // Tiles in file order (north to south, west to east): readers seek less.
-    std::vector<CellWindow> tiles = raster.tiles;
+    std::vector<CellWindow> tiles = rasters.front().tiles;
     std::sort(tiles.begin(), tiles.end(), [&](const CellWindow& a, const CellWindow& b) {
         const TilePlace pa = placeOf(a, bounds), pb = placeOf(b, bounds);
         return std::make_pair(pa.y_px, pa.x_px) < std::make_pair(pb.y_px, pb.x_px);
     });
     std::vector<float> buffer(size_t(kGeoTiffTile) * kGeoTiffTile);
     size_t written = 0;
-    for (const CellWindow& t : tiles) {
-        const EsriAsciiGrid g = raster.samples(t);
-        bool any = false;
-        for (int r = 0; r < kGeoTiffTile; r++)
-            for (int c = 0; c < kGeoTiffTile; c++) {
-                const float v = g.heights_m(r, c);
-                any = any || std::isfinite(v);
-                buffer[size_t(kGeoTiffTile - 1 - r) * kGeoTiffTile + size_t(c)] = v;  // north up
-            }
-        if (!any) continue;  // left sparse: nodata
-        const TilePlace p = placeOf(t, bounds);
-        const uint32_t k = TIFFComputeTile(tif.get(), p.x_px, p.y_px, 0, 0);
-        if (TIFFWriteEncodedTile(tif.get(), k, buffer.data(), tmsize_t(buffer.size() * 4)) < 0)
-            fail(path, "writing tile " + std::to_string(k) + " failed");
-        written++;
-    }
-    if (!TIFFWriteDirectory(tif.get())) fail(path, "writing the directory failed");
+    for (const CellWindow& t : tiles)
+        for (size_t k = 0; k < rasters.size(); k++) {
+            const EsriAsciiGrid g = rasters[k].samples(t);
+            bool any = false;
+            for (int r = 0; r < kGeoTiffTile; r++)
+                for (int c = 0; c < kGeoTiffTile; c++) {
+                    const float v = g.heights_m(r, c);
+                    any = any || std::isfinite(v);
+                    buffer[size_t(kGeoTiffTile - 1 - r) * kGeoTiffTile + size_t(c)] =
+                        v;  // north up
+                }
+            if (!any) continue;  // left sparse: nodata
+            const TilePlace p = placeOf(t, bounds);
+            TIFF* tif = tifs[k].get();
+            const uint32_t i = TIFFComputeTile(tif, p.x_px, p.y_px, 0, 0);
+            if (TIFFWriteEncodedTile(tif, i, buffer.data(), tmsize_t(buffer.size() * 4)) < 0)
+                fail(paths[k], "writing tile " + std::to_string(i) + " failed");
+            written += k == 0;
+        }
+    for (size_t k = 0; k < rasters.size(); k++)
+        if (!TIFFWriteDirectory(tifs[k].get())) fail(paths[k], "writing the directory failed");
     return written;
+}
+
+void checkWritable(const TiledRaster& raster, const std::string& path,
+                   const GeoTiffOptions& options) {
+    checkGeoTiffEpsg(options.epsg, "GeoTIFF '" + path + "': EPSG");
+    if (raster.tileCells != kGeoTiffTile)
+        fail(path, "tiles of " + std::to_string(raster.tileCells) + " cells, the file's are " +
+                       std::to_string(kGeoTiffTile));
+    if (raster.tiles.empty()) fail(path, "the raster has no known sample");
 }
 
 }  // namespace
@@ -126,19 +147,42 @@ void checkGeoTiffEpsg(int epsg, const std::string& what) {
             "CRS, e.g. a UTM zone (EPSG 326ZZ north, 327ZZ south)");
 }
 
+size_t writeSparseGeoTiffs(const std::vector<TiledRaster>& rasters,
+                           const std::vector<std::string>& names,
+                           const std::vector<GeoTiffOptions>& options, const CommitFile& commit) {
+    if (rasters.empty() || names.size() != rasters.size() || options.size() != rasters.size())
+        throw std::invalid_argument("writeSparseGeoTiffs: one name and one options per raster");
+    for (size_t k = 0; k < rasters.size(); k++) {
+        checkWritable(rasters[k], names[k], options[k]);  // errors name the file, before any exists
+        if (!(rasters[k].tiles == rasters[0].tiles) ||
+            rasters[k].cellSize_m != rasters[0].cellSize_m)
+            fail(names[k], "its tiles differ from those of '" + names[0] + "'");
+    }
+    // Each file is committed by its own writer; the innermost writes them all at once, and each
+    // is closed before its writer returns.
+    std::vector<std::string> temporaries(rasters.size());
+    size_t written = 0;
+    std::function<void(size_t)> open = [&](size_t k) {
+        if (k == rasters.size()) {
+            written = writeTiles(rasters, temporaries, options);
+            return;
+        }
+        commit(k, [&, k](const std::string& temporary) {
+            temporaries[k] = temporary;
+            open(k + 1);
+            return true;
+        });
+    };
+    open(0);
+    return written;
+}
+
 size_t saveSparseGeoTiff(const TiledRaster& raster, const std::string& path,
                          const GeoTiffOptions& options) {
-    checkGeoTiffEpsg(options.epsg, "GeoTIFF '" + path + "': EPSG");
-    if (raster.tileCells != kGeoTiffTile)
-        fail(path, "tiles of " + std::to_string(raster.tileCells) + " cells, the file's are " +
-                       std::to_string(kGeoTiffTile));
-    if (raster.tiles.empty()) fail(path, "the raster has no known sample");
-    size_t written = 0;
-    writeFileAtomically(path, [&](const std::string& temporary) {
-        written = writeTiles(raster, temporary, options);
-        return true;
-    });
-    return written;
+    return writeSparseGeoTiffs({raster}, {path}, {options},
+                               [&](size_t, const std::function<bool(const std::string&)>& write) {
+                                   writeFileAtomically(path, write);
+                               });
 }
 
 std::string geoTiffWorldFileText(const TiledRaster& raster) {

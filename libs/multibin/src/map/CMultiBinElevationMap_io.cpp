@@ -498,13 +498,18 @@ void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     using L = RasterLayer;
     const multibin::TiledRaster height = multibin::tiledLayer(*this, L::Height);
     if (!height.tiles.empty()) {
-        for (const L layer : {L::Height, L::Sigma, L::Certainty, L::Source}) {
-            const std::string path = filNamePrefix + "_" + multibin::mapLayerName(layer) + ".tif";
-            multibin::GeoTiffOptions options;
-            options.description = multibin::layerPreviewStyle(layer).title;
-            multibin::saveSparseGeoTiff(multibin::tiledLayer(*this, layer, &height.tiles), path,
-                                        options);
+        const std::vector<L> all{L::Height, L::Sigma, L::Certainty, L::Source};
+        std::vector<std::string> paths;
+        std::vector<multibin::GeoTiffOptions> options(all.size());
+        for (size_t i = 0; i < all.size(); i++) {
+            paths.push_back(filNamePrefix + "_" + multibin::mapLayerName(all[i]) + ".tif");
+            options[i].description = multibin::layerPreviewStyle(all[i]).title;
         }
+        multibin::writeSparseGeoTiffs(
+            multibin::tiledLayers(*this, all, &height.tiles), paths, options,
+            [&](size_t k, const std::function<bool(const std::string&)>& write) {
+                multibin::writeFileAtomically(paths[k], write);
+            });
         multibin::writeFileAtomically(filNamePrefix + "_height.tfw",
                                       multibin::geoTiffWorldFileText(height));
         const std::vector<L> shown{L::Height, L::Sigma, L::Source};

@@ -89,9 +89,9 @@ namespace mrpt::maps {
  * [map]
  * multiBinElevationMap_count = 1
  * [map_multiBinElevationMap_00_creationOpts]
- * resolution = 0.02      ; all keys optional
+ * resolution_m = 0.02      ; all keys optional (doc/options.md)
  * [map_multiBinElevationMap_00_insertOpts]
- * max_elevation_uncertainty = 0.1
+ * max_elevation_uncertainty_m = 0.1
  * \endcode
  * Unknown keys and malformed values are errors that name the section and the key.
  *

@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <string>
+#include <vector>
 
 #include "multibin/io/TiledRaster.h"
 
@@ -32,6 +34,17 @@ void checkGeoTiffEpsg(int epsg, const std::string& what);
  * writeFileAtomically(); errors name `path`. Returns the number of tiles written. */
 size_t saveSparseGeoTiff(const TiledRaster& raster, const std::string& path,
                          const GeoTiffOptions& options);
+/** Commits file k: calls write(temporaryPath), which fills that file, then puts it in place
+ * (writeFileAtomically(path, write), OutputFolder::writeWith(name, write)). */
+using CommitFile =
+    std::function<void(size_t k, const std::function<bool(const std::string& temporary)>& write)>;
+
+/** saveSparseGeoTiff() of several rasters over the same tiles (tiledLayers()), in one loop over
+ * the tiles: each tile is read once for all files. names[k] names file k in errors; commit puts
+ * each in place. Returns the tiles written of rasters[0]. */
+size_t writeSparseGeoTiffs(const std::vector<TiledRaster>& rasters,
+                           const std::vector<std::string>& names,
+                           const std::vector<GeoTiffOptions>& options, const CommitFile& commit);
 
 /** The ESRI world file (.tfw) of saveSparseGeoTiff()'s image: the same placement, for programs
  * that read world files and not GeoTIFF tags. */
