@@ -55,7 +55,6 @@ const Group kGroups[] = {
      " and elevation_untraversable.png"},
 };
 
-const char* const kLayerNames[] = {"height", "sigma", "certainty", "source"};
 using Layer = CMultiBinElevationMap::RasterLayer;
 const Layer kLayers[] = {Layer::Height, Layer::Sigma, Layer::Certainty, Layer::Source};
 /** The traversability layers `asc` writes (doc/traversability.md), in TraversabilityLayer order. */
@@ -154,7 +153,8 @@ std::vector<std::string> OutputSelection::fileNames() const {
         for (const char* l : {"height", "sigma", "source"})
             f.push_back(std::string("elevation_") + l + ".png");
     if (asc)
-        for (const char* l : kLayerNames) f.push_back(std::string("elevation_") + l + ".asc");
+        for (const Layer l : kLayers)
+            f.push_back(std::string("elevation_") + multibin::mapLayerName(l) + ".asc");
     if (asc)
         for (const char* l : kTraversabilityNames)
             f.push_back(std::string("elevation_") + l + ".asc");
@@ -253,7 +253,7 @@ void MapLayers::requireDense(const std::string& output) const {
 
 const multibin::EsriAsciiGrid& MapLayers::dense(int i) const {
     if (!m_computed[i]) {
-        requireDense(std::string("the ") + kLayerNames[i] + " raster");
+        requireDense(std::string("the ") + multibin::mapLayerName(kLayers[i]) + " raster");
         m_dense[i] = m_map->toRaster(kLayers[i], cells);
         m_computed[i] = true;
     }
@@ -263,7 +263,7 @@ const multibin::EsriAsciiGrid& MapLayers::dense(int i) const {
 void MapLayers::saveAsc(const OutputFolder& folder) const {
     requireDense("--outputs asc");
     for (int i = 0; i < 4; i++)
-        folder.writeWith(std::string("elevation_") + kLayerNames[i] + ".asc",
+        folder.writeWith(std::string("elevation_") + multibin::mapLayerName(kLayers[i]) + ".asc",
                          [&](const std::string& path) {
                              dense(i).save(path);
                              return true;
@@ -338,7 +338,8 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
             for (int i = 0; i < 4; i++)
                 if (i == 0 ? sel.tif : sel.tifLayers) {
                     chosen.push_back(kLayers[i]);
-                    names.push_back(std::string("elevation_") + kLayerNames[i] + ".tif");
+                    names.push_back(std::string("elevation_") + multibin::mapLayerName(kLayers[i]) +
+                                    ".tif");
                     options.emplace_back();
                     options.back().epsg = sel.epsg;
                     options.back().description = multibin::layerPreviewStyle(kLayers[i]).title;

@@ -1,7 +1,7 @@
 /* Part of the multibin elevation-mapping library.
  *
  * elevation-mapper: builds a CMultiBinElevationMap from a rawlog or a simplemap and writes the
- * outputs chosen with --outputs (serialized map, float TIFF, .3Dscene, PNG previews; ESRI ASCII
+ * outputs chosen with --outputs (serialized map, GeoTIFF, .3Dscene, PNG previews; ESRI ASCII
  * rasters and a PLY mesh on request); with --ground-truth it also evaluates the map side by side
  * with its baselines and MRPT's height maps (report.json and figures). `--help` lists the options.
  *
