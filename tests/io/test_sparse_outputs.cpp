@@ -359,3 +359,25 @@ TEST(SparseMapOutputs, FilesGrowWithThePatchesNotTheirBoundingBox) {
              {10.5, 5}, {-0.5, 5}, {d / 2, d / 2}, {d - 0.5, d + 5}})
         EXPECT_TRUE(std::isnan(t.atPoint(x, y))) << x << " " << y;
 }
+
+// getAsImage() of a window longer than 4096 cells: one pixel per 2 x 2 block, both ends drawn.
+TEST(SparseMapOutputs, GetAsImageOfALongWindowIsDownsampled) {
+    Map map;
+    map.creationOptions.resolution_m = 1.0;
+    map.creationOptions.max_size_m = 6000;
+    map.setCreationOptions(map.creationOptions);
+    for (const double x : {0.5, 5000.5}) map.insertIndividualPoint(x, 0.5, 0.25);
+    ASSERT_GT(map.dem_get_size_x(), 4096u);
+    mrpt::img::CImage img;
+    map.getAsImage(img);
+    EXPECT_EQ(img.getWidth(), (map.dem_get_size_x() + 1) / 2);
+    EXPECT_EQ(img.getHeight(), (map.dem_get_size_y() + 1) / 2);
+    // The two known cells' blocks are coloured, the rest black.
+    size_t coloured = 0;
+    for (size_t y = 0; y < img.getHeight(); y++)
+        for (size_t x = 0; x < img.getWidth(); x++) {
+            const auto* p = img.ptr<uint8_t>(int(x), int(y));
+            coloured += (p[0] | p[1] | p[2]) != 0;
+        }
+    EXPECT_EQ(coloured, 2u);
+}
