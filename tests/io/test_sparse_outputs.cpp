@@ -53,6 +53,7 @@ struct ReadTiff {
     std::vector<double> pixelScale, tiepoint;
     std::string nodata;
     int epsg = 0;  //!< ProjectedCSTypeGeoKey, 0 if absent
+    int directories = 0;
     std::map<uint32_t, std::vector<float>> tiles;
 
     explicit ReadTiff(const fs::path& path) {
@@ -64,6 +65,7 @@ struct ReadTiff {
         std::unique_ptr<TIFF, void (*)(TIFF*)> tif(XTIFFOpen(path.c_str(), "r"), XTIFFClose);
         if (!tif) throw std::runtime_error("cannot open " + path.string());
         TIFF* t = tif.get();
+        directories = TIFFNumberOfDirectories(t);
         TIFFGetField(t, TIFFTAG_IMAGEWIDTH, &width);
         TIFFGetField(t, TIFFTAG_IMAGELENGTH, &height);
         TIFFGetField(t, TIFFTAG_TILEWIDTH, &tileWidth);
@@ -184,6 +186,7 @@ TEST(SparseGeoTiff, ALongDiagonalStripReadsBackWithOnlyItsTiles) {
     EXPECT_EQ(t.bits, 32);
     EXPECT_EQ(t.nodata, "nan");
     EXPECT_EQ(t.epsg, 0);
+    EXPECT_EQ(t.directories, 1);  // one image, no empty second directory
     // Of the box's tiles only the strip's hold bytes: about 3 per 256 cells of route.
     const size_t withBytes = size_t(
         std::count_if(t.byteCounts.begin(), t.byteCounts.end(), [](uint64_t n) { return n > 0; }));
