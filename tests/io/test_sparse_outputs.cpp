@@ -52,7 +52,7 @@ struct ReadTiff {
     std::vector<uint64_t> byteCounts;  //!< per tile; 0 for a tile left out
     std::vector<double> pixelScale, tiepoint;
     std::string nodata;
-    int epsg = 0;  //!< ProjectedCSTypeGeoKey, 0 if absent
+    int epsg = 0;  //!< ProjectedCSTypeGeoKey (KvUserDefined: a local frame), 0 if absent
     int directories = 0;
     std::map<uint32_t, std::vector<float>> tiles;
 
@@ -185,8 +185,8 @@ TEST(SparseGeoTiff, ALongDiagonalStripReadsBackWithOnlyItsTiles) {
     EXPECT_EQ(t.sampleFormat, SAMPLEFORMAT_IEEEFP);
     EXPECT_EQ(t.bits, 32);
     EXPECT_EQ(t.nodata, "nan");
-    EXPECT_EQ(t.epsg, 0);
-    EXPECT_EQ(t.directories, 1);  // one image, no empty second directory
+    EXPECT_EQ(t.epsg, KvUserDefined);  // no CRS: a local frame in metres
+    EXPECT_EQ(t.directories, 1);       // one image, no empty second directory
     // Of the box's tiles only the strip's hold bytes: about 3 per 256 cells of route.
     const size_t withBytes = size_t(
         std::count_if(t.byteCounts.begin(), t.byteCounts.end(), [](uint64_t n) { return n > 0; }));

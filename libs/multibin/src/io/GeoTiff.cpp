@@ -74,6 +74,10 @@ void setTags(TIFF* tif, const TiledRaster& raster, const CellWindow& bounds,
     if (options.epsg > 0) {
         GTIFKeySet(gtif.get(), GTModelTypeGeoKey, TYPE_SHORT, 1, ModelTypeProjected);
         GTIFKeySet(gtif.get(), ProjectedCSTypeGeoKey, TYPE_SHORT, 1, options.epsg);
+    } else {  // a user-defined projected frame in metres: GDAL reads a local CRS in metres
+        GTIFKeySet(gtif.get(), GTModelTypeGeoKey, TYPE_SHORT, 1, ModelTypeProjected);
+        GTIFKeySet(gtif.get(), ProjectedCSTypeGeoKey, TYPE_SHORT, 1, KvUserDefined);
+        GTIFKeySet(gtif.get(), ProjLinearUnitsGeoKey, TYPE_SHORT, 1, Linear_Meter);
     }
     if (!GTIFWriteKeys(gtif.get())) fail(path, "libgeotiff could not write the geo keys");
 }

@@ -13,7 +13,7 @@ namespace multibin {
 /** What saveSparseGeoTiff() writes besides the samples. */
 struct GeoTiffOptions {
     /** EPSG code of the projected CRS (metres) the output frame is in, e.g. 32633 for UTM zone
-     * 33N; 0: none (the file is placed in the map frame, with no CRS). */
+     * 33N; 0: none (a user-defined frame in metres: GDAL reads a local CRS). */
     int epsg = 0;
     std::string description;  //!< TIFF ImageDescription, e.g. "height [m]"
 };
@@ -28,8 +28,8 @@ void checkGeoTiffEpsg(int epsg, const std::string& what);
 /** Writes `raster` (tileCells must be kGeoTiffTile) as a single-band float32 GeoTIFF over its
  * tileBounds(): north up, 256 x 256 tiles, DEFLATE with the floating-point predictor, NaN as
  * nodata (GDAL_NODATA tag), placed by ModelPixelScale and ModelTiepoint (pixel-is-area) in the
- * raster's frame, ProjectedCSTypeGeoKey when options.epsg is set. Only the tiles of
- * raster.tiles that hold a known sample are written; the others keep offset and byte count 0,
+ * raster's frame, ProjectedCSTypeGeoKey options.epsg (or user-defined, in metres). Only the tiles
+ * of raster.tiles that hold a known sample are written; the others keep offset and byte count 0,
  * which GDAL reads as nodata (its SPARSE_OK convention). Memory: one tile. Written through
  * writeFileAtomically(); errors name `path`. Returns the number of tiles written. */
 size_t saveSparseGeoTiff(const TiledRaster& raster, const std::string& path,
