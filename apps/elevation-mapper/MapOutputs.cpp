@@ -20,6 +20,8 @@
 
 #include "ProgressBar.h"
 #include "multibin/io/ErrorMessage.h"
+#include "multibin/io/MapLayerFiles.h"
+#include "multibin/io/NumberText.h"
 #include "multibin/io/OutputFile.h"
 #include "multibin/io/RasterExport.h"
 
@@ -36,18 +38,25 @@ struct Group {
 const Group kGroups[] = {
     {"map", &OutputSelection::map, "elevation_map.bin (the serialized map, gz)"},
     {"tif", &OutputSelection::tif,
-     "elevation_height.tif + .tfw (float32 heights [m], NaN unknown, world file)"},
+     "elevation_height.tif + .tfw (GeoTIFF: float32 heights [m], NaN unknown, tiled,\n"
+     "        compressed, only the tiles with data; world file)"},
+    {"tif-layers", &OutputSelection::tifLayers,
+     "elevation_{sigma,certainty,source}.tif (the other layers as GeoTIFF)"},
     {"scene", &OutputSelection::scene, "elevation.3Dscene (3D view, opens in SceneViewer3D)"},
     {"png", &OutputSelection::png,
-     "elevation_{height,sigma,source}.png (previews: axes [m], scale, legend)"},
-    {"asc", &OutputSelection::asc, "elevation_{height,sigma,certainty,source}.asc (ESRI ASCII)"},
-    {"ply", &OutputSelection::ply, "elevation.ply (triangle mesh [m])"},
+     "elevation_{height,sigma,source}.png (previews: axes [m], scale, legend;\n"
+     "        downsampled beyond 2048 cells a side)"},
+    {"asc", &OutputSelection::asc,
+     "elevation_{height,sigma,certainty,source}.asc (ESRI ASCII; dense: up to 4096 x 4096\n"
+     "        known cells)"},
+    {"ply", &OutputSelection::ply, "elevation.ply (triangle mesh [m]; up to 4096 x 4096 cells)"},
     {"gridmap", &OutputSelection::gridmap,
      "elevation_traversability.gridmap.gz (MRPT occupancy grid: P(untraversable), unknown 0.5)"
      " and elevation_untraversable.png"},
 };
 
-const char* const kLayerNames[] = {"height", "sigma", "certainty", "source"};
+using Layer = CMultiBinElevationMap::RasterLayer;
+const Layer kLayers[] = {Layer::Height, Layer::Sigma, Layer::Certainty, Layer::Source};
 /** The traversability layers `asc` writes (doc/traversability.md), in TraversabilityLayer order. */
 const char* const kTraversabilityNames[] = {"untraversable", "step", "slope", "roughness",
                                             "foothold"};
@@ -123,16 +132,29 @@ OutputSelection OutputSelection::parse(const std::string& list) {
     return sel;
 }
 
+int OutputSelection::parseEpsg(const std::string& text) {
+    if (text.empty()) return 0;
+    double v = 0;
+    if (!multibin::parseFiniteNumber(text, v) || v != std::floor(v) || std::abs(v) > 1e6)
+        throw std::invalid_argument("--epsg: '" + text + "' is not an EPSG code");
+    multibin::checkGeoTiffEpsg(int(v), "--epsg");
+    return int(v);
+}
+
 std::vector<std::string> OutputSelection::fileNames() const {
     std::vector<std::string> f;
     if (map) f.push_back("elevation_map.bin");
     if (tif) f.insert(f.end(), {"elevation_height.tif", "elevation_height.tfw"});
+    if (tifLayers)
+        for (const char* l : {"sigma", "certainty", "source"})
+            f.push_back(std::string("elevation_") + l + ".tif");
     if (scene) f.push_back("elevation.3Dscene");
     if (png)
         for (const char* l : {"height", "sigma", "source"})
             f.push_back(std::string("elevation_") + l + ".png");
     if (asc)
-        for (const char* l : kLayerNames) f.push_back(std::string("elevation_") + l + ".asc");
+        for (const Layer l : kLayers)
+            f.push_back(std::string("elevation_") + multibin::mapLayerName(l) + ".asc");
     if (asc)
         for (const char* l : kTraversabilityNames)
             f.push_back(std::string("elevation_") + l + ".asc");
@@ -213,31 +235,46 @@ void OutputFolder::moveIn(const std::string& name, const std::string& file) cons
 }
 
 MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
-    using L = CMultiBinElevationMap::RasterLayer;
     MapLayers m;
-    m.height = map.toRaster(L::Height);
-    const multibin::RasterBox box = multibin::knownBox(m.height, kMargin_cells);
-    m.height = multibin::cropRaster(m.height, box);
-    m.sigma = multibin::cropRaster(map.toRaster(L::Sigma), box);
-    m.certainty = multibin::cropRaster(map.toRaster(L::Certainty), box);
-    m.source = multibin::cropRaster(map.toRaster(L::Source), box);
+    m.m_map = &map;
+    m.tiled[0] = multibin::tiledLayer(map, Layer::Height);
+    for (int i = 1; i < 4; i++)
+        m.tiled[i] = multibin::tiledLayer(map, kLayers[i], &m.tiled[0].tiles);
+    m.cells = multibin::knownWindow(m.tiled[0], kMargin_cells);
     return m;
 }
 
+void MapLayers::requireDense(const std::string& output) const {
+    if (cells.nx == 0) throw std::invalid_argument(output + ": the map knows no cell");
+    multibin::checkDenseOutputFits(cells, tiled[0].cellSize_m, output,
+                                   "choose --outputs tif,tif-layers,png (GeoTIFF and previews "
+                                   "read tile by tile, any size)");
+}
+
+const multibin::EsriAsciiGrid& MapLayers::dense(int i) const {
+    if (!m_computed[i]) {
+        requireDense(std::string("the ") + multibin::mapLayerName(kLayers[i]) + " raster");
+        m_dense[i] = m_map->toRaster(kLayers[i], cells);
+        m_computed[i] = true;
+    }
+    return m_dense[i];
+}
+
 void MapLayers::saveAsc(const OutputFolder& folder) const {
-    const multibin::EsriAsciiGrid* grids[] = {&height, &sigma, &certainty, &source};
+    requireDense("--outputs asc");
     for (int i = 0; i < 4; i++)
-        folder.writeWith(std::string("elevation_") + kLayerNames[i] + ".asc",
+        folder.writeWith(std::string("elevation_") + multibin::mapLayerName(kLayers[i]) + ".asc",
                          [&](const std::string& path) {
-                             grids[i]->save(path);
+                             dense(i).save(path);
                              return true;
                          });
 }
 
 SupersampledLayers SupersampledLayers::of(const CMultiBinElevationMap& map, const MapLayers& layers,
                                           double cell_m) {
+    layers.requireDense("--export-resolution");
     SupersampledLayers out;
-    const multibin::EsriAsciiGrid& box = layers.height;
+    const multibin::EsriAsciiGrid& box = layers.dense(0);
     // The same area as the map-resolution rasters: their cells' outer edges.
     const double x0 = box.xllcenter_m - 0.5 * box.cellsize_m;
     const double y0 = box.yllcenter_m - 0.5 * box.cellsize_m;
@@ -283,15 +320,38 @@ void SupersampledLayers::saveAsc(const OutputFolder& folder) const {
 
 std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const MapLayers& layers,
                                          const OutputSelection& sel, const OutputFolder& folder) {
+    // The dense outputs refuse a long route's box before any file is written.
+    if (sel.asc) layers.requireDense("--outputs asc");
+    if (sel.ply) layers.requireDense("--outputs ply");
+    if (sel.gridmap) layers.requireDense("--outputs gridmap");
     // Each step writes one or more files; the bar counts steps.
     std::vector<std::pair<std::string, std::function<void()>>> steps;
     if (sel.map)
         steps.emplace_back("elevation_map.bin",
                            [&] { folder.write("elevation_map.bin", gzSerialized(map)); });
-    if (sel.tif)
-        steps.emplace_back("elevation_height.tif", [&] {
-            folder.write("elevation_height.tif", multibin::encodeFloatTiff(layers.height));
-            folder.write("elevation_height.tfw", multibin::worldFileText(layers.height));
+    if (sel.tif || sel.tifLayers)
+        steps.emplace_back("elevation_*.tif", [&] {
+            // Every GeoTIFF asked for in one loop over the tiles (one query per cell).
+            std::vector<Layer> chosen;
+            std::vector<std::string> names;
+            std::vector<multibin::GeoTiffOptions> options;
+            for (int i = 0; i < 4; i++)
+                if (i == 0 ? sel.tif : sel.tifLayers) {
+                    chosen.push_back(kLayers[i]);
+                    names.push_back(std::string("elevation_") + multibin::mapLayerName(kLayers[i]) +
+                                    ".tif");
+                    options.emplace_back();
+                    options.back().epsg = sel.epsg;
+                    options.back().description = multibin::layerPreviewStyle(kLayers[i]).title;
+                }
+            multibin::writeSparseGeoTiffs(
+                multibin::tiledLayers(map, chosen, &layers.tiled[0].tiles), names, options,
+                [&](size_t k, const std::function<bool(const std::string&)>& write) {
+                    folder.writeWith(names[k], write);
+                });
+            if (sel.tif)
+                folder.write("elevation_height.tfw",
+                             multibin::geoTiffWorldFileText(layers.tiled[0]));
         });
     if (sel.scene)
         steps.emplace_back("elevation.3Dscene", [&] {
@@ -300,44 +360,34 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
             multibin::buildTerrainView(map, sel.sceneColouring, *obj);
             scene.insert(obj);
             // The first view: the whole map from above at an angle.
-            const auto& h = layers.height;
+            const multibin::TiledRaster& h = layers.tiled[0];
+            const multibin::CellWindow& w = layers.cells;
             auto& camera = scene.getViewport("main")->getCamera();
-            camera.setPointingAt(0.5 * (h.xllcenter_m + h.xMax_m()),
-                                 0.5 * (h.yllcenter_m + h.yMax_m()), 0.0);
+            camera.setPointingAt(0.5 * (h.cellCenterX_m(w.ix0) + h.cellCenterX_m(w.ix0 + w.nx - 1)),
+                                 0.5 * (h.cellCenterY_m(w.iy0) + h.cellCenterY_m(w.iy0 + w.ny - 1)),
+                                 0.0);
             camera.setZoomDistance(
-                1.2 * std::max({h.xMax_m() - h.xllcenter_m, h.yMax_m() - h.yllcenter_m, 1.0}));
+                1.2 * std::max({(w.nx - 1) * h.cellSize_m, (w.ny - 1) * h.cellSize_m, 1.0}));
             camera.setAzimuthDegrees(-60);
             camera.setElevationDegrees(45);
             folder.write("elevation.3Dscene", gzSerialized(scene));
         });
-    if (sel.png) {
-        multibin::PreviewStyle h;
-        h.title = "height [m]";
-        h.colormap = cv::COLORMAP_VIRIDIS;
-        steps.emplace_back("elevation_height.png", [&folder, &layers, h] {
-            folder.write("elevation_height.png", multibin::encodePreviewPng(layers.height, h));
+    if (sel.png)
+        steps.emplace_back("elevation_{height,sigma,source}.png", [&] {
+            const std::vector<Layer> shown{Layer::Height, Layer::Sigma, Layer::Source};
+            const auto png = multibin::layerPreviewPngs(
+                multibin::tiledLayers(map, shown, &layers.tiled[0].tiles), shown, layers.cells);
+            for (size_t i = 0; i < shown.size(); i++)
+                folder.write(std::string("elevation_") + multibin::mapLayerName(shown[i]) + ".png",
+                             png[i]);
         });
-        multibin::PreviewStyle s;
-        s.title = "sigma [m]";
-        s.colormap = cv::COLORMAP_INFERNO;
-        s.valueFormat = "%.4f";
-        steps.emplace_back("elevation_sigma.png", [&folder, &layers, s] {
-            folder.write("elevation_sigma.png", multibin::encodePreviewPng(layers.sigma, s));
-        });
-        multibin::PreviewStyle src;
-        src.title = "source of the height";
-        src.categories = multibin::heightSourceCategories();
-        steps.emplace_back("elevation_source.png", [&folder, &layers, src] {
-            folder.write("elevation_source.png", multibin::encodePreviewPng(layers.source, src));
-        });
-    }
     if (sel.asc) steps.emplace_back("elevation_*.asc", [&] { layers.saveAsc(folder); });
     if (sel.asc)
         steps.emplace_back("traversability *.asc", [&] {
             for (int i = 0; i < 5; i++)
                 folder.writeWith(std::string("elevation_") + kTraversabilityNames[i] + ".asc",
                                  [&](const std::string& path) {
-                                     traversabilityLike(map, i, layers.height).save(path);
+                                     traversabilityLike(map, i, layers.dense(0)).save(path);
                                      return true;
                                  });
         });
@@ -350,12 +400,13 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
             u.title = "P(untraversable)";
             u.colormap = cv::COLORMAP_INFERNO;
             u.valueFormat = "%.2f";
-            folder.write("elevation_untraversable.png",
-                         multibin::encodePreviewPng(traversabilityLike(map, 0, layers.height), u));
+            folder.write(
+                "elevation_untraversable.png",
+                multibin::encodePreviewPng(traversabilityLike(map, 0, layers.dense(0)), u));
         });
     if (sel.ply)
         steps.emplace_back("elevation.ply", [&] {
-            folder.write("elevation.ply", multibin::meshPlyText(layers.height));
+            folder.write("elevation.ply", multibin::meshPlyText(layers.dense(0)));
         });
 
     ProgressBar bar("writing");

@@ -11,12 +11,17 @@
 #include <vector>
 
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/io/TiledRaster.h"
 #include "multibin/map/TerrainView.h"
 
 /** What elevation-mapper writes (--outputs): a comma-separated list of groups. */
 struct OutputSelection {
-    bool map = true;    //!< elevation_map.bin: the serialized map (gz)
-    bool tif = true;    //!< elevation_height.tif + .tfw: float32 heights [m] with a world file
+    bool map = true;  //!< elevation_map.bin: the serialized map (gz)
+    /** elevation_height.tif + .tfw: float32 GeoTIFF of the heights [m], tiled, compressed,
+     * only the tiles with data (doc/user-guide.md), with a world file */
+    bool tif = true;
+    /** elevation_{sigma,certainty,source}.tif: the other layers as the same GeoTIFF */
+    bool tifLayers = false;
     bool scene = true;  //!< elevation.3Dscene: the 3D view (SceneViewer3D)
     bool png = true;    //!< elevation_{height,sigma,source}.png: previews with legends
     bool asc = false;   //!< elevation_{height,sigma,certainty,source}.asc: ESRI ASCII rasters
@@ -24,6 +29,9 @@ struct OutputSelection {
     /** elevation_traversability.gridmap.gz: MRPT COccupancyGridMap2D, occupancy =
      * P(untraversable), unknown 0.5; and elevation_untraversable.png */
     bool gridmap = false;
+    /** EPSG code of the projected CRS of the robot poses (--epsg), written into the GeoTIFFs;
+     * 0: none. */
+    int epsg = 0;
     /** What colours the scene (--scene-colour). */
     multibin::SceneColouring sceneColouring = multibin::SceneColouring::Height;
 
@@ -32,6 +40,8 @@ struct OutputSelection {
     static std::string help();
     /** Parses "map,tif,asc" or "all"; throws std::invalid_argument naming an unknown group. */
     static OutputSelection parse(const std::string& list);
+    /** Parses --epsg: empty for none, else a projected CRS's code (checkGeoTiffEpsg()). */
+    static int parseEpsg(const std::string& text);
     /** The file names the selection writes. */
     std::vector<std::string> fileNames() const;
 };
@@ -64,14 +74,27 @@ private:
     std::vector<std::pair<std::string, std::string>> m_inputs;
 };
 
-/** The map's layers as rasters over the known area: the bounding box of its known cells plus
- * a margin, the same box for every layer. Empty rasters for a map with no known cell. */
+/** The map's layers, read tile by tile (multibin::TiledRaster over the map's occupied tiles),
+ * and the area of the previews and dense outputs: the bounding box of its known cells plus a
+ * margin. The dense rasters over that box (ESRI ASCII, PLY, the figures) are computed on first
+ * use, and only when the box holds at most multibin::kMaxDenseOutputCells cells: a long route's
+ * box is mostly empty. */
 struct MapLayers {
-    multibin::EsriAsciiGrid height, sigma, certainty, source;
+    multibin::TiledRaster tiled[4];  //!< height, sigma, certainty, source (RasterLayer order)
+    multibin::CellWindow cells;      //!< known cells plus kMargin_cells; empty if none known
     static constexpr int kMargin_cells = 5;
     static MapLayers of(const mrpt::maps::CMultiBinElevationMap& map);
+    /** Throws std::invalid_argument naming `output` unless the box fits a dense raster. */
+    void requireDense(const std::string& output) const;
+    /** Layer i (RasterLayer order) over `cells`, NaN where unknown; requireDense() first. */
+    const multibin::EsriAsciiGrid& dense(int i) const;
     /** Writes elevation_{height,sigma,certainty,source}.asc into `dir` (any folder). */
     void saveAsc(const OutputFolder& folder) const;
+
+private:
+    const mrpt::maps::CMultiBinElevationMap* m_map = nullptr;
+    mutable multibin::EsriAsciiGrid m_dense[4];
+    mutable bool m_computed[4] = {false, false, false, false};
 };
 
 /** The sub-cell surface (heightAt) sampled every `cell_m` over the box of `layers` (--export-

@@ -1,7 +1,7 @@
 /* Part of the multibin elevation-mapping library.
  *
  * elevation-mapper: builds a CMultiBinElevationMap from a rawlog or a simplemap and writes the
- * outputs chosen with --outputs (serialized map, float TIFF, .3Dscene, PNG previews; ESRI ASCII
+ * outputs chosen with --outputs (serialized map, GeoTIFF, .3Dscene, PNG previews; ESRI ASCII
  * rasters and a PLY mesh on request); with --ground-truth it also evaluates the map side by side
  * with its baselines and MRPT's height maps (report.json and figures). `--help` lists the options.
  *
@@ -50,7 +50,7 @@ namespace {
 struct Arguments {
     std::string config, section = "MappingApplication", rawlog, simplemap,
                         out = "elevation-mapper-out", groundTruth, profile, evalArea,
-                        outputs = OutputSelection::kDefault, sceneColour, exportResolution;
+                        outputs = OutputSelection::kDefault, sceneColour, exportResolution, epsg;
     bool withMrf = false, plots = true;
     bool usedDefaults = false;
 };
@@ -82,6 +82,8 @@ void printUsage() {
            "  --outputs LIST       comma-separated, or 'all' (default: "
         << d.outputs << ")\n"
         << OutputSelection::help()
+        << "  --epsg CODE          the projected CRS of the robot poses (e.g. 32633, UTM 33N),\n"
+           "                       written into the GeoTIFFs (default: none, the map frame)\n"
         << "  --scene-colour NAME  colour of elevation.3Dscene: height, sigma, certainty or\n"
            "                       source (default: height; sigma if the ini sets\n"
            "                       color_by_sigma = true)\n"
@@ -121,6 +123,7 @@ Arguments parseArguments(int argc, char** argv) {
         {"--outputs", &a.outputs},    {"--ground-truth", &a.groundTruth}, {"--profile", &a.profile},
         {"--eval-area", &a.evalArea}, {"--scene-colour", &a.sceneColour}};
     flags["--export-resolution"] = &a.exportResolution;
+    flags["--epsg"] = &a.epsg;
     for (int i = 1; i < argc; i++) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
@@ -222,6 +225,7 @@ int run(const Arguments& args, std::string& stage) {
                                      {"ground truth", args.groundTruth}})
         checkRegularFile(what, path);
     OutputSelection selection = OutputSelection::parse(args.outputs);
+    selection.epsg = OutputSelection::parseEpsg(args.epsg);
     double exportCell_m = 0;  // --export-resolution: 0 = none
     if (!args.exportResolution.empty() &&
         (!multibin::parseFiniteNumber(args.exportResolution, exportCell_m) || !(exportCell_m > 0)))
@@ -375,7 +379,7 @@ int run(const Arguments& args, std::string& stage) {
               << " by Gaussian surface (" << fs_.supportAreas << " support areas); " << fs_.unfilled
               << " left unknown\n"
               << "insertion time: " << insert_s << " s; fill time: " << fill_s << " s\n"
-              << "rasters: " << layers.height.cols() << " x " << layers.height.rows()
+              << "rasters: " << layers.cells.nx << " x " << layers.cells.ny
               << " cells (the known cells plus " << MapLayers::kMargin_cells << ")\n"
               << "wrote " << fs::absolute(folder.dir()).string() << "/{";
     for (size_t i = 0; i < written.size(); i++) std::cout << (i ? ", " : "") << written[i];

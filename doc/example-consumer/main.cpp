@@ -11,7 +11,7 @@ int main() {
         "[map]\n"
         "multiBinElevationMap_count = 1\n"
         "[map_multiBinElevationMap_00_creationOpts]\n"
-        "resolution = 0.05\n");
+        "resolution_m = 0.05\n");
     mrpt::maps::TSetOfMetricMapInitializers inits;
     inits.loadFromConfigFile(ini, "map");
     mrpt::maps::CMultiMetricMap maps(inits);

@@ -54,27 +54,20 @@ EsriAsciiGrid cropRaster(const EsriAsciiGrid& raster, const RasterBox& box) {
     return g;
 }
 
-std::vector<uint8_t> encodeFloatTiff(const EsriAsciiGrid& raster) {
-    const int rows = raster.rows(), cols = raster.cols();
-    if (rows == 0 || cols == 0) throw std::invalid_argument("the raster is empty");
-    cv::Mat img(rows, cols, CV_32FC1);
-    for (int r = 0; r < rows; r++)  // image row 0 is the northernmost
-        for (int c = 0; c < cols; c++) img.at<float>(rows - 1 - r, c) = raster.heights_m(r, c);
-    std::vector<uint8_t> bytes;
-    if (!cv::imencode(".tif", img, bytes)) throw std::runtime_error("TIFF encoding failed");
-    return bytes;
-}
-
-std::string worldFileText(const EsriAsciiGrid& raster) {
+std::string worldFileText(double pixel_m, double upperLeftCenterX_m, double upperLeftCenterY_m) {
     // Pixel size in x, rotation terms, pixel size in y (negative: rows go south), centre of the
     // upper-left pixel.
     std::ostringstream w;
     w.precision(12);
-    w << raster.cellsize_m << "\n0\n0\n"
-      << -raster.cellsize_m << "\n"
-      << raster.xllcenter_m << "\n"
-      << raster.yMax_m() << "\n";
+    w << pixel_m << "\n0\n0\n"
+      << -pixel_m << "\n"
+      << upperLeftCenterX_m << "\n"
+      << upperLeftCenterY_m << "\n";
     return w.str();
+}
+
+std::string worldFileText(const EsriAsciiGrid& raster) {
+    return worldFileText(raster.cellsize_m, raster.xllcenter_m, raster.yMax_m());
 }
 
 std::string meshPlyText(const EsriAsciiGrid& raster) {
@@ -163,9 +156,14 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     if (rows == 0 || cols == 0) throw std::invalid_argument("the raster is empty");
     const bool categorical = !style.categories.empty();
 
-    // Map panel about 600 px on its long side: whole pixels per cell when enlarging.
-    double scale = 600.0 / std::max(rows, cols);
-    if (scale >= 1) scale = std::min(20.0, std::floor(scale));
+    if (std::max(rows, cols) > kPreviewMaxSide_px)
+        throw std::invalid_argument("a preview of " + std::to_string(cols) + " x " +
+                                    std::to_string(rows) + " samples: more than " +
+                                    std::to_string(kPreviewMaxSide_px) +
+                                    " on a side; downsample it first (blockReduced)");
+    // Small rasters enlarged to about 600 px (whole pixels per cell), larger ones one pixel per
+    // sample: shrinking by skipping samples would drop a thin route.
+    const double scale = std::clamp(std::floor(600.0 / std::max(rows, cols)), 1.0, 20.0);
     const int W = std::max(1, int(std::lround(cols * scale)));
     const int H = std::max(1, int(std::lround(rows * scale)));
     const int L = 70, T = 34, R = 170, B = 70;
@@ -225,6 +223,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     text(img, "x [m]", {L + W / 2 - 15, T + H + 33});
     text(img, "y [m]", {4, T - 8});
     text(img, style.title, {L, 22}, 0.55);
+    if (!style.note.empty()) text(img, style.note, {L + textWidth(style.title, 0.55) + 16, 22});
 
     // Scale bar under the axis.
     const double barM = niceStep(xSpan / 4);
@@ -269,18 +268,6 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     std::vector<uint8_t> bytes;
     if (!cv::imencode(".png", img, bytes)) throw std::runtime_error("PNG encoding failed");
     return bytes;
-}
-
-void saveFloatTiff(const EsriAsciiGrid& raster, const std::string& path) {
-    std::vector<uint8_t> tiff;
-    try {
-        tiff = encodeFloatTiff(raster);
-    } catch (const std::exception& e) {
-        throw std::runtime_error("cannot write '" + path + "': " + e.what());
-    }
-    writeFileAtomically(path, tiff);
-    writeFileAtomically(std::filesystem::path(path).replace_extension(".tfw").string(),
-                        worldFileText(raster));
 }
 
 void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {

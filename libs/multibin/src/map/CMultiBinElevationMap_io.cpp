@@ -11,10 +11,12 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
-#include "multibin/io/RasterExport.h"
+#include "multibin/io/MapLayerFiles.h"
+#include "multibin/io/OutputFile.h"
 #include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
@@ -361,52 +363,125 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
 }
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer) const {
+    return toRaster(layer, m_impl->grid.window());
+}
+
+multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer,
+                                                        const multibin::CellWindow& w) const {
+    return std::move(toRasters({layer}, w).front());
+}
+
+std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
+    const std::vector<RasterLayer>& layers, const multibin::CellWindow& w) const {
     fillIfLoaded();  // a loaded map's rasters hold its filled cells, as the writer's did
     const multibin::MapLock::Shared lock(m_impl->lock);
-    const multibin::CellWindow& w = m_impl->grid.window();
-    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(m_impl->grid.lattice());
+    const multibin::BinGrid& grid = m_impl->grid;
+    multibin::EsriAsciiGrid g =
+        multibin::EsriAsciiGrid::onLattice(multibin::Lattice{grid.cellSize_m(), w});
     const Eigen::Vector2d& o = m_impl->origin_m;  // the raster is in the pose frame
     g.xllcenter_m += o.x();
     g.yllcenter_m += o.y();
+    std::vector<multibin::EsriAsciiGrid> out(layers.size(), g);
+    // A cell without a bin in either grid and without a filled value is unknown: most cells of
+    // a sparse route's tiles, skipped without a query.
+    const multibin::fill::FillResult& f = m_impl->fill;
+    const multibin::CellWindow& fw = m_impl->fillWindow;
+    const bool withFill = insertionOptions.dem_return_filled && f.source.size() == fw.cellCount();
+    const auto mayBeKnown = [&](int ix, int iy) {
+        bool any = false;
+        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
+        if (!any && isDualGrid())
+            m_impl->local.forEachBin(m_impl->local.cellIndex(grid.cellCenter_m(ix)),
+                                     m_impl->local.cellIndex(grid.cellCenter_m(iy)),
+                                     [&](const multibin::Bin&) { any = true; });
+        return any ||
+               (withFill && fw.contains(ix, iy) && f.isFilled(f.index(ix - fw.ix0, iy - fw.iy0)));
+    };
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
             const int ix = w.ix0 + c, iy = w.iy0 + r;
+            if (!mayBeKnown(ix, iy)) continue;
             double h, s;
-            const HeightSource src = cellElevation(o.x() + m_impl->grid.cellCenter_m(ix),
-                                                   o.y() + m_impl->grid.cellCenter_m(iy), h, s,
-                                                   insertionOptions.dem_return_filled);
+            const HeightSource src =
+                cellElevation(o.x() + grid.cellCenter_m(ix), o.y() + grid.cellCenter_m(iy), h, s,
+                              insertionOptions.dem_return_filled);
             if (src == HeightSource::Unknown) continue;
-            float& out = g.heights_m(r, c);
-            switch (layer) {
-                case RasterLayer::Height:
-                    out = float(h);
-                    break;
-                case RasterLayer::Sigma:
-                    out = float(s);
-                    break;
-                case RasterLayer::Source:
-                    out = float(static_cast<int>(src));
-                    break;
-                case RasterLayer::Certainty: {
-                    // The certainty of the surface the height layer reports (0 where filled).
-                    multibin::CellSurface c;
-                    out = src == HeightSource::Measured &&
-                                  multibin::surfaceAt(
-                                      m_impl->grid, isDualGrid() ? &m_impl->local : nullptr,
-                                      m_impl->grid.cellCenter_m(ix), m_impl->grid.cellCenter_m(iy),
-                                      binUpdateParams(), false, c)
-                              ? float(c.certainty)
-                              : 0.f;
-                } break;
+            for (size_t k = 0; k < layers.size(); k++) {
+                float& v = out[k].heights_m(r, c);
+                switch (layers[k]) {
+                    case RasterLayer::Height:
+                        v = float(h);
+                        break;
+                    case RasterLayer::Sigma:
+                        v = float(s);
+                        break;
+                    case RasterLayer::Source:
+                        v = float(static_cast<int>(src));
+                        break;
+                    case RasterLayer::Certainty: {
+                        // The certainty of the surface the height layer reports (0 where
+                        // filled).
+                        multibin::CellSurface cs;
+                        v = src == HeightSource::Measured &&
+                                    multibin::surfaceAt(
+                                        grid, isDualGrid() ? &m_impl->local : nullptr,
+                                        grid.cellCenter_m(ix), grid.cellCenter_m(iy),
+                                        binUpdateParams(), false, cs)
+                                ? float(cs.certainty)
+                                : 0.f;
+                    } break;
+                }
             }
         }
-    return g;
+    return out;
+}
+
+std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileCells) const {
+    if (tileCells < 1)
+        throw std::invalid_argument("occupiedTiles: tileCells " + std::to_string(tileCells) +
+                                    " must be at least 1");
+    fillIfLoaded();
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    std::set<std::pair<int, int>> corners;  // (iy0, ix0): ordered row by row from the south
+    const auto add = [&](int ix, int iy) {
+        const multibin::CellWindow t = multibin::tileOfCell(ix, iy, tileCells);
+        corners.emplace(t.iy0, t.ix0);
+    };
+    // One pass over the stored bins until the tiled store lists its own tiles.
+    m_impl->grid.store().forEachStoredBin(
+        [&](int ix, int iy, const multibin::Bin&) { add(ix, iy); });
+    if (isDualGrid()) {  // local cells not yet written back, at the global cell of their centre
+        const multibin::BinGrid& l = m_impl->local;
+        l.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
+            add(m_impl->grid.cellIndex(l.cellCenter_m(ix)),
+                m_impl->grid.cellIndex(l.cellCenter_m(iy)));
+        });
+    }
+    const multibin::fill::FillResult& f = m_impl->fill;
+    const multibin::CellWindow& fw = m_impl->fillWindow;
+    if (insertionOptions.dem_return_filled && f.source.size() == fw.cellCount())
+        for (int r = 0; r < fw.ny; r++)
+            for (int c = 0; c < fw.nx; c++)
+                if (f.isFilled(f.index(c, r))) add(fw.ix0 + c, fw.iy0 + r);
+    std::vector<multibin::CellWindow> tiles;
+    tiles.reserve(corners.size());
+    for (const auto& [iy0, ix0] : corners)
+        tiles.push_back(multibin::CellWindow{ix0, iy0, tileCells, tileCells});
+    return tiles;
 }
 
 void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
     fillIfLoaded();
     const multibin::MapLock::Shared lock(m_impl->lock);
-    const multibin::EsriAsciiGrid g = toRaster(sigma ? RasterLayer::Sigma : RasterLayer::Height);
+    const RasterLayer layer = sigma ? RasterLayer::Sigma : RasterLayer::Height;
+    // A long route's window is drawn in blocks, each read tile by tile.
+    constexpr int kMaxSide_px = 4096;
+    const multibin::CellWindow& w = m_impl->grid.window();
+    const int k = multibin::blockFactorFor(w, kMaxSide_px);
+    const multibin::EsriAsciiGrid g =
+        k == 1 ? toRaster(layer, w)
+               : multibin::blockReduced(multibin::tiledLayer(*this, layer), w, k,
+                                        multibin::BlockReduce::Mean);
     const int rows = g.rows(), cols = g.cols();
     img.resize(std::max(cols, 1), std::max(rows, 1), mrpt::img::CH_RGB);
     img.filledRectangle(0, 0, std::max(cols, 1) - 1, std::max(rows, 1) - 1,
@@ -434,26 +509,35 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
 
 void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     const std::string& filNamePrefix) const {
+    fillIfLoaded();
     const multibin::MapLock::Shared lock(m_impl->lock);
-    // Rasters cover the known cells plus a margin, not the whole grown window.
-    const multibin::RasterBox box = multibin::knownBox(toRaster(RasterLayer::Height), 5);
-    const auto raster = [&](RasterLayer l) { return multibin::cropRaster(toRaster(l), box); };
-    for (const bool sigma : {false, true}) {
-        const std::string layer = sigma ? "_sigma" : "_height";
-        mrpt::img::CImage img;
-        getAsImage(img, sigma);
-        if (!img.saveToFile(filNamePrefix + layer + ".png"))
-            throw std::runtime_error("CMultiBinElevationMap: cannot write " + filNamePrefix +
-                                     layer + ".png");
-        raster(sigma ? RasterLayer::Sigma : RasterLayer::Height)
-            .save(filNamePrefix + layer + ".asc");
-    }
-    raster(RasterLayer::Certainty).save(filNamePrefix + "_certainty.asc");
-    raster(RasterLayer::Source).save(filNamePrefix + "_source.asc");
-    const multibin::EsriAsciiGrid heights = raster(RasterLayer::Height);
-    if (heights.rows() > 0 && heights.cols() > 0) {
-        multibin::saveFloatTiff(heights, filNamePrefix + "_height.tif");
-        multibin::saveMeshPly(heights, filNamePrefix + ".ply");
+    // What elevation-mapper writes by default (doc/user-guide.md), read tile by tile: sparse
+    // GeoTIFF layers, downsampled previews, the 3D view. ESRI ASCII and PLY are dense over the
+    // known area: elevation-mapper --outputs asc,ply writes them for maps that fit.
+    using L = RasterLayer;
+    const multibin::TiledRaster height = multibin::tiledLayer(*this, L::Height);
+    if (!height.tiles.empty()) {
+        const std::vector<L> all{L::Height, L::Sigma, L::Certainty, L::Source};
+        std::vector<std::string> paths;
+        std::vector<multibin::GeoTiffOptions> options(all.size());
+        for (size_t i = 0; i < all.size(); i++) {
+            paths.push_back(filNamePrefix + "_" + multibin::mapLayerName(all[i]) + ".tif");
+            options[i].description = multibin::layerPreviewStyle(all[i]).title;
+        }
+        multibin::writeSparseGeoTiffs(
+            multibin::tiledLayers(*this, all, &height.tiles), paths, options,
+            [&](size_t k, const std::function<bool(const std::string&)>& write) {
+                multibin::writeFileAtomically(paths[k], write);
+            });
+        multibin::writeFileAtomically(filNamePrefix + "_height.tfw",
+                                      multibin::geoTiffWorldFileText(height));
+        const std::vector<L> shown{L::Height, L::Sigma, L::Source};
+        const auto png =
+            multibin::layerPreviewPngs(multibin::tiledLayers(*this, shown, &height.tiles), shown,
+                                       multibin::knownWindow(height, 5));
+        for (size_t i = 0; i < shown.size(); i++)
+            multibin::writeFileAtomically(
+                filNamePrefix + "_" + multibin::mapLayerName(shown[i]) + ".png", png[i]);
     }
     mrpt::opengl::COpenGLScene scene;
     auto obj = mrpt::opengl::CSetOfObjects::Create();

@@ -16,7 +16,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "multibin/io/RasterExport.h"
+#include "multibin/io/MapLayerFiles.h"
 #include "multibin/map/TerrainView.h"
 
 #include "multibin/io/EsriAsciiGrid.h"
@@ -79,19 +79,19 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
     // Built relative to the map origin and placed at it, so the view's floats stay small at
     // georeferenced coordinates.
     const mrpt::math::TPoint2D origin = map.mapOrigin();
-    EsriAsciiGrid whole = map.toRaster(Layer::Height);
-    whole.xllcenter_m -= origin.x;
-    whole.yllcenter_m -= origin.y;
+    // Read tile by tile, one vertex per cell up to 2048 a side, else per block.
+    std::vector<TiledRaster> layers = tiledLayers(map, {Layer::Height, layerOf(colouring)});
+    for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
     auto placed = mrpt::opengl::CSetOfObjects::Create();
     placed->setName("map origin");
     placed->setLocation(origin.x, origin.y, 0);
     const bool atZero = origin.x == 0 && origin.y == 0;
     mrpt::opengl::CSetOfObjects& into = atZero ? out : *placed;
-    const RasterBox box = knownBox(whole, 1);
-    const EsriAsciiGrid heights = cropRaster(whole, box);
-    const EsriAsciiGrid values = colouring == SceneColouring::Height
-                                     ? heights
-                                     : cropRaster(map.toRaster(layerOf(colouring)), box);
+    const CellWindow box = knownWindow(layers[0], 1);
+    const std::vector<EsriAsciiGrid> blocks =
+        blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px),
+                     {BlockReduce::Mean, layerBlockReduce(layerOf(colouring))});
+    const EsriAsciiGrid &heights = blocks[0], &values = blocks[1];
     const int nx = heights.cols(), ny = heights.rows();
     if (nx < 2 || ny < 2) return;
 

@@ -30,6 +30,7 @@
 // sensorModelStats().
 namespace multibin {
 class BinGrid;
+struct CellWindow;
 class PosePropagator;
 struct PoseVariances;
 struct EsriAsciiGrid;
@@ -90,9 +91,9 @@ namespace mrpt::maps {
  * [map]
  * multiBinElevationMap_count = 1
  * [map_multiBinElevationMap_00_creationOpts]
- * resolution = 0.02      ; all keys optional
+ * resolution_m = 0.02      ; all keys optional (doc/options.md)
  * [map_multiBinElevationMap_00_insertOpts]
- * max_elevation_uncertainty = 0.1
+ * max_elevation_uncertainty_m = 0.1
  * \endcode
  * Unknown keys and malformed values are errors that name the section and the key.
  *
@@ -331,8 +332,19 @@ public:
     /** One layer over the grid window as a raster, NaN where unknown; row 0 is the southernmost
      * row. Filled cells are included when insertionOptions.dem_return_filled is set. */
     multibin::EsriAsciiGrid toRaster(RasterLayer layer = RasterLayer::Height) const;
+    /** The layer over any window of cells (cell indices of grid(): multibin/geometry/Lattice.h),
+     * NaN where unknown: a large map's outputs read it tile by tile (occupiedTiles()). */
+    multibin::EsriAsciiGrid toRaster(RasterLayer layer, const multibin::CellWindow& cells) const;
+    /** Several layers over a window, one query per cell: toRaster(layers[i], cells) each. */
+    std::vector<multibin::EsriAsciiGrid> toRasters(const std::vector<RasterLayer>& layers,
+                                                   const multibin::CellWindow& cells) const;
+    /** The aligned windows of tileCells x tileCells cells of grid() (multibin::tileOfCell,
+     * multibin/io/TiledRaster.h) that may hold a known cell (a bin of either grid, or a filled
+     * cell), row by row from the south: where the data is, whatever the window's extent. */
+    std::vector<multibin::CellWindow> occupiedTiles(int tileCells = 256) const;
     /** Colour image of the heights (or sigmas) with insertionOptions.colormap, north up; black
-     * where unknown. */
+     * where unknown. One pixel per cell of the window; a window longer than 4096 cells is drawn
+     * one pixel per k x k block of cells (their mean), k the smallest that fits 4096. */
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
     /** @name Traversability (multibin/traversability/TerrainFeatures.h, doc/traversability.md)
      * @{ */
@@ -397,11 +409,12 @@ public:
     bool isEmpty() const override;
     std::string asString() const override;
     void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
-    /** Writes PREFIX_height.png and PREFIX_sigma.png (colour images, north up); ESRI ASCII
-     * rasters PREFIX_height.asc, PREFIX_sigma.asc [m], PREFIX_certainty.asc and
-     * PREFIX_source.asc (see RasterLayer); PREFIX_height.tif (float32 TIFF with a .tfw world
-     * file); PREFIX.ply (triangle mesh [m]) and PREFIX.3Dscene. The rasters cover the known
-     * cells plus 5 cells, not the whole window. */
+    /** Writes what elevation-mapper writes by default, read tile by tile so the files grow
+     * with the data, not its bounding box: PREFIX_height.tif, PREFIX_sigma.tif,
+     * PREFIX_certainty.tif and PREFIX_source.tif (float32 GeoTIFF: tiled, compressed, only the
+     * tiles with data, NaN unknown; see RasterLayer) with PREFIX_height.tfw (world file);
+     * previews PREFIX_height.png, PREFIX_sigma.png, PREFIX_source.png (axes [m], legend;
+     * downsampled beyond 2048 cells a side); PREFIX.3Dscene. No raster for an empty map. */
     void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
     float compute3DMatchingRatio(const mrpt::maps::CMetricMap* otherMap,
                                  const mrpt::poses::CPose3D& otherMapPose,

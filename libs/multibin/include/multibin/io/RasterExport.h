@@ -24,12 +24,11 @@ RasterBox knownBox(const EsriAsciiGrid& raster, int margin_cells);
 /** The samples of `raster` inside `box`, with the georeference moved accordingly. */
 EsriAsciiGrid cropRaster(const EsriAsciiGrid& raster, const RasterBox& box);
 
-/** A single-band float32 TIFF of the raster, north up, NaN where unknown. Throws
- * std::invalid_argument if the raster is empty. */
-std::vector<uint8_t> encodeFloatTiff(const EsriAsciiGrid& raster);
-
-/** The ESRI world file (.tfw) that places encodeFloatTiff()'s image in the map frame [m]. */
+/** The ESRI world file (.tfw) that places an image of the raster (north up, one pixel per
+ * sample) in the map frame [m]. */
 std::string worldFileText(const EsriAsciiGrid& raster);
+/** The same from the pixel size and the centre of the upper-left pixel [m]. */
+std::string worldFileText(double pixel_m, double upperLeftCenterX_m, double upperLeftCenterY_m);
 
 /** The raster as a triangle mesh in ASCII PLY: one vertex per known sample at its cell centre
  * (x, y, height) [m], two triangles per 2x2 block of known samples (one where exactly three are
@@ -56,18 +55,23 @@ struct PreviewStyle {
     /** Categorical layers: a legend of swatches replaces the colour bar. Samples with other
      * values are drawn as unknown. */
     std::vector<RasterCategory> categories;
+    /** A line under the title, e.g. "1 pixel = 8 x 8 cells (mean)" for a downsampled raster. */
+    std::string note;
 };
 
+/** The longest side of encodePreviewPng()'s map panel [px]: rasters beyond it are given
+ * downsampled (blockReduced(), TiledRaster.h). */
+constexpr int kPreviewMaxSide_px = 2048;
+
 /** A PNG preview of a raster layer: north up, x and y axes with ticks in metres, a scale bar, a
- * colour bar (or a categorical legend) and unknown cells in a grey that no colormap uses. */
+ * colour bar (or a categorical legend) and unknown cells in a grey that no colormap uses. The
+ * map panel is about 600 px on its long side for small rasters (whole pixels per sample), one
+ * pixel per sample for larger ones; throws std::invalid_argument for a raster longer than
+ * kPreviewMaxSide_px. */
 std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const PreviewStyle& style);
 
 /** The grey of unknown cells in encodePreviewPng() (R, G, B). */
 constexpr uint8_t kUnknownGrey[3] = {200, 200, 200};
-
-/** Writes encodeFloatTiff() to `path` and worldFileText() to PATH with extension .tfw, each
- * through writeFileAtomically(); errors name the file. */
-void saveFloatTiff(const EsriAsciiGrid& raster, const std::string& path);
 
 /** Writes meshPlyText() to `path` through writeFileAtomically(); errors name the file. */
 void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path);
