@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
+#include <memory>
+
 #include "multibin/map/BinGrid.h"
 #include "multibin/map/MapTypes.h"
 
@@ -74,6 +76,29 @@ bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m
  * reportedVariance_m2() is what a query reports. False if neither grid has a surface there. */
 bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
               const BinUpdateParams& params, bool reliefSigma, CellSurface& out);
+
+/** heightAt over many points: the work of a cell (its surfaces, each surface's plane from its
+ * neighbours) done once for the queries that read it, while the grids do not change (the
+ * caller holds the map's lock). Answers bit for bit as heightAt. A cell is kept until a cell
+ * 4 rows or `columns` columns (rounded up to a power of 2) away needs its slot: queries in the
+ * order of their cells (rows, then columns) compute each cell once; any order is correct. */
+class HeightAtCache {
+public:
+    /** For queries on `grid` and, with a dual grid, `local` (null otherwise), spanning about
+     * `columns` cells in x (a window's width at most: 4 rows of that many cells are kept). */
+    HeightAtCache(const BinGrid& grid, const BinGrid* local, const BinUpdateParams& params,
+                  int columns);
+    ~HeightAtCache();
+    HeightAtCache(const HeightAtCache&) = delete;
+    HeightAtCache& operator=(const HeightAtCache&) = delete;
+
+    /** heightAt(grid, local, x_m, y_m, params, reliefSigma, out). */
+    bool heightAt(double x_m, double y_m, bool reliefSigma, CellSurface& out);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
 
 /** The slope sigma assumed where no points give one [-]: 45 degrees. */
 constexpr double kUnknownSlope = 1.0;
