@@ -79,15 +79,15 @@ bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
 
 /** heightAt over many points: the work of a cell (its surfaces, each surface's plane from its
  * neighbours) done once for the queries that read it, while the grids do not change (the
- * caller holds the map's lock). Answers bit for bit as heightAt. A cell is kept until a cell
- * 4 rows or `columns` columns (rounded up to a power of 2) away needs its slot: queries in the
- * order of their cells (rows, then columns) compute each cell once; any order is correct. */
+ * caller holds the map's lock). Answers bit for bit as heightAt. A grid's cells are kept in 4
+ * rows of slots as wide as the queries' x span (at most the window): queries in the order of
+ * their cells (rows, then columns) compute each cell once; any order is correct. */
 class HeightAtCache {
 public:
-    /** For queries on `grid` and, with a dual grid, `local` (null otherwise), spanning about
-     * `columns` cells in x (a window's width at most: 4 rows of that many cells are kept). */
+    /** For queries on `grid` and, with a dual grid, `local` (null otherwise), spanning
+     * `xSpan_m` in x. */
     HeightAtCache(const BinGrid& grid, const BinGrid* local, const BinUpdateParams& params,
-                  int columns);
+                  double xSpan_m);
     ~HeightAtCache();
     HeightAtCache(const HeightAtCache&) = delete;
     HeightAtCache& operator=(const HeightAtCache&) = delete;
