@@ -6,21 +6,17 @@
  *   ninja -C build bench_height_batch && build/tests/bench/bench_height_batch
  *
  * /0: 100 000 points uniform over the map's window (about a fifth known; as
- *     python/bench/bench_height.py's blocks); /1: the same number of points on a regular grid of 4
- *     per cell, row by row (a raster of the map at half its cell size); /2: 100 000 uniform
- *     points where the map has measured the terrain (the query's own cost is highest). */
+ *     python/bench/bench_height.py's blocks); /1: 316 x 316 points half a cell apart, row by row,
+ *     around the middle of the measured places (a raster at twice the map's resolution); /2, /3,
+ *     /4: 100 000 uniform points where the map answers measured, unknown, filled. */
 #include <benchmark/benchmark.h>
-#include <mrpt/config/CConfigFile.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
-#include <mrpt/maps/CMultiMetricMap.h>
-#include <mrpt/maps/CSimpleMap.h>
 #include <time.h>
 
-#include <memory>
 #include <random>
-#include <stdexcept>
-#include <string>
 #include <vector>
+
+#include "../core/mockup_map.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 
@@ -34,19 +30,7 @@ double threadCpu_s() {
 
 /** The mock-up map, mapped once, its gaps filled. */
 const CMultiBinElevationMap& mockupMap() {
-    static const std::unique_ptr<mrpt::maps::CMultiMetricMap> maps = [] {
-        const std::string src = MULTIBIN_SOURCE_DIR;
-        const mrpt::config::CConfigFile ini(src + "/ini/mockup.ini");
-        mrpt::maps::TSetOfMetricMapInitializers inits;
-        inits.loadFromConfigFile(ini, "MappingApplication");
-        auto m = std::make_unique<mrpt::maps::CMultiMetricMap>(inits);
-        mrpt::maps::CSimpleMap simplemap;
-        if (!simplemap.loadFromFile(src + "/rawlogs/mockup.simplemap"))
-            throw std::runtime_error("cannot read rawlogs/mockup.simplemap");
-        m->mapByClass<CMultiBinElevationMap>()->insertSimpleMapWithPosePdfs(simplemap);
-        m->mapByClass<CMultiBinElevationMap>()->dem_update_map();
-        return m;
-    }();
+    static const auto maps = test_maps::mockupMaps();
     return *maps->mapByClass<CMultiBinElevationMap>();
 }
 
@@ -57,13 +41,19 @@ void queryPoints(const CMultiBinElevationMap& map, int which, std::vector<double
     const double x0 = map.getXMin(), x1 = map.getXMax(), y0 = map.getYMin(), y1 = map.getYMax();
     x.clear();
     y.clear();
-    if (which == 1) {  // row by row, 4 points a cell from the window's lower-left corner
+    if (which == 1) {  // 316 x 316 points half a cell apart, row by row, around the middle
+        std::vector<double> mx, my;  // of the measured places
+        queryPoints(map, 2, mx, my);
+        double cx = 0, cy = 0;
+        for (size_t i = 0; i < mx.size(); i++) cx += mx[i] / double(mx.size());
+        for (size_t i = 0; i < my.size(); i++) cy += my[i] / double(my.size());
         const double step_m = 0.5 * map.creationOptions.resolution_m;
-        const size_t columns = size_t((x1 - x0) / step_m);
-        for (size_t k = 0; k < kPoints; k++) {
-            x.push_back(x0 + (double(k % columns) + 0.25) * step_m);
-            y.push_back(y0 + (double(k / columns) + 0.25) * step_m);
-        }
+        const int side = 316;
+        for (int r = 0; r < side; r++)
+            for (int c = 0; c < side; c++) {
+                x.push_back(cx + (c - side / 2 + 0.25) * step_m);
+                y.push_back(cy + (r - side / 2 + 0.25) * step_m);
+            }
         return;
     }
     std::mt19937 rng(7);

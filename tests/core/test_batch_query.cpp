@@ -3,10 +3,7 @@
  * on cell borders, outside the window and not finite, in shuffled order), on a dual grid, with
  * the `nearest` query, and on an empty map. */
 #include <gtest/gtest.h>
-#include <mrpt/config/CConfigFile.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
-#include <mrpt/maps/CMultiMetricMap.h>
-#include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CObservationPointCloud.h>
 
@@ -15,31 +12,16 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
-#include <memory>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "mockup_map.h"
+
 namespace {
 using Map = mrpt::maps::CMultiBinElevationMap;
 using Source = Map::HeightSource;
-
-/** The mock-up map as elevation-mapper builds it (rawlogs/mockup.simplemap), gaps filled. */
-std::shared_ptr<mrpt::maps::CMultiMetricMap> mockupMaps() {
-    const std::string src = MULTIBIN_SOURCE_DIR;
-    const mrpt::config::CConfigFile ini(src + "/ini/mockup.ini");
-    mrpt::maps::TSetOfMetricMapInitializers inits;
-    inits.loadFromConfigFile(ini, "MappingApplication");
-    auto maps = std::make_shared<mrpt::maps::CMultiMetricMap>(inits);
-    mrpt::maps::CSimpleMap simplemap;
-    if (!simplemap.loadFromFile(src + "/rawlogs/mockup.simplemap"))
-        throw std::runtime_error("cannot read rawlogs/mockup.simplemap");
-    auto map = maps->mapByClass<Map>();
-    map->insertSimpleMapWithPosePdfs(simplemap);
-    map->dem_update_map();
-    return maps;
-}
 
 uint64_t bits(double v) {
     uint64_t b;
@@ -111,7 +93,7 @@ void queryPoints(double x0, double x1, double y0, double y1, double cell_m, doub
 }  // namespace
 
 TEST(BatchQuery, MockupMapAnswersAsHeightBitForBit) {
-    const auto maps = mockupMaps();
+    const auto maps = test_maps::mockupMaps();
     const Map& map = *maps->mapByClass<Map>();
     std::vector<double> x, y;
     const double cell_m = map.creationOptions.resolution_m;

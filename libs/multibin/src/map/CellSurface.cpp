@@ -385,7 +385,7 @@ bool planeOfCellAt(CellPlanesCache& cache, int ix, int iy, double x_m, double y_
     const BinGrid& grid = cache.grid();
     const double s = grid.cellSize_m();
     const double qx = x_m - grid.cellCenter_m(ix), qy = y_m - grid.cellCenter_m(iy);
-    const int k = surfaceHolding(planes, count, qx, qy, s);
+    const int k = count == 1 ? 0 : surfaceHolding(planes, count, qx, qy, s);  // 1: no choice
     const PlaneMoments& m = planes[k].moments;
     const SurfacePlane& plane = cache.planeOf(ix, iy, k);
     // Without points (a map loaded from a file keeps no moments) the centroid is the centre.
