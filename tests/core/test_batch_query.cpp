@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "mockup_map.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/map/CellSurface.h"
 
 namespace {
 using Map = mrpt::maps::CMultiBinElevationMap;
@@ -112,6 +114,31 @@ TEST(BatchQuery, MockupMapAnswersAsHeightBitForBit) {
     nearest.insertionOptions.height_query = Map::TInsertionOptions::HeightQuery::Nearest;
     expectBatchAsSingle(nearest, x, y, counts);
     EXPECT_GT(counts[int(Source::Measured)], 2000u);
+}
+
+TEST(BatchQuery, ACacheNarrowerThanItsQueriesAnswersAsHeightAt) {
+    // Slots for 4 columns only and the points in random order: cells evict each other all the
+    // time, and every answer is still heightAt's.
+    const auto maps = test_maps::mockupMaps();
+    const Map& map = *maps->mapByClass<Map>();
+    std::vector<double> x, y;
+    queryPoints(map.getXMin(), map.getXMax(), map.getYMin(), map.getYMax(),
+                map.creationOptions.resolution_m, map.mapOrigin().x, 20000, x, y);
+    const multibin::BinUpdateParams params = map.binUpdateParams();
+    multibin::HeightAtCache cache(map.grid(), nullptr, params, 0.0);
+    size_t known = 0, mismatches = 0;
+    for (size_t i = 0; i < x.size(); i++) {
+        const double xi = x[i] - map.mapOrigin().x, yi = y[i] - map.mapOrigin().y;
+        multibin::CellSurface a, b;
+        const bool haveA = multibin::heightAt(map.grid(), nullptr, xi, yi, params, true, a);
+        const bool haveB = cache.heightAt(xi, yi, true, b);
+        known += haveA;
+        mismatches += haveA != haveB ||
+                      (haveA && (bits(a.height_m) != bits(b.height_m) ||
+                                 bits(a.reportedVariance_m2()) != bits(b.reportedVariance_m2())));
+    }
+    EXPECT_EQ(mismatches, 0u) << "of " << x.size() << " points";
+    EXPECT_GT(known, 2000u);
 }
 
 TEST(BatchQuery, DualGridAnswersAsHeightBitForBit) {

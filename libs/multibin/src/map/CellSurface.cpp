@@ -486,12 +486,13 @@ bool heightOnGrids(CellPlanesCache& grid, CellPlanesCache* local, double x_m, do
 }
 
 /** The exponent of the power of 2 of slot columns for queries spanning `xSpan_m` in x: the
- * span's cells and the 3 more a query reads beyond them, at most the window's width. */
+ * span's cells and the 3 more a query reads beyond them, at most the window's width and 4096
+ * (12 MB of slots, touched as used; a wider row computes its cells up to 4 times). */
 int columnsLog2(const BinGrid& grid, double xSpan_m) {
     const double spanned = xSpan_m / grid.cellSize_m() + 4.0, window = grid.window().nx;
     const double columns = spanned < window ? spanned : window;  // NaN: the window
     int bits = 2;
-    while (bits < 30 && double(1 << bits) < columns) bits++;
+    while (bits < 12 && double(1 << bits) < columns) bits++;
     return bits;
 }
 }  // namespace
