@@ -71,10 +71,8 @@ std::vector<uint32_t> cellOrder(const multibin::BinGrid& lattice, Range x, Range
 void CMultiBinElevationMap::heights(const double* x_m, const double* y_m, size_t n,
                                     HeightAnswer* out) const {
     if (n > 0 && (!x_m || !y_m || !out))
-        throw std::invalid_argument(
-            "CMultiBinElevationMap::heights: x_m, y_m and out must not be "
-            "null (n = " +
-            std::to_string(n) + ")");
+        throw std::invalid_argument("CMultiBinElevationMap::heights: x_m, y_m and out must " +
+                                    std::string("not be null (n = ") + std::to_string(n) + ")");
     if (n == 1) {  // nothing to share
         out[0] = height(x_m[0], y_m[0]);
         return;

@@ -80,8 +80,9 @@ bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
 /** heightAt over many points: the work of a cell (its surfaces, each surface's plane from its
  * neighbours) done once for the queries that read it, while the grids do not change (the
  * caller holds the map's lock). Answers bit for bit as heightAt. A grid's cells are kept in 4
- * rows of slots as wide as the queries' x span (at most the window): queries in the order of
- * their cells (rows, then columns) compute each cell once; any order is correct. */
+ * rows of slots as wide as the queries' x span (at most the window's width and 4096 cells):
+ * queries in the order of their cells (rows, then columns) compute each cell about once; any
+ * order is correct. */
 class HeightAtCache {
 public:
     /** For queries on `grid` and, with a dual grid, `local` (null otherwise), spanning
