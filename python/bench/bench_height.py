@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Times multibin.ElevationMap.height() over 1 M points against a Python loop of single queries
-and against the C++ query loop (multibin_query_table --time: the same query, HeightQuery.h).
+and against C++: the same batch query (multibin_query_table --time: HeightQuery.h, the map's
+heights()) and a C++ loop of single height() calls (--one-by-one).
 
 The map: the shipped mock-up mapped and saved, then loaded and filled by both sides (the same
 bins in the same memory layout). The points: uniform over the map's window (about a fifth of
 them known). Each method is timed per block of 100 000 points, the fastest of N runs of each
 block in CPU time of the calling thread (the query runs there, GIL released or not), summed over
-the blocks: a shared machine's other work is not counted, and all three see the same blocks. The figures of doc/python.md:
+the blocks: a shared machine's other work is not counted, and all four see the same blocks. The figures of doc/python.md:
 
     PYTHONPATH=build/python/module /usr/bin/python3 python/bench/bench_height.py [--build build]
 """
@@ -79,18 +80,23 @@ def main():
             xs, ys = x[sel][:BLOCK], y[sel][:BLOCK]
             by_source[name] = (len(xs), blockwise(args.runs, xs, ys, m.height),
                                blockwise(args.loop_runs, xs, ys, python_loop))
-        cpp_s = float(subprocess.run(
-            [str(helper), "--fill", "--time", str(args.runs), str(tmp / "map.bin"),
-             str(tmp / "xy.bin")], check=True, capture_output=True, text=True).stdout)
+        def cpp(*mode):
+            return float(subprocess.run(
+                [str(helper), "--fill", "--time", str(args.runs), *mode, str(tmp / "map.bin"),
+                 str(tmp / "xy.bin")], check=True, capture_output=True, text=True).stdout)
+
+        cpp_s, cpp_loop_s = cpp(), cpp("--one-by-one")
 
     print(f"{args.points} points ({known} known) on the mock-up map; CPU time, per block of "
           f"{BLOCK} the fastest of {args.runs} runs ({args.loop_runs} for the Python loop), "
           f"summed:")
     for name, t in [("height(x, y) vectorised", vectorised_s),
-                    ("Python loop of height(xi, yi)", loop_s), ("C++ query loop", cpp_s)]:
+                    ("Python loop of height(xi, yi)", loop_s), ("C++ heights() batch", cpp_s),
+                    ("C++ loop of height()", cpp_loop_s)]:
         print(f"  {name:30s} {t * 1e3:8.1f} ms  ({t / args.points * 1e9:5.0f} ns/point)")
     print(f"  Python loop / vectorised: {loop_s / vectorised_s:.1f} x (target >= 5)")
-    print(f"  vectorised / C++ loop:    {vectorised_s / cpp_s:.2f} x (target <= 1.5)")
+    print(f"  vectorised / C++ batch:   {vectorised_s / cpp_s:.2f} x (target <= 1.5)")
+    print(f"  vectorised / C++ loop:    {vectorised_s / cpp_loop_s:.2f} x")
     print("By source (up to one block of the points the map answers so):")
     for name, (n, vec_s, py_s) in by_source.items():
         print(f"  {name:9s} {n:6d} points: vectorised {vec_s / n * 1e9:5.0f} ns/point, Python "

@@ -5,10 +5,11 @@
  *   multibin_query_table [--fill] MAP XY_IN TABLE_OUT
  *       x, y float64 pairs in; x, y, height, sigma, source float64 rows out (NaN where unknown);
  *       with --fill the gaps are filled first (a loaded map holds no fill: it is lazy)
- *   multibin_query_table [--fill] --time N MAP XY_IN
- *       the query loop over the points, timed per block of kTimedBlock points in CPU time of the
+ *   multibin_query_table [--fill] --time N [--one-by-one] MAP XY_IN
+ *       the query over the points, timed per block of kTimedBlock points in CPU time of the
  *       thread (the fastest of N runs of each block: a shared machine's other work is not
- *       counted); prints the sum of the blocks' times [s] */
+ *       counted); prints the sum of the blocks' times [s]. The block as one batch (the module's
+ *       queryHeights), or with --one-by-one a loop of single height() calls */
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/serialization/CArchive.h>
@@ -68,12 +69,16 @@ int main(int argc, char** argv) {
         std::vector<std::string> a(argv + 1, argv + argc);
         const bool fill = !a.empty() && a[0] == "--fill";
         if (fill) a.erase(a.begin());
+        const bool oneByOne = a.size() == 5 && a[0] == "--time" && a[2] == "--one-by-one";
+        if (oneByOne) a.erase(a.begin() + 2);
         const bool timing = a.size() == 4 && a[0] == "--time";
         if (!timing && a.size() != 3) {
             std::cerr << "usage: multibin_query_table [--fill] MAP XY_IN TABLE_OUT | [--fill] "
-                         "--time N MAP XY_IN\n";
+                         "--time N [--one-by-one] MAP XY_IN\n";
             return 2;
         }
+        const auto query =
+            oneByOne ? multibin::python::queryHeightsOneByOne : multibin::python::queryHeights;
         CMultiBinElevationMap map;
         loadMap(timing ? a[2] : a[0], map);
         if (fill) map.dem_update_map();
@@ -89,8 +94,8 @@ int main(int argc, char** argv) {
                 double best_s = 1e300;
                 for (int run = 0; run < std::stoi(a[1]); run++) {
                     const double t0_s = threadCpu_s();
-                    multibin::python::queryHeights(map, x.data() + b, y.data() + b, m, h.data() + b,
-                                                   s.data() + b, src.data() + b);
+                    query(map, x.data() + b, y.data() + b, m, h.data() + b, s.data() + b,
+                          src.data() + b);
                     best_s = std::min(best_s, threadCpu_s() - t0_s);
                 }
                 total_s += best_s;

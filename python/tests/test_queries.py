@@ -26,6 +26,27 @@ def test_height_of_a_non_contiguous_view_is_that_of_its_values(plane_map):
         np.testing.assert_array_equal(a, b)
 
 
+def test_height_over_an_array_is_height_at_each_point_bit_for_bit():
+    # A rough slope with a filled hole; the array goes through the map's batch query, a scalar
+    # through height() alone: points measured, filled, unknown, on cell borders and outside.
+    rng = np.random.default_rng(4)
+    pts, cov = plane_points(30000, size_m=1.0)
+    pts[:, 2] = 0.2 * pts[:, 0] + 0.03 * np.sin(9 * pts[:, 1]) + rng.normal(0, 0.003, len(pts))
+    keep = np.hypot(pts[:, 0] - 0.5, pts[:, 1] - 0.5) > 0.1
+    m = multibin.ElevationMap(resolution_m=0.05)
+    m.insert_points(pts[keep], cov[keep])
+    m.fill()
+    x, y = rng.uniform(-0.2, 1.2, 3000), rng.uniform(-0.2, 1.2, 3000)
+    x[::5] = np.round(x[::5] / 0.05) * 0.05
+    h, s, src = m.height(x, y)
+    one = [m.height(xi, yi) for xi, yi in zip(x.tolist(), y.tolist())]
+    assert {multibin.SOURCE_UNKNOWN, multibin.SOURCE_MEASURED} <= set(src.tolist())
+    assert np.any(src >= multibin.SOURCE_FILLED_MEDIAN)
+    np.testing.assert_array_equal(src, [int(a[2]) for a in one])
+    np.testing.assert_array_equal(h.view(np.uint64), np.array([float(a[0]) for a in one]).view(np.uint64))
+    np.testing.assert_array_equal(s.view(np.uint64), np.array([float(a[1]) for a in one]).view(np.uint64))
+
+
 def test_height_at_nan_coordinates_is_unknown(plane_map):
     h, s, src = plane_map.height([np.nan, 0.5], [0.5, np.inf])
     assert np.all(np.isnan(h)) and np.all(src == multibin.SOURCE_UNKNOWN)

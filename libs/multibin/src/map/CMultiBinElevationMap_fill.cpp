@@ -87,7 +87,13 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::elevationQuery(
     const multibin::MapLock::Shared lock(m_impl->lock);
     const bool measured = surfaceQuery(subCell, x_m, y_m, height_m, sigma_m);
     if (measured) return HeightSource::Measured;
-    if (!includeFilled || m_impl->fill.source.empty()) return HeightSource::Unknown;
+    return includeFilled ? filledQuery(x_m, y_m, height_m, sigma_m) : HeightSource::Unknown;
+}
+
+CMultiBinElevationMap::HeightSource CMultiBinElevationMap::filledQuery(double x_m, double y_m,
+                                                                       double& height_m,
+                                                                       double& sigma_m) const {
+    if (m_impl->fill.source.empty()) return HeightSource::Unknown;
     const int ix = m_impl->grid.cellIndex(x_m - m_impl->origin_m.x()),
               iy = m_impl->grid.cellIndex(y_m - m_impl->origin_m.y());
     if (!m_impl->fillWindow.contains(ix, iy)) return HeightSource::Unknown;

@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <utility>
+#include <vector>
 
 #include "multibin/map/BinUpdate.h"
 
@@ -228,40 +231,97 @@ bool gradientOf(const PlaneMoments& m, double points, Gradient& g) {
     return true;
 }
 
-/** The surfaces of the 4 x 4 cells from (ix0, iy0): every cell a heightAt query reads (the four
- * cells around the point and their neighbours), each computed once. */
-class PlanesAround {
-public:
-    PlanesAround(const BinGrid& grid, int ix0, int iy0, const BinUpdateParams& p)
-        : m_ix0(ix0), m_iy0(iy0) {
-        for (int j = 0; j < kSide; j++)
-            for (int i = 0; i < kSide; i++)
-                m_count[j][i] = cellPlanes(grid, ix0 + i, iy0 + j, p, m_planes[j][i]);
-    }
-    /** The planes of cell (ix, iy), which must lie in the 4 x 4; returns how many. */
-    int of(int ix, int iy, const CellPlane*& planes) const {
-        planes = m_planes[iy - m_iy0][ix - m_ix0];
-        return m_count[iy - m_iy0][ix - m_ix0];
-    }
-
-private:
-    static constexpr int kSide = 4;
-    int m_ix0, m_iy0;
-    CellPlane m_planes[kSide][kSide][kMaxSurfaces];
-    int m_count[kSide][kSide];
+/** The plane of one surface of a cell, as far as it does not depend on the query point: its
+ * gradient from the cell's and the agreeing neighbours' points, the variance at its centroid and
+ * the pose part. */
+struct SurfacePlane {
+    Gradient g;
+    double variance_m2 = 0;      //!< at the centroid, with the relief the plane misses [m^2]
+    double poseVariance_m2 = 0;  //!< CellSurface::poseVariance_m2 [m^2]
 };
 
-/** The plane of cell (ix, iy) at (x_m, y_m), which may lie outside the cell: the surface
- * that holds the point, its gradient from the cell's and the agreeing neighbours' points.
- * `around` holds the cell and its eight neighbours. */
-bool planeOfCellAt(const BinGrid& grid, const PlanesAround& around, int ix, int iy, double x_m,
-                   double y_m, CellSurface& out) {
+/** The cells heightAt reads, each computed on first use: its surfaces (cellPlanes) and their
+ * planes (SurfacePlane). Cell (ix, iy) has the slot (iy mod 4, ix mod columns), columns a power
+ * of 2 of at least 4: the 4 x 4 cells a query reads (the 2 x 2 around the point and their
+ * neighbours) never share a slot, and queries sorted by row and column find the cells of the
+ * queries before them. A slot holds its cell until another cell needs it. */
+class CellPlanesCache {
+public:
+    CellPlanesCache(const BinGrid& grid, const BinUpdateParams& p, int columnsLog2 = 2)
+        : m_grid(grid), m_params(p), m_columnMask((1 << std::max(columnsLog2, 2)) - 1) {
+        const size_t slots = size_t(4) * size_t(m_columnMask + 1);
+        if (slots > kInline) {  // a batch's: on the heap
+            m_heapTags.resize(slots);
+            m_heapSlots.reset(new Slot[slots]);
+            m_tags = m_heapTags.data();
+            m_slots = m_heapSlots.get();
+        }
+    }
+    CellPlanesCache(const CellPlanesCache&) = delete;
+    CellPlanesCache& operator=(const CellPlanesCache&) = delete;
+
+    /** The surfaces of cell (ix, iy); returns how many. */
+    int planesOf(int ix, int iy, const CellPlane*& planes) {
+        if (!m_grid.window().contains(ix, iy)) return 0;  // as cellPlanes: no bins there
+        const size_t k = slotOf(ix, iy);
+        planes = m_slots[k].surfaces;
+        return m_tags[k].count;
+    }
+    /** The plane of surface k of cell (ix, iy), which holds at least k + 1 surfaces. */
+    const SurfacePlane& planeOf(int ix, int iy, int k);
+    /** Computes the surfaces of the 4 x 4 cells from (ix0, iy0) not held yet, in one loop: the
+     * loads of their bins overlap there, as they do not between the planes' arithmetic. */
+    void readCells(int ix0, int iy0) {
+        for (int iy = iy0; iy < iy0 + 4; iy++)
+            for (int ix = ix0; ix < ix0 + 4; ix++)
+                if (m_grid.window().contains(ix, iy)) slotOf(ix, iy);
+    }
+    const BinGrid& grid() const { return m_grid; }
+
+private:
+    struct Tag {
+        int ix = 0, iy = 0;
+        int count = -1;       //!< surfaces; -1: the slot holds no cell yet
+        unsigned planes = 0;  //!< bit k: planes[k] computed
+    };
+    struct Slot {
+        Slot() {}  // written before read: a large cache costs only the slots queries use
+        union {
+            CellPlane surfaces[kMaxSurfaces];
+        };
+        union {
+            SurfacePlane planes[kMaxSurfaces];
+        };
+    };
+    /** The slots of one query (4 x 4), kept in the object: a single query allocates nothing. */
+    static constexpr size_t kInline = 16;
+
+    size_t slotOf(int ix, int iy) {
+        const size_t k = size_t(iy & 3) * size_t(m_columnMask + 1) + size_t(ix & m_columnMask);
+        Tag& t = m_tags[k];
+        if (t.count < 0 || t.ix != ix || t.iy != iy)
+            t = Tag{ix, iy, cellPlanes(m_grid, ix, iy, m_params, m_slots[k].surfaces), 0};
+        return k;
+    }
+
+    const BinGrid& m_grid;
+    const BinUpdateParams m_params;
+    const int m_columnMask;
+    Tag m_inlineTags[kInline];
+    Slot m_inlineSlots[kInline];
+    std::vector<Tag> m_heapTags;
+    std::unique_ptr<Slot[]> m_heapSlots;
+    Tag* m_tags = m_inlineTags;
+    Slot* m_slots = m_inlineSlots;
+};
+
+/** The plane of surface `surface` of cell (ix, iy): its gradient from the cell's and the agreeing
+ * neighbours' points. `cache` holds the cell and its eight neighbours. */
+void surfacePlane(CellPlanesCache& cache, int ix, int iy, int surface, SurfacePlane& out) {
     const CellPlane* planes;
-    const int count = around.of(ix, iy, planes);
-    if (count == 0) return false;
-    const double s = grid.cellSize_m();
-    const double qx = x_m - grid.cellCenter_m(ix), qy = y_m - grid.cellCenter_m(iy);
-    const CellPlane& own = planes[surfaceHolding(planes, count, qx, qy, s)];
+    cache.planesOf(ix, iy, planes);
+    const CellPlane& own = planes[surface];
+    const double s = cache.grid().cellSize_m();
     const PlaneMoments& m = own.moments;
     const double h = own.surface.height_m, hVar = own.surface.variance_m2;
     Gradient gOwn;
@@ -273,7 +333,7 @@ bool planeOfCellAt(const BinGrid& grid, const PlanesAround& around, int ix, int 
     for (int dy = -1; dy <= 1; dy++)
         for (int dx = -1; dx <= 1; dx++) {
             const CellPlane* nb = nullptr;
-            const int nbCount = (dx == 0 && dy == 0) ? 0 : around.of(ix + dx, iy + dy, nb);
+            const int nbCount = (dx == 0 && dy == 0) ? 0 : cache.planesOf(ix + dx, iy + dy, nb);
             for (int k = 0; k < nbCount; k++) {
                 if (!(nb[k].moments.weight > 0)) continue;
                 const double ex = dx * s + nb[k].moments.mx_m - m.mx_m;
@@ -291,24 +351,49 @@ bool planeOfCellAt(const BinGrid& grid, const PlanesAround& around, int ix, int 
                 break;
             }
         }
-    Gradient g;
+    Gradient& g = out.g;
     if (!gradientOf(window, windowPoints, g)) g = gOwn;
-    // Without points (a map loaded from a file keeps no moments) the centroid is the centre.
-    const double ex = qx - m.mx_m, ey = qy - m.my_m;
-    out = own.surface;
-    out.height_m = h + g.gx * ex + g.gy * ey;
     // The points' scatter around the plane beyond their own variances: it widens h's variance,
     // and the truth at the query point departs from the plane by as much (the relief the plane
     // does not follow).
     const double relief_m2 =
         window.weight > 0 ? (g.chi2 - 1) * windowPoints / double(window.weight) : 0.0;
-    out.variance_m2 =
-        std::max(hVar, m.weight > 0 ? g.chi2 / m.weight : 0.0) + relief_m2 + g.variance(ex, ey);
+    out.variance_m2 = std::max(hVar, m.weight > 0 ? g.chi2 / m.weight : 0.0) + relief_m2;
     // A pose error moves the surface sideways too, shared by the points like its height part: on
     // a slope g the height at a fixed place changes by g . (horizontal shift).
     out.poseVariance_m2 =
         own.surface.poseVariance_m2 +
         poseVariance_m2(own.poseHorizontalSigmaCode) * (g.gx * g.gx + g.gy * g.gy);
+}
+
+const SurfacePlane& CellPlanesCache::planeOf(int ix, int iy, int k) {
+    const size_t slot = slotOf(ix, iy);
+    if (!(m_tags[slot].planes & (1u << k))) {
+        surfacePlane(*this, ix, iy, k, m_slots[slot].planes[k]);  // its neighbours: other slots
+        m_tags[slot].planes |= 1u << k;
+    }
+    return m_slots[slot].planes[k];
+}
+
+/** The plane of cell (ix, iy) at (x_m, y_m), which may lie outside the cell: the surface
+ * that holds the point, its plane from the cell's and the agreeing neighbours' points. */
+bool planeOfCellAt(CellPlanesCache& cache, int ix, int iy, double x_m, double y_m,
+                   CellSurface& out) {
+    const CellPlane* planes;
+    const int count = cache.planesOf(ix, iy, planes);
+    if (count == 0) return false;
+    const BinGrid& grid = cache.grid();
+    const double s = grid.cellSize_m();
+    const double qx = x_m - grid.cellCenter_m(ix), qy = y_m - grid.cellCenter_m(iy);
+    const int k = count == 1 ? 0 : surfaceHolding(planes, count, qx, qy, s);  // 1: no choice
+    const PlaneMoments& m = planes[k].moments;
+    const SurfacePlane& plane = cache.planeOf(ix, iy, k);
+    // Without points (a map loaded from a file keeps no moments) the centroid is the centre.
+    const double ex = qx - m.mx_m, ey = qy - m.my_m;
+    out = planes[k].surface;
+    out.height_m = planes[k].surface.height_m + plane.g.gx * ex + plane.g.gy * ey;
+    out.variance_m2 = plane.variance_m2 + plane.g.variance(ex, ey);
+    out.poseVariance_m2 = plane.poseVariance_m2;
     return true;
 }
 
@@ -317,13 +402,16 @@ bool planeOfCellAt(const BinGrid& grid, const PlanesAround& around, int ix, int 
  * agrees with the point's own cell within 3 sigma of the planes (never across a step). One
  * cell's plane carries its few points' noise; the blend averages four such estimates, as
  * bilinear interpolation of cell values does, while each keeps its slope. */
-bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateParams& p,
-                   bool reliefSigma, CellSurface& out) {
+bool planeHeightAt(CellPlanesCache& cache, double x_m, double y_m, bool reliefSigma,
+                   CellSurface& out) {
+    const BinGrid& grid = cache.grid();
     const int ix = grid.cellIndex(x_m), iy = grid.cellIndex(y_m);
     const double s = grid.cellSize_m();
     const int bx = grid.cellIndex(x_m - 0.5 * s), by = grid.cellIndex(y_m - 0.5 * s);
-    const PlanesAround around(grid, bx - 1, by - 1, p);
-    if (!planeOfCellAt(grid, around, ix, iy, x_m, y_m, out)) return false;
+    const CellPlane* planes;
+    if (cache.planesOf(ix, iy, planes) == 0) return false;
+    cache.readCells(bx - 1, by - 1);
+    planeOfCellAt(cache, ix, iy, x_m, y_m, out);
     const double fx = (x_m - grid.cellCenter_m(bx)) / s, fy = (y_m - grid.cellCenter_m(by)) / s;
     const CellSurface own = out;
     double weightSum = 0, heightSum = 0, varianceSum = 0;
@@ -332,7 +420,7 @@ bool planeHeightAt(const BinGrid& grid, double x_m, double y_m, const BinUpdateP
             const double w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
             CellSurface c = own;
             if (bx + i != ix || by + j != iy) {
-                if (!planeOfCellAt(grid, around, bx + i, by + j, x_m, y_m, c)) continue;
+                if (!planeOfCellAt(cache, bx + i, by + j, x_m, y_m, c)) continue;
                 const double d = c.height_m - own.height_m;
                 if (d * d > 9.0 * (c.variance_m2 + own.variance_m2)) continue;
             }
@@ -387,12 +475,54 @@ bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m
     return combineGrids(haveG, g, haveL, l, out);
 }
 
+namespace {
+/** heightAt over the cells of `grid` and, if not null, of the local grid. */
+bool heightOnGrids(CellPlanesCache& grid, CellPlanesCache* local, double x_m, double y_m,
+                   bool reliefSigma, CellSurface& out) {
+    CellSurface g, l;
+    const bool haveG = planeHeightAt(grid, x_m, y_m, reliefSigma, g);
+    const bool haveL = local && planeHeightAt(*local, x_m, y_m, reliefSigma, l);
+    return combineGrids(haveG, g, haveL, l, out);
+}
+
+/** The exponent of the power of 2 of slot columns for queries spanning `xSpan_m` in x: the
+ * span's cells and the 3 more a query reads beyond them, at most the window's width and 4096
+ * (12 MB of slots, touched as used; a wider row computes its cells up to 4 times). */
+int columnsLog2(const BinGrid& grid, double xSpan_m) {
+    const double spanned = xSpan_m / grid.cellSize_m() + 4.0, window = grid.window().nx;
+    const double columns = spanned < window ? spanned : window;  // NaN: the window
+    int bits = 2;
+    while (bits < 12 && double(1 << bits) < columns) bits++;
+    return bits;
+}
+}  // namespace
+
 bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
               const BinUpdateParams& p, bool reliefSigma, CellSurface& out) {
-    CellSurface g, l;
-    const bool haveG = planeHeightAt(grid, x_m, y_m, p, reliefSigma, g);
-    const bool haveL = local && planeHeightAt(*local, x_m, y_m, p, reliefSigma, l);
-    return combineGrids(haveG, g, haveL, l, out);
+    CellPlanesCache g(grid, p);  // one query's 4 x 4 cells, in the object
+    if (!local) return heightOnGrids(g, nullptr, x_m, y_m, reliefSigma, out);
+    CellPlanesCache l(*local, p);
+    return heightOnGrids(g, &l, x_m, y_m, reliefSigma, out);
+}
+
+struct HeightAtCache::Impl {
+    Impl(const BinGrid& grid, const BinGrid* local, const BinUpdateParams& p, double xSpan_m)
+        : global(grid, p, columnsLog2(grid, xSpan_m)) {
+        if (local) this->local.emplace(*local, p, columnsLog2(*local, xSpan_m));
+    }
+    CellPlanesCache global;
+    std::optional<CellPlanesCache> local;
+};
+
+HeightAtCache::HeightAtCache(const BinGrid& grid, const BinGrid* local, const BinUpdateParams& p,
+                             double xSpan_m)
+    : m_impl(std::make_unique<Impl>(grid, local, p, xSpan_m)) {}
+
+HeightAtCache::~HeightAtCache() = default;
+
+bool HeightAtCache::heightAt(double x_m, double y_m, bool reliefSigma, CellSurface& out) {
+    return heightOnGrids(m_impl->global, m_impl->local ? &*m_impl->local : nullptr, x_m, y_m,
+                         reliefSigma, out);
 }
 
 }  // namespace multibin

@@ -273,6 +273,10 @@ public:
      * query). dem_get_z() and getHeight() answer through it; the other queries are variants
      * (doc/user-guide.md, "Height queries"). */
     HeightAnswer height(double x_m, double y_m) const;
+    /** height() at n points: out[i] is height(x_m[i], y_m[i]) bit for bit, under one read lock;
+     * the work of a cell is done once for the points near it (points sorted or on a grid share
+     * most; the answers keep the points' order). */
+    void heights(const double* x_m, const double* y_m, size_t n, HeightAnswer* out) const;
 
     const multibin::BinGrid& grid() const;
     multibin::BinUpdateParams binUpdateParams() const;
@@ -466,6 +470,9 @@ private:
      * where it filled the cell of (x, y). */
     HeightSource elevationQuery(bool subCell, double x_m, double y_m, double& height_m,
                                 double& sigma_m, bool includeFilled) const;
+    /** The last gap filling's height where it filled the cell of (x, y), else Unknown (the
+     * caller holds the lock): elevationQuery() where unmeasured. */
+    HeightSource filledQuery(double x_m, double y_m, double& height_m, double& sigma_m) const;
     /** Gap filling of the whole window into the last fill (the caller holds the lock for
      * writing): dem_update_map()'s work. */
     void fillNow() const;

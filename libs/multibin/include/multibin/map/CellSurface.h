@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
+#include <memory>
+
 #include "multibin/map/BinGrid.h"
 #include "multibin/map/MapTypes.h"
 
@@ -74,6 +76,30 @@ bool surfaceAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m
  * reportedVariance_m2() is what a query reports. False if neither grid has a surface there. */
 bool heightAt(const BinGrid& grid, const BinGrid* local, double x_m, double y_m,
               const BinUpdateParams& params, bool reliefSigma, CellSurface& out);
+
+/** heightAt over many points: the work of a cell (its surfaces, each surface's plane from its
+ * neighbours) done once for the queries that read it, while the grids do not change (the
+ * caller holds the map's lock). Answers bit for bit as heightAt. A grid's cells are kept in 4
+ * rows of slots as wide as the queries' x span (at most the window's width and 4096 cells):
+ * queries in the order of their cells (rows, then columns) compute each cell about once; any
+ * order is correct. */
+class HeightAtCache {
+public:
+    /** For queries on `grid` and, with a dual grid, `local` (null otherwise), spanning
+     * `xSpan_m` in x. */
+    HeightAtCache(const BinGrid& grid, const BinGrid* local, const BinUpdateParams& params,
+                  double xSpan_m);
+    ~HeightAtCache();
+    HeightAtCache(const HeightAtCache&) = delete;
+    HeightAtCache& operator=(const HeightAtCache&) = delete;
+
+    /** heightAt(grid, local, x_m, y_m, params, reliefSigma, out). */
+    bool heightAt(double x_m, double y_m, bool reliefSigma, CellSurface& out);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
 
 /** The slope sigma assumed where no points give one [-]: 45 degrees. */
 constexpr double kUnknownSlope = 1.0;
