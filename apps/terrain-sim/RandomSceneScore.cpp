@@ -131,9 +131,10 @@ RandomSceneScores::CellKind cellKind(const CMultiBinElevationMap& map, double x,
                : RandomSceneScores::GroundWins;
 }
 
-void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomSceneScores& s) {
+void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, Maps& without,
+                 RandomSceneScores& s) {
     const int last = sc.passes.back().placement;
-    Rms dem, mrptMean;
+    Rms dem, mrptMean, noObject;
     double worst = 0;
     for (int r = 0; r < reg.gt.rows(); ++r)
         for (int k = 0; k < reg.gt.cols(); ++k) {
@@ -150,6 +151,8 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomScene
                 continue;
             }
             dem.add(z - truth);
+            double z0;
+            if (without.map.dem_get_z(x, y, z0)) noObject.add(z0 - truth);
             worst = std::max(worst, std::abs(z - truth));
             const auto kind = cellKind(m.map, x, y, truth);
             s.objectSquaredError_m2[kind] += (z - truth) * (z - truth);
@@ -160,6 +163,7 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomScene
     s.objectCells = dem.n;
     s.objectRmse_m = dem.value();
     s.objectMrptRmse_m = mrptMean.value();
+    s.objectNoObjectRmse_m = noObject.value();
     s.objectWorstError_m = dem.n ? worst : RandomSceneScores::kNaN;
 }
 
@@ -236,7 +240,7 @@ RandomSceneScores scoreRandomScene(const RandomScene& sc,
     const multibin::EsriAsciiGrid gt = sc.ground.groundTruth(with.map.dem_get_resolution());
     const Regions reg(gt, sc.placements);
     RandomSceneScores s;
-    scoreObject(sc, reg, with, s);
+    scoreObject(sc, reg, with, without, s);
     scoreStaticAndFilled(reg, with, without, s);
     scoreQueries(sc, reg, with, s);
     return s;

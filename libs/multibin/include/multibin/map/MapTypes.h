@@ -66,11 +66,19 @@ struct VisibilityParams {
      * the default equal to the certainty increment, a moved object is forgotten as fast as the
      * new surface is learnt. */
     float certaintyDecrement = 1.0f;
+    /** The share [0, 1] of the certainty it keeps after the decrement that a bin above a line of
+     * sight loses to each ray (a bin as certain as the target's surface or more; a less certain
+     * one goes at once): 0 is the paper's rule. A vertical face collects tens of points per cell
+     * and pass where ground collects a few, so a point count outweighs every later ray; halving
+     * per ray lets the rays of one pass clear an object that left (doc/random-scenes.md). 1
+     * removes the bin. */
+    float certaintyShare = 0.5f;
 
     /** The options protocol of every option struct of the library (map, fill, sensors,
      * visibility): read its keys from a strict ini section, write them, validate (throws
      * std::invalid_argument naming the key). Keys: visibility_constraint,
-     * visibility_margin_m (alias visibility_margin), visibility_certainty_decrement. */
+     * visibility_margin_m (alias visibility_margin), visibility_certainty_decrement,
+     * visibility_certainty_share. */
     void read(StrictConfigSection& section);
     void write(mrpt::config::CConfigFileBase& target, const std::string& section) const;
     void validate() const;
