@@ -66,12 +66,11 @@ struct VisibilityParams {
      * the default equal to the certainty increment, a moved object is forgotten as fast as the
      * new surface is learnt. */
     float certaintyDecrement = 1.0f;
-    /** The share [0, 1] of the certainty it keeps after the decrement that a bin above a line of
-     * sight loses to each ray (a bin as certain as the target's surface or more; a less certain
-     * one goes at once): 0 is the paper's rule. A vertical face collects tens of points per cell
-     * and pass where ground collects a few, so a point count outweighs every later ray; halving
-     * per ray lets the rays of one pass clear an object that left (doc/random-scenes.md). 1
-     * removes the bin. */
+    /** What a bin above a line of sight (and as certain as the ray's target or more; a less
+     * certain one goes at once) loses per ray after the decrement: this share [0, 1] of the
+     * certainty left. 0 is the paper's fixed amount, 1 removes the bin. A vertical face collects
+     * tens of points per cell and pass where ground collects a few, so with a fixed amount per
+     * point the face outweighs every later ray through where it stood (doc/visibility.md). */
     float certaintyShare = 0.5f;
 
     /** The options protocol of every option struct of the library (map, fill, sensors,
