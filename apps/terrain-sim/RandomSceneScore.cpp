@@ -18,15 +18,18 @@ namespace {
 using mrpt::maps::CHeightGridMap2D;
 using mrpt::maps::CMultiBinElevationMap;
 
+using CellMask = Eigen::Matrix<bool, Eigen::Dynamic, Eigen::Dynamic>;
+
 struct Maps {
     CMultiBinElevationMap map;  // default options
     std::unique_ptr<CHeightGridMap2D> mrptMean;
+    std::vector<CellMask> hitInPass;  //!< per pass, the truth raster's cells a point fell in
 };
 
 /** Every pass's laser scans into the map and, as points, into MRPT's mean height grid. The noise
  * streams depend on the seed and the pass only, so the runs with and without the object draw
  * alike. */
-void mapPasses(const RandomScene& sc, bool withObject, Maps& m) {
+void mapPasses(const RandomScene& sc, bool withObject, const multibin::EsriAsciiGrid& gt, Maps& m) {
     const Terrain& g = sc.ground;
     const double cell = m.map.dem_get_resolution();
     m.mrptMean = std::make_unique<CHeightGridMap2D>(CHeightGridMap2D::mrSimpleAverage,
@@ -37,6 +40,8 @@ void mapPasses(const RandomScene& sc, bool withObject, Maps& m) {
         const SurfaceTexture texture(seen, sc.seed, sc.darkPatches);
         const LaserSim laser(sc.laser, seen, texture, sc.seed);
         std::mt19937_64 rng(hash64(sc.seed * 1000003 + p));
+        CellMask& hit = m.hitInPass.emplace_back(gt.rows(), gt.cols());
+        hit.setConstant(false);
         for (const Frame& f : sc.passes[p].frames) {
             const auto scan = laser.scan(f.truth, syntheticStamp(f.t_s + 100.0 * p), rng);
             m.map.insertObservation(*scan, f.estimate);
@@ -48,6 +53,10 @@ void mapPasses(const RandomScene& sc, bool withObject, Maps& m) {
                 float x, y, z;
                 points.getPoint(k, x, y, z);
                 m.mrptMean->insertIndividualPoint(x, y, z, ip);
+                const long col = std::lround((x - gt.xllcenter_m) / gt.cellsize_m);
+                const long row = std::lround((y - gt.yllcenter_m) / gt.cellsize_m);
+                if (row >= 0 && col >= 0 && row < gt.rows() && col < gt.cols())
+                    hit(row, col) = true;
             }
         }
     }
@@ -131,14 +140,25 @@ RandomSceneScores::CellKind cellKind(const CMultiBinElevationMap& map, double x,
                : RandomSceneScores::GroundWins;
 }
 
-void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomSceneScores& s) {
+void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, Maps& without,
+                 RandomSceneScores& s) {
     const int last = sc.passes.back().placement;
-    Rms dem, mrptMean;
+    Rms dem, mrptMean, noObject, seenAfter;
+    // The last pass each placement was seen in: a cell of it is seen again if a later pass put a
+    // point in it.
+    std::vector<size_t> lastPassAt(sc.placements.size(), 0);
+    for (size_t p = 0; p < sc.passes.size(); ++p)
+        if (sc.passes[p].placement >= 0) lastPassAt[sc.passes[p].placement] = p;
     double worst = 0;
     for (int r = 0; r < reg.gt.rows(); ++r)
         for (int k = 0; k < reg.gt.cols(); ++k) {
-            bool vacated = false;
-            for (int v : sc.vacatedPlacements()) vacated = vacated || reg.grown[v](r, k);
+            bool vacated = false, seenAgain = false;
+            for (int v : sc.vacatedPlacements()) {
+                if (!reg.grown[v](r, k)) continue;
+                vacated = true;
+                for (size_t p = lastPassAt[v] + 1; p < m.hitInPass.size(); ++p)
+                    seenAgain = seenAgain || m.hitInPass[p](r, k);
+            }
             if (!vacated || (last >= 0 && reg.grown[last](r, k))) continue;
             const double x = reg.gt.xllcenter_m + k * reg.gt.cellsize_m;
             const double y = reg.gt.yllcenter_m + r * reg.gt.cellsize_m;
@@ -150,6 +170,9 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomScene
                 continue;
             }
             dem.add(z - truth);
+            if (seenAgain) seenAfter.add(z - truth);
+            double z0;
+            if (without.map.dem_get_z(x, y, z0)) noObject.add(z0 - truth);
             worst = std::max(worst, std::abs(z - truth));
             const auto kind = cellKind(m.map, x, y, truth);
             s.objectSquaredError_m2[kind] += (z - truth) * (z - truth);
@@ -160,6 +183,9 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, RandomScene
     s.objectCells = dem.n;
     s.objectRmse_m = dem.value();
     s.objectMrptRmse_m = mrptMean.value();
+    s.objectNoObjectRmse_m = noObject.value();
+    s.objectSeenAgainRmse_m = seenAfter.value();
+    s.objectSeenAgainCells = seenAfter.n;
     s.objectWorstError_m = dem.n ? worst : RandomSceneScores::kNaN;
 }
 
@@ -231,12 +257,12 @@ RandomSceneScores scoreRandomScene(const RandomScene& sc,
         configure(with.map);
         configure(without.map);
     }
-    mapPasses(sc, true, with);
-    mapPasses(sc, false, without);
     const multibin::EsriAsciiGrid gt = sc.ground.groundTruth(with.map.dem_get_resolution());
+    mapPasses(sc, true, gt, with);
+    mapPasses(sc, false, gt, without);
     const Regions reg(gt, sc.placements);
     RandomSceneScores s;
-    scoreObject(sc, reg, with, s);
+    scoreObject(sc, reg, with, without, s);
     scoreStaticAndFilled(reg, with, without, s);
     scoreQueries(sc, reg, with, s);
     return s;

@@ -21,6 +21,12 @@ struct RandomSceneScores {
     /** Vacated object: cells over a footprint the object left, grown by one cell. RMSE from the
      * ground of dem_get_z (after dem_update_map) and of MRPT's mean [m]. */
     double objectRmse_m = kNaN, objectMrptRmse_m = kNaN;
+    /** The same cells in the map of the scene with the object never there: the floor [m]. */
+    double objectNoObjectRmse_m = kNaN;
+    /** The same over the cells a pass after the object left put a laser point in (the others
+     * no observation could correct) [m], and their number. */
+    double objectSeenAgainRmse_m = kNaN;
+    size_t objectSeenAgainCells = 0;
     size_t objectCells = 0, objectUnknown = 0;
     double objectWorstError_m = kNaN;  //!< largest |DEM - ground| over those cells [m]
     /** What those cells hold at the end (a bin "at the ground" lies within 30 mm of the truth),

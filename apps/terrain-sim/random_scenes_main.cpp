@@ -99,6 +99,8 @@ int main(int argc, char** argv) {
     }
     Quantity object{"moved object RMSE, footprint + 1 cell [mm]", "<= 15 mm in 90 %", {}, {}};
     Quantity mrptObject{"  MRPT's mean there [mm]", "-", {}, {}};
+    Quantity noObject{"  the map there, the object never there [mm]", "-", {}, {}};
+    Quantity seenAgain{"  the cells a later pass saw again [mm]", "<= 15 mm in 90 %", {}, {}};
     // "No worse than without the object": the two runs draw the same noise streams, but a beam
     // that meets the object draws differently from there on, so 2 % is the runs' own spread.
     Quantity staticRatio{"static terrain RMSE, with / without the object", "<= 1.02", {}, {}};
@@ -113,19 +115,22 @@ int main(int argc, char** argv) {
                 noise.c_str(), (unsigned long)first, (unsigned long)last,
                 ini.empty() ? "" : " --ini ", ini.c_str());
     std::printf(
-        "# seed object_mm mrpt_mm unknown static_mm static_noobj_mm static_mrpt_mm filled_mm "
+        "# seed object_mm mrpt_mm object_noobj_mm object_seen_mm seen_n/cells unknown static_mm "
+        "static_noobj_mm static_mrpt_mm "
+        "filled_mm "
         "filled_n "
         "query_mm query_mrpt_mm query_floor_mm | scene\n");
     for (uint64_t seed = first; seed <= last; ++seed) {
         opts.seed = seed;
         const RandomScene sc = makeRandomScene(opts);
         const RandomSceneScores s = scoreRandomScene(sc, configure);
-        std::printf("%lu %.1f %.1f %zu %.2f %.2f %.2f %.1f %zu %.2f %.2f %.2f | %s\n",
-                    (unsigned long)seed, 1e3 * s.objectRmse_m, 1e3 * s.objectMrptRmse_m,
-                    s.objectUnknown, 1e3 * s.staticRmse_m, 1e3 * s.staticRmseNoObject_m,
-                    1e3 * s.staticMrptRmse_m, 1e3 * s.filledRmse_m, s.filledCells,
-                    1e3 * s.queryRmse_m, 1e3 * s.queryMrptRmse_m, 1e3 * s.queryFloorRmse_m,
-                    sc.describe().c_str());
+        std::printf(
+            "%lu %.1f %.1f %.1f %.1f %zu/%zu %zu %.2f %.2f %.2f %.1f %zu %.2f %.2f %.2f | %s\n",
+            (unsigned long)seed, 1e3 * s.objectRmse_m, 1e3 * s.objectMrptRmse_m,
+            1e3 * s.objectNoObjectRmse_m, 1e3 * s.objectSeenAgainRmse_m, s.objectSeenAgainCells,
+            s.objectCells, s.objectUnknown, 1e3 * s.staticRmse_m, 1e3 * s.staticRmseNoObject_m,
+            1e3 * s.staticMrptRmse_m, 1e3 * s.filledRmse_m, s.filledCells, 1e3 * s.queryRmse_m,
+            1e3 * s.queryMrptRmse_m, 1e3 * s.queryFloorRmse_m, sc.describe().c_str());
         std::fflush(stdout);
         record(object, 1e3 * s.objectRmse_m, s.objectRmse_m > 0.015, seed);
         for (int k = 0; k < RandomSceneScores::kCellKinds && s.objectRmse_m > 0.015; ++k) {
@@ -133,6 +138,8 @@ int main(int argc, char** argv) {
             failingCells[k] += s.objectCellsOfKind[k];
         }
         record(mrptObject, 1e3 * s.objectMrptRmse_m, false, seed);
+        record(noObject, 1e3 * s.objectNoObjectRmse_m, false, seed);
+        record(seenAgain, 1e3 * s.objectSeenAgainRmse_m, s.objectSeenAgainRmse_m > 0.015, seed);
         const double ratio = s.staticRmse_m / s.staticRmseNoObject_m;
         record(staticRatio, ratio, ratio > 1.02, seed);
         record(staticMrpt, s.staticRmse_m / s.staticMrptRmse_m, false, seed);
@@ -143,8 +150,8 @@ int main(int argc, char** argv) {
     }
     std::printf("\n| quantity | bound | scenes | median | 90th pct | worst | failing scenes |\n");
     std::printf("| --- | --- | ---: | ---: | ---: | ---: | --- |\n");
-    for (const Quantity* q :
-         {&object, &mrptObject, &staticRatio, &staticMrpt, &filled, &query, &queryFloor}) {
+    for (const Quantity* q : {&object, &mrptObject, &noObject, &seenAgain, &staticRatio,
+                              &staticMrpt, &filled, &query, &queryFloor}) {
         std::string fails;
         for (const auto& f : q->failing) fails += (fails.empty() ? "" : " ") + f;
         std::printf("| %s | %s | %zu | %.3g | %.3g | %.3g | %zu: %s |\n", q->name, q->bound,

@@ -179,8 +179,9 @@ TEST(OptionKeys, RuleTextsSayTheRule) {
 TEST(OptionKeys, BrokenRulesReachTheUserWholeThroughMrptsInitializers) {
     const std::string dir = std::string(MULTIBIN_BINARY_DIR) + "/test_option_keys";
     std::filesystem::create_directories(dir);
-    for (const std::string key : {"fill_median_window_cells = 4", "visibility_margin_m = -1",
-                                  "stereo_halo_jump_px = 0", "fill_pso_particles = 0"}) {
+    for (const std::string key :
+         {"fill_median_window_cells = 4", "visibility_margin_m = -1", "stereo_halo_jump_px = 0",
+          "fill_pso_particles = 0", "visibility_certainty_share = 1.5"}) {
         SCOPED_TRACE(key);
         const std::string path = dir + "/broken.ini";
         std::ofstream(path) << "[map]\nmultiBinElevationMap_count = 1\n"

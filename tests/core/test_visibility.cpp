@@ -88,19 +88,25 @@ TEST(Visibility, OccluderIsWeighedAgainstTheCellSurfaceNotItsWinningBin) {
 }
 
 TEST(Visibility, MoreCertainOccluderOnlyLosesCertainty) {
-    BinGrid g(0.1);
-    g.reset(0.1, CellWindow{-5, -5, 30, 10});
-    BinUpdateParams p;
-    VisibilityParams v;
-    g.beginCycle();
-    for (int i = 0; i < 5; i++) g.insertPoints({pointAt(1.05, 0.05, 0.30, 0.005)}, p);
-    g.beginCycle();
-    g.insertPoints({pointAt(2.05, 0.05, 0.0, 0.005)}, p);
-    const VisibilityStats s = applyVisibilityConstraint(g, {0.05, 0.05, 0.5}, v, p);
-    EXPECT_EQ(s.binsRemoved, 0u);
-    EXPECT_EQ(s.binsWeakened, 1u);
-    ASSERT_NE(g.winningBin(10, 0), nullptr);
-    EXPECT_FLOAT_EQ(g.winningBin(10, 0)->certainty, 4.f);
+    // One contradicting point: the decrement (1), then the share of the rest: (5 - 1) x 0.5 by
+    // default; the paper's fixed amount with share 0.
+    for (const float share : {0.5f, 0.0f}) {
+        SCOPED_TRACE(share);
+        BinGrid g(0.1);
+        g.reset(0.1, CellWindow{-5, -5, 30, 10});
+        BinUpdateParams p;
+        VisibilityParams v;
+        v.certaintyShare = share;
+        g.beginCycle();
+        for (int i = 0; i < 5; i++) g.insertPoints({pointAt(1.05, 0.05, 0.30, 0.005)}, p);
+        g.beginCycle();
+        g.insertPoints({pointAt(2.05, 0.05, 0.0, 0.005)}, p);
+        const VisibilityStats s = applyVisibilityConstraint(g, {0.05, 0.05, 0.5}, v, p);
+        EXPECT_EQ(s.binsRemoved, 0u);
+        EXPECT_EQ(s.binsWeakened, 1u);
+        ASSERT_NE(g.winningBin(10, 0), nullptr);
+        EXPECT_FLOAT_EQ(g.winningBin(10, 0)->certainty, share > 0 ? 2.f : 4.f);
+    }
 }
 
 TEST(Visibility, ConsistentTerrainIsUntouched) {

@@ -18,6 +18,7 @@ void visitKeys(Params& o, Visit&& visit) {
     visit("visibility_constraint", o.enabled);
     visit({"visibility_margin_m", "visibility_margin"}, o.margin_m, atLeast(0, "m"));
     visit("visibility_certainty_decrement", o.certaintyDecrement, positive());
+    visit("visibility_certainty_share", o.certaintyShare, between(0, 1));
 }
 }  // namespace
 

@@ -166,7 +166,7 @@ public:
          * update the global grid; all others update the local grid. */
         std::vector<std::string> global_sensor_labels{"STEREO"};
         /** Visibility constraint after each observation (keys `visibility_constraint`,
-         * `visibility_margin`, `visibility_certainty_decrement`). */
+         * `visibility_margin`, `visibility_certainty_decrement`, `visibility_certainty_share`). */
         multibin::VisibilityParams visibility;
         /** Sensor models: laser, stereo, depth camera (keys `laser_*`, `stereo_*`, `depth_*`). */
         multibin::sensors::SensorModelOptions sensors;

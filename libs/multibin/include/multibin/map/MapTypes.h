@@ -67,11 +67,18 @@ struct VisibilityParams {
      * the default equal to the certainty increment, a moved object is forgotten as fast as the
      * new surface is learnt. */
     float certaintyDecrement = 1.0f;
+    /** What a bin above a line of sight (and as certain as the ray's target or more; a less
+     * certain one goes at once) loses per ray after the decrement: this share [0, 1] of the
+     * certainty left. 0 is the paper's fixed amount, 1 removes the bin. A vertical face collects
+     * tens of points per cell and pass where ground collects a few, so with a fixed amount per
+     * point the face outweighs every later ray through where it stood (doc/visibility.md). */
+    float certaintyShare = 0.5f;
 
     /** The options protocol of every option struct of the library (map, fill, sensors,
      * visibility): read its keys from a strict ini section, write them, validate (throws
      * std::invalid_argument naming the key). Keys: visibility_constraint,
-     * visibility_margin_m (alias visibility_margin), visibility_certainty_decrement. */
+     * visibility_margin_m (alias visibility_margin), visibility_certainty_decrement,
+     * visibility_certainty_share. */
     void read(StrictConfigSection& section);
     void write(mrpt::config::CConfigFileBase& target, const std::string& section) const;
     void validate() const;

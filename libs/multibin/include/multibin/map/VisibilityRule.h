@@ -15,7 +15,8 @@ namespace multibin {
  * clears the highest bin stored anywhere (or leaves the window): in each cell it enters that was
  * not updated in this cycle, a bin above the line (ConflictTest) is stale. It is removed if it is
  * less certain than the updated cell's surface (CellSurface), otherwise it loses
- * `certaintyDecrement` per new point (and is removed at 0).
+ * `certaintyDecrement` per new point and then `certaintyShare` of what it keeps (and is removed
+ * at 0; a share of 0 is the paper's fixed amount).
  *
  * This is the oracle: applyVisibilityConstraint (the fast path) must edit exactly the bins this
  * edits, bit for bit, with the same counts of rays, removals and weakenings. Its cost is rays x
@@ -37,6 +38,7 @@ public:
     /** The smallest margin any bin can have (its variance at the floor): a bound no higher than
      * this above a line holds no conflicting bin. */
     double minMargin_m() const { return m_minMargin_m; }
+    const VisibilityParams& visibility() const { return m_visibility; }
     bool operator()(const Bin& b, double lineHeight_m) const {
         const double above = b.height_m - lineHeight_m;
         return above > m_minMargin_m && above > margin_m(b);
@@ -139,17 +141,18 @@ void weakenBinsAboveMeasurements(BinGrid& grid, const BinGrid::UpdatedCell& u, d
 
 /** Cell (ix, iy), crossed by a line of sight at `rayHigh_m`: its bins above the line are removed
  * if less certain than the target (`target()`: called only when a bin conflicts), otherwise
- * they lose `decrement` (removed at 0). */
+ * they lose `decrement` and then the share `certaintyShare` of the rest (removed at 0). */
 template <class TargetCertainty>
 void editOccluder(BinGrid& grid, int ix, int iy, double rayHigh_m, const ConflictTest& conflicts,
                   TargetCertainty&& target, float decrement, VisibilityStats& stats) {
+    const float keep = 1.0f - conflicts.visibility().certaintyShare;
     grid.editBins(ix, iy, [&](Bin& b) {
         if (!conflicts(b, rayHigh_m)) return true;
         if (b.certainty < target()) {
             stats.binsRemoved++;
             return false;
         }
-        b.certainty -= decrement;
+        b.certainty = (b.certainty - decrement) * keep;
         stats.binsWeakened++;
         if (b.certainty > 0) return true;
         stats.binsRemoved++;
