@@ -447,7 +447,7 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
         const multibin::CellWindow t = multibin::tileOfCell(ix, iy, tileCells);
         corners.emplace(t.iy0, t.ix0);
     };
-    // One pass over the stored bins until the tiled store lists its own tiles.
+    // The stored bins, tile by tile (BinStore): the cost follows the data, not the window.
     m_impl->grid.store().forEachStoredBin(
         [&](int ix, int iy, const multibin::Bin&) { add(ix, iy); });
     if (isDualGrid()) {  // local cells not yet written back, at the global cell of their centre
