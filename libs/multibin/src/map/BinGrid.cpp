@@ -26,12 +26,16 @@ BinGrid::BinGrid(double cellSize_m) : m_store(cellSize_m) { m_index.reset(); }
 void BinGrid::reset(double cellSize_m, const CellWindow& window) {
     m_store.reset(cellSize_m, window);
     m_index.reset();
+    forgetLastTile();
 }
 
-size_t BinGrid::writableSlot(int ix, int iy) {
+size_t BinGrid::writableSlotInNewTile(int ix, int iy) {
     bool tileAdded;
     const size_t s = m_store.writableSlot(ix, iy, tileAdded);
     if (tileAdded) m_index.tileAdded(uint32_t(s / BinStore::kTileSlots), m_store.slotCount());
+    m_lastTileX = BinStore::tileOf(ix);
+    m_lastTileY = BinStore::tileOf(iy);
+    m_lastTileBase = s - BinStore::slotInTile(ix, iy);
     return s;
 }
 

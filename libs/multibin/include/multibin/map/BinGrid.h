@@ -74,6 +74,7 @@ public:
     template <typename OnLeave>
     void moveWindowTo(int ix0, int iy0, OnLeave&& onLeave) {
         m_store.moveWindowTo(ix0, iy0, onLeave, [this](size_t s) { m_index.forgetSlot(s); });
+        forgetLastTile();
     }
     void moveWindowTo(int ix0, int iy0) {
         moveWindowTo(ix0, iy0, [](int, int) {});
@@ -162,8 +163,16 @@ public:
 private:
     /** The insertion core over `count` map-frame points, a block at a time:
      * `fillBlock(begin, n, block)` writes points begin .. begin + n - 1 into `block`. */
-    /** The slot of cell (ix, iy) for a write: its tile allocated (and indexed) if it had none. */
-    size_t writableSlot(int ix, int iy);
+    /** The slot of cell (ix, iy) for a write: its tile allocated (and indexed) if it had none.
+     * Consecutive points mostly share a tile: the last one is remembered. */
+    size_t writableSlot(int ix, int iy) {
+        if (BinStore::tileOf(ix) == m_lastTileX && BinStore::tileOf(iy) == m_lastTileY)
+            return m_lastTileBase + BinStore::slotInTile(ix, iy);
+        return writableSlotInNewTile(ix, iy);
+    }
+    size_t writableSlotInNewTile(int ix, int iy);
+    /** Forgets the remembered tile (tiles were freed or dropped). */
+    void forgetLastTile() { m_lastTileX = std::numeric_limits<int>::min(); }
     template <typename BlockSource>
     InsertStats insertBlocks(size_t count, BlockSource&& fillBlock, const BinUpdateParams& params,
                              double continuityBound_m);
@@ -178,6 +187,9 @@ private:
 
     BinStore m_store;
     VisibilityIndex m_index;
+    /** The tile of the last write and its first slot (writableSlot). */
+    int m_lastTileX = std::numeric_limits<int>::min(), m_lastTileY = 0;
+    size_t m_lastTileBase = 0;
     int m_insertionThreads = 1;
 };
 
