@@ -37,7 +37,6 @@ inline std::unique_ptr<mrpt::maps::CMultiBinElevationMap> routeMap(double length
                                                                    size_t* points = nullptr) {
     auto map = std::make_unique<mrpt::maps::CMultiBinElevationMap>();
     map->creationOptions.resolution_m = kCell_m;
-    map->creationOptions.max_size_m = length_m + 20;  // the dense window until tiles land
     map->setCreationOptions(map->creationOptions);
     size_t n = 0;
     for (double s = 0; s < length_m; s += kStep_m) {

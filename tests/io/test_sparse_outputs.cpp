@@ -306,7 +306,6 @@ namespace {
 std::unique_ptr<Map> patchMap(const std::vector<std::pair<double, double>>& corners) {
     auto map = std::make_unique<Map>();
     map->creationOptions.resolution_m = 0.25;
-    map->creationOptions.max_size_m = 500;
     map->setCreationOptions(map->creationOptions);
     for (const auto& [x0, y0] : corners)
         for (int i = 0; i < 40; i++)
@@ -367,7 +366,6 @@ TEST(SparseMapOutputs, FilesGrowWithThePatchesNotTheirBoundingBox) {
 TEST(SparseMapOutputs, GetAsImageOfALongWindowIsDownsampled) {
     Map map;
     map.creationOptions.resolution_m = 1.0;
-    map.creationOptions.max_size_m = 6000;
     map.setCreationOptions(map.creationOptions);
     for (const double x : {0.5, 5000.5}) map.insertIndividualPoint(x, 0.5, 0.25);
     ASSERT_GT(map.dem_get_size_x(), 4096u);
