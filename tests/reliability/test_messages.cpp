@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "../apps/mapper_run.h"
 #include "multibin/io/ErrorMessage.h"
 #include "reliability_helpers.h"
 
@@ -59,11 +60,11 @@ struct MapperRun {
     int exitCode;
     std::string err;
 };
-/** The mapper on `flag input` (the mock-up for the rest), stopped after 30 s. */
+/** The mapper on `flag input` (the mock-up's first 20 entries for the rest), stopped after 30 s. */
 MapperRun runMapper(const fs::path& dir, const std::string& flag, const std::string& input) {
     const fs::path src = MULTIBIN_SOURCE_DIR;
     std::string args = " --config " + (src / "ini" / "mockup.ini").string() + " --rawlog " +
-                       (src / "rawlogs" / "mockup.rawlog").string();
+                       mapper_run::mockupRawlogPrefix(20);
     const std::string given = flag + " '" + input + "'";
     if (flag == "--config" || flag == "--rawlog") {
         const size_t at = args.find(flag);
@@ -139,7 +140,7 @@ TEST(Messages, SlowRequestsAreRefusedBeforeAnyOutput) {
     const fs::path dir = scratchDir("messages_slow");
     const fs::path src = MULTIBIN_SOURCE_DIR;
     const std::string common = " --config " + (src / "ini" / "mockup.ini").string() + " --rawlog " +
-                               (src / "rawlogs" / "mockup.rawlog").string() + " --no-plots --out " +
+                               mapper_run::mockupRawlogPrefix(20) + " --no-plots --out " +
                                (dir / "out").string();
     for (const auto& [extra, what] :
          {std::pair{std::string(" --ground-truth ") + (src / "rawlogs" / "mockup_gt.asc").string() +
