@@ -16,6 +16,9 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
+
+#include <zlib.h>
 
 #include "PoseOverTime.h"
 #include "RawlogSourceGuard.h"
@@ -23,13 +26,24 @@
 #include "multibin/io/ErrorMessage.h"
 
 namespace {
-/** deflate expands at most 1032:1, so a gz file holds at most this many bytes per stored byte. */
-constexpr uint64_t kMaxDeflateRatio = 1032;
-
 struct FileSize {
-    uint64_t progress_bytes;  // uncompressed size for the progress bar (gz trailer, mod 4 GiB)
-    uint64_t bound_bytes;     // an upper bound on the uncompressed bytes (for the read budget)
+    uint64_t progress_bytes;  // the bytes MRPT will read, for the progress bar
+    uint64_t bound_bytes;     // the bytes MRPT will read (for the read budget)
 };
+
+/** The bytes a gz file decompresses to, counted by inflating it as MRPT's stream does (gzread):
+ * what follows the gzip members (padding, junk) does not count. An upper bound from the file's
+ * size (deflate's 1032:1) grew with such padding: 1 MB of zeros after a small member let an entry
+ * ask for 17 GB. */
+uint64_t gzDecompressedBytes(const std::string& path) {
+    gzFile f = gzopen(path.c_str(), "rb");
+    if (!f) throw std::runtime_error("cannot open '" + path + "'");
+    std::vector<char> buf(1 << 16);
+    uint64_t total = 0;
+    for (int n; (n = gzread(f, buf.data(), unsigned(buf.size()))) > 0;) total += uint64_t(n);
+    gzclose(f);
+    return total;
+}
 
 FileSize fileSize(const std::string& path) {
     std::ifstream f(path, std::ios::binary);
@@ -39,12 +53,9 @@ FileSize fileSize(const std::string& path) {
     f.clear();
     f.seekg(0, std::ios::end);
     const auto size = static_cast<uint64_t>(f.tellg());
-    if (magic[0] != 0x1f || magic[1] != 0x8b || size < 18) return {size, size};
-    unsigned char t[4];
-    f.seekg(-4, std::ios::end);
-    f.read(reinterpret_cast<char*>(t), 4);
-    return {uint64_t(t[0]) | uint64_t(t[1]) << 8 | uint64_t(t[2]) << 16 | uint64_t(t[3]) << 24,
-            size * kMaxDeflateRatio};
+    if (magic[0] != 0x1f || magic[1] != 0x8b) return {size, size};
+    const uint64_t inflated = gzDecompressedBytes(path);
+    return {inflated, inflated};
 }
 
 void openOrThrow(mrpt::io::CFileGZInputStream& in, const std::string& path,

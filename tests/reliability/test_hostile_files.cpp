@@ -3,6 +3,7 @@
  * code 1 and one line naming the file and the entry, within a second, and read every memory-bomb
  * under a 1 GB address-space limit. */
 #include <gtest/gtest.h>
+#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
@@ -369,6 +370,34 @@ TEST(HostileFiles, FilesDeclaringMoreThanTheyHoldAreRefusedUnderAOneGigabyteLimi
     // Control: the shipped walk maps under the same limit.
     const fs::path walk = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog";
     EXPECT_EQ(runMapper("--rawlog", walk, dir).exitCode, 0);
+}
+
+// Padding after the gzip member (issue 37, kind 3): the budget was 16 x an upper bound of the
+// bytes a gz file holds, its size x 1032, so 64 kB of zeros after a small member let an entry ask
+// for 1.1 GB. The bound is now the bytes the members inflate to: a rawlog entry declaring 2^26
+// beams and a simplemap declaring 2^23 keyframes (0.3 GB each, taken and then found missing
+// before) are refused before the allocation.
+TEST(HostileFiles, PaddingAfterACompressedFileDoesNotRaiseTheReadBudget) {
+    const fs::path dir = scratchDir("hostile_gz_padding");
+    const Bytes beamBomb =
+        declaring(sensoryFrameWith(scan(12345)), "CObservation2DRangeScan", 12345, 1u << 26, 16);
+    mrpt::maps::CSimpleMap sm;
+    auto sf = mrpt::obs::CSensoryFrame::Create();
+    sf->insert(scan(50));
+    sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), sf);
+    const Bytes smBomb = declaring(bytesOf(sm), "CSimpleMap", 1, 1u << 23, 0);
+    for (const auto& [name, flag, bytes] :
+         {std::tuple{"beams.rawlog", "--rawlog", sensoryFrameWith(scan(3)) + beamBomb},
+          std::tuple{"keyframes.simplemap", "--simplemap", smBomb}}) {
+        SCOPED_TRACE(name);
+        const fs::path f = dir / name;
+        {
+            mrpt::io::CFileGZOutputStream gz(f.string());
+            gz.Write(bytes.data(), bytes.size());
+        }
+        std::ofstream(f, std::ios::binary | std::ios::app) << std::string(64 << 10, '\0');
+        expectOneLineError(runMapper(flag, f, dir), f, "declares more data than the file holds");
+    }
 }
 
 TEST(HostileFiles, ADirectoryGivenAsTheRawlogOrTheIniIsAOneLineError) {
