@@ -207,7 +207,7 @@ bool finitePose(const mrpt::poses::CPose3D& p) {
 
 size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& visit,
                                      const Progress& progress, double robotPoseMaxDt_s,
-                                     PoseCounts* counts) {
+                                     PoseCounts* counts, MrptWarnings* warnings) {
     mrpt::io::CFileGZInputStream in;
     openOrThrow(in, path, "rawlog");
     const FileSize size = fileSize(path);
@@ -217,13 +217,13 @@ size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& vis
         [&](double, size_t n) {
             if (progress) progress(double(in.getPosition()) / total, n);
         },
-        robotPoseMaxDt_s, counts);
+        robotPoseMaxDt_s, counts, warnings);
 }
 
 size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& name,
                                      uint64_t sizeBound_bytes, const Visitor& visit,
                                      const Progress& progress, double robotPoseMaxDt_s,
-                                     PoseCounts* counts) {
+                                     PoseCounts* counts, MrptWarnings* warnings) {
     RawlogStreamGuard guard(in);
     auto arch = mrpt::serialization::archiveFrom(guard);
     const uint64_t start = in.getPosition();
@@ -257,6 +257,7 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
         try {
             const RawlogStreamGuard::Header h = guard.peekHeader();
             if (h.bytes == 0) break;  // clean end, between two entries
+            const MrptWarnings::Capture capture(warnings, entryName());
             obj = readBounded(guard, left, entryName(), [&] {
                 return isOfClass(h, CLASS_ID(mrpt::obs::CActionCollection))
                            ? readActionCollection(arch, guard, h, left, entryName())
@@ -327,18 +328,21 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
     return entries;
 }
 
-mrpt::maps::CSimpleMap RawlogSource::loadSimplemap(const std::string& path) {
+mrpt::maps::CSimpleMap RawlogSource::loadSimplemap(const std::string& path,
+                                                   MrptWarnings* warnings) {
     mrpt::io::CFileGZInputStream in;
     openOrThrow(in, path, "simplemap");
-    return readSimplemap(in, "simplemap '" + path + "'", fileSize(path).bound_bytes);
+    return readSimplemap(in, "simplemap '" + path + "'", fileSize(path).bound_bytes, warnings);
 }
 
 mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const std::string& name,
-                                                   uint64_t sizeBound_bytes) {
+                                                   uint64_t sizeBound_bytes,
+                                                   MrptWarnings* warnings) {
     mrpt::maps::CSimpleMap sm;
     uint64_t asked = 0;
     RawlogStreamGuard guard(in);
     try {
+        const MrptWarnings::Capture capture(warnings, name);
         ReadBudget budget(ReadBudget::limitFor(sizeBound_bytes));
         try {
             auto arch = mrpt::serialization::archiveFrom(guard);

@@ -296,6 +296,7 @@ int run(const Arguments& args, std::string& stage) {
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
     stage = "mapping " + inputName;
+    MrptWarnings mrptWarnings;  // MRPT's own lines while reading: once each, after the bar
     ProgressBar bar("mapping");
     if (!args.rawlog.empty()) {
         RawlogSource::forEachInRawlog(
@@ -310,9 +311,10 @@ int run(const Arguments& args, std::string& stage) {
                 }
             },
             [&](double f, size_t n) { bar.update(f, std::to_string(n) + " entries"); },
-            elevation->insertionOptions.robot_pose_max_dt_s, &poseCounts);
+            elevation->insertionOptions.robot_pose_max_dt_s, &poseCounts, &mrptWarnings);
     } else {
-        const mrpt::maps::CSimpleMap sm = RawlogSource::loadSimplemap(args.simplemap);
+        const mrpt::maps::CSimpleMap sm =
+            RawlogSource::loadSimplemap(args.simplemap, &mrptWarnings);
         for (const auto& m : maps.maps)
             if (m.get() != elevation.get()) m->loadFromSimpleMap(sm);
         CMultiBinElevationMap::forEachObservationWithPosePdf(
@@ -325,6 +327,8 @@ int run(const Arguments& args, std::string& stage) {
             });
     }
     bar.finish("done");
+    for (const std::string& w : mrptWarnings.summary())
+        std::cerr << "elevation-mapper: warning: " << w << "\n";
     std::cout << tally.report();
     const multibin::InsertStats& fused = elevation->insertStats();
     if (fused.accepted == 0 && fused.outsideMap > 0)

@@ -3,7 +3,10 @@
  * reach the terminal as an escape sequence; inputs that are not regular files (a device, a FIFO)
  * a one-line error naming the input, within seconds. */
 #include <gtest/gtest.h>
+#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
@@ -128,6 +131,58 @@ TEST(Messages, ALabelInAnErrorCannotForgeALineOrEscapeTheTerminal) {
     EXPECT_EQ(p.exitCode, 1) << p.err;
     EXPECT_EQ(std::count(p.err.begin(), p.err.end(), '\n'), 1) << p.err;
     EXPECT_EQ(p.err.find('\x1b'), std::string::npos) << p.err;
+}
+#endif
+
+#ifdef ELEVATION_MAPPER_EXE
+// MRPT warns once per object it reads: a rawlog or a simplemap of 60 depth scans whose range
+// image is smaller than their calibration printed 60 lines "[CObservation3DRangeScan] Warning:
+// autofixing incorrect camera resolution ..." (on a terminal, among the progress bar's). The
+// reading path collects them: one line, with the count and the first entry.
+TEST(Messages, RepeatedMrptWarningsArriveOnceWithTheirCount) {
+    const fs::path dir = scratchDir("messages_mrpt_warnings");
+    mrpt::maps::CSimpleMap sm;
+    {
+        mrpt::io::CFileGZOutputStream out((dir / "depth.rawlog").string());
+        auto arch = mrpt::serialization::archiveFrom(out);
+        for (int i = 0; i < 60; i++) {
+            auto scan = mrpt::obs::CObservation3DRangeScan::Create();
+            scan->sensorLabel = "DEPTH";
+            scan->timestamp = mrpt::Clock::fromDouble(100 + i);
+            scan->hasRangeImage = true;
+            scan->rangeImage.setConstant(3, 4, 1000);  // 4 x 3 px of 1 m ...
+            scan->rangeUnits = 0.001f;
+            scan->cameraParams.ncols = 640;  // ... calibrated as 640 x 480 px
+            scan->cameraParams.nrows = 480;
+            scan->cameraParams.setIntrinsicParamsFromValues(500, 500, 320, 240);
+            scan->cameraParamsIntensity = scan->cameraParams;
+            scan->sensorPose = mrpt::poses::CPose3D(0, 0, 0.5, 0, mrpt::DEG2RAD(60.0), 0);
+            auto pose = mrpt::obs::CObservationRobotPose::Create();
+            pose->timestamp = scan->timestamp;
+            pose->pose = posePdf(0.01 * i);
+            auto sf = mrpt::obs::CSensoryFrame::Create();
+            sf->insert(pose);
+            sf->insert(scan);
+            arch << *sf;
+            sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf(0.01 * i)), sf);
+        }
+    }
+    {
+        mrpt::io::CFileGZOutputStream out((dir / "depth.simplemap").string());
+        mrpt::serialization::archiveFrom(out) << sm;
+    }
+    const std::string ini = (fs::path(MULTIBIN_SOURCE_DIR) / "ini" / "mockup.ini").string();
+    for (const char* input : {"--rawlog", "--simplemap"}) {
+        SCOPED_TRACE(input);
+        const std::string file = (dir / (std::string("depth.") + (input + 2))).string();
+        const auto r =
+            mapper_run::runMapper(dir, "--config " + ini + " " + input + " " + file +
+                                           " --outputs map --out " + (dir / "out").string());
+        EXPECT_EQ(r.exitCode, 0) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find("MRPT said 60 times (first at "), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("autofixing incorrect camera resolution"), std::string::npos) << r.err;
+    }
 }
 #endif
 
