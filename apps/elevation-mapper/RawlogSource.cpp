@@ -2,10 +2,12 @@
 #include "RawlogSource.h"
 
 #include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/lazy_load_path.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CActionRobotMovement3D.h>
+#include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/rtti/CObject.h>
@@ -198,6 +200,42 @@ mrpt::maps::CSimpleMap readSimplemapVersion0(mrpt::serialization::CArchive& arch
     return sm;
 }
 
+/** A point cloud stored outside the rawlog (MRPT's external storage), loaded here before the map
+ * would load it: from a regular file only (a device never ends), under the read budget of that
+ * file's bytes (MRPT's deserializer allocates the point count the file declares: a 180-byte file
+ * declaring 2^28 points took gigabytes). Throws naming `where`, the label and the file. */
+void loadExternalPointCloud(const mrpt::obs::CObservationPointCloud& pc, const std::string& where) {
+    if (!pc.isExternallyStored() || pc.pointcloud) return;
+    const std::string path = mrpt::io::lazy_load_absolute_path(pc.getExternalStorageFile());
+    const std::string what =
+        where + ": point cloud '" + pc.sensorLabel + "' stored in '" + path + "'";
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+        throw RefusedEntry(what + " cannot be read: no such file");
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw RefusedEntry(what + ": not a regular file");
+    const uint64_t bound = fileSize(path).bound_bytes;
+    uint64_t asked = 0;
+    std::string failure;
+    {
+        ReadBudget budget(ReadBudget::limitFor(bound));
+        try {
+            pc.load();
+        } catch (const std::exception& e) {
+            asked = ReadBudget::largestRefused();
+            if (asked == 0) failure = e.what();
+        }
+    }
+    if (asked > 0)
+        throw RefusedEntry(what + " declares more data than the file holds: loading it asked for " +
+                           gigabytes(asked) + " in all, more than 64 MiB + 16 x its " +
+                           std::to_string(bound) + " bytes");
+    if (!failure.empty())
+        throw RefusedEntry(
+            what + " cannot be read: " + multibin::oneLineMessage(std::runtime_error(failure)));
+    if (!pc.pointcloud) throw RefusedEntry(what + " holds no point cloud");
+}
+
 bool finitePose(const mrpt::poses::CPose3D& p) {
     for (int i = 0; i < 6; i++)
         if (!std::isfinite(p[i])) return false;
@@ -231,6 +269,8 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
     size_t entries = 0;
     auto entryName = [&] { return name + ": entry " + std::to_string(entries); };
     auto visitObs = [&](const mrpt::obs::CObservation::Ptr& obs) {
+        if (const auto* pc = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(obs.get()))
+            loadExternalPointCloud(*pc, entryName());
         if (const auto rp = std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(obs)) {
             if (!finitePose(rp->pose.mean))
                 throw std::runtime_error(entryName() + ": robot pose '" + rp->sensorLabel +
@@ -379,6 +419,8 @@ mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const 
             if (!obs)
                 throw std::runtime_error(where + ": observation " + std::to_string(k) +
                                          " is null or an object that is not an observation");
+            if (const auto* pc = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(obs.get()))
+                loadExternalPointCloud(*pc, where);
             k++;
         }
         if (!finitePose(posePdf->getMeanVal()))
