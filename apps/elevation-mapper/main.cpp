@@ -284,9 +284,11 @@ int run(const Arguments& args, std::string& stage) {
     ObservationTally tally;
     RunFacts facts;
     PoseCounts poseCounts;  // a rawlog's: how its observations got their pose
+    PoseReach reach;        // how far the robot poses go, against the supported range
     auto insertTimed = [&](const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& pose, bool poseHasCov) {
         tally.before(*elevation);
+        reach.add(pose.mean);
         const auto t0 = Clock::now();
         const bool inserted = poseHasCov ? elevation->insertObservation(obs, pose)
                                          : elevation->insertObservation(obs, pose.mean);
@@ -331,6 +333,11 @@ int run(const Arguments& args, std::string& stage) {
         std::cerr << "elevation-mapper: warning: " << w << "\n";
     std::cout << tally.report();
     const multibin::InsertStats& fused = elevation->insertStats();
+    const std::string beyond =
+        reach.beyondSupportedRange(elevation->mapOrigin().x, elevation->mapOrigin().y);
+    if (fused.accepted == 0 && !beyond.empty())
+        throw std::runtime_error(inputName + ": " + beyond + "; " + tally.whyNothingFused(fused));
+    if (!beyond.empty()) std::cerr << "elevation-mapper: warning: " << beyond << "\n";
     if (fused.accepted == 0 && fused.outsideMap > 0)
         throw std::runtime_error(inputName + ": the map's window (" + windowText(*elevation) +
                                  ") does not hold the data: " + std::to_string(fused.outsideMap) +

@@ -187,6 +187,43 @@ TEST(Messages, RepeatedMrptWarningsArriveOnceWithTheirCount) {
 #endif
 
 #ifdef ELEVATION_MAPPER_EXE
+// A robot beyond the coordinate range the map supports (doc/frames.md) was blamed on the map's
+// window ("the map's window (x 1e+08..1e+08 m ...) does not hold the data ... check grow,
+// max_size_m"), or mapped without a word where single precision rounds to metres. The error
+// names the poses and the range; a run that maps is warned.
+TEST(Messages, APoseBeyondTheSupportedRangeIsNamedNotTheMapsWindow) {
+    const fs::path dir = scratchDir("messages_pose_range");
+    auto rawlogAt = [&](double x_m, double y_m) {
+        const fs::path path = dir / ("at_" + std::to_string(x_m) + "_" + std::to_string(y_m));
+        mrpt::io::CFileGZOutputStream out(path.string());
+        auto arch = mrpt::serialization::archiveFrom(out);
+        for (int i = 0; i < 3; i++) {
+            auto pose = mrpt::obs::CObservationRobotPose::Create();
+            pose->timestamp = mrpt::Clock::fromDouble(100 + i);
+            pose->pose = posePdf(x_m + 0.01 * i, y_m);
+            auto scan = floorScan(181);
+            scan->sensorLabel = "LASER";
+            scan->timestamp = pose->timestamp;
+            mrpt::obs::CSensoryFrame sf;
+            sf.insert(pose);
+            sf.insert(scan);
+            arch << sf;
+        }
+        return path.string();
+    };
+    for (const auto& [x_m, y_m] : {std::pair{1e12, 0.0}, std::pair{0.0, -5e9}}) {
+        SCOPED_TRACE(std::to_string(x_m) + ", " + std::to_string(y_m));
+        const MapperRun r = runMapper(dir, "--rawlog", rawlogAt(x_m, y_m));
+        expectOneLineNaming(r, "beyond the supported range (|x|, |y| <= 1e+07 m");
+        EXPECT_EQ(r.err.find("window"), std::string::npos) << r.err;
+    }
+    const MapperRun far = runMapper(dir, "--rawlog", rawlogAt(5e7, 0));
+    EXPECT_EQ(far.exitCode, 0) << far.err;
+    EXPECT_NE(far.err.find("warning: the robot poses reach x 5e+07"), std::string::npos) << far.err;
+}
+#endif
+
+#ifdef ELEVATION_MAPPER_EXE
 // Requests that took minutes (issue 37, kind 8): a profile line to a far point was sampled every
 // half cell along its whole length; an export resolution near the old cap (1e8 samples) took
 // minutes and wrote gigabytes, and failed after the other outputs were written. Both are
