@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
 
 #include "../core/test_files.h"
@@ -69,13 +70,21 @@ inline std::string mockupRawlogPrefix(size_t entries) {
     });
 }
 
-/** ini/mockup.ini with the traversability layer's Monte Carlo draws cut from 128 to 4: the same
- * code computes the layer, 32 times fewer draws (the layer is most of an evaluated run's time). */
-inline std::string mockupIniWithFewDraws() {
-    const std::filesystem::path path =
-        std::filesystem::path(MULTIBIN_BINARY_DIR) / "test-inputs" / "mockup-4-draws.ini";
-    return sharedTestInput(path, [](const std::filesystem::path& tmp) {
-        std::ofstream(tmp) << readAll(std::string(MULTIBIN_SOURCE_DIR) + "/ini/mockup.ini")
+/** ini/mockup.ini with the traversability layer's Monte Carlo draws cut from 128 to 4 (the same
+ * code computes the layer, 32 times fewer draws: the layer was most of an evaluated run's time),
+ * and without the gap filling when `fill` is false (the fill was most of a short run's time under
+ * the sanitizers: Eigen at -O1 with its assertions). For tests of what the mapper does with paths
+ * and outputs. */
+inline std::string mockupQuickIni(bool fill) {
+    const std::filesystem::path path = std::filesystem::path(MULTIBIN_BINARY_DIR) / "test-inputs" /
+                                       (fill ? "mockup-4-draws.ini" : "mockup-4-draws-no-fill.ini");
+    return sharedTestInput(path, [fill](const std::filesystem::path& tmp) {
+        std::string text = readAll(std::string(MULTIBIN_SOURCE_DIR) + "/ini/mockup.ini");
+        const std::string on = "fill_enabled = true";
+        const size_t at = text.find(on);
+        if (at == std::string::npos) throw std::runtime_error("ini/mockup.ini: no '" + on + "'");
+        if (!fill) text.replace(at, on.size(), "fill_enabled = false");
+        std::ofstream(tmp) << text
                            << "\n[MappingApplication_multiBinElevationMap_00_traversabilityOpts]\n"
                               "monte_carlo_draws = 4\n";
     });

@@ -200,7 +200,7 @@ namespace {
  * truth, into dir/out. */
 mapper_run::RunResult runMapper(const fs::path& dir, const std::string& rawlog,
                                 const std::string& truth) {
-    return mapper_run::runMapper(dir, "--config " + mapper_run::mockupIniWithFewDraws() +
+    return mapper_run::runMapper(dir, "--config " + mapper_run::mockupQuickIni(true) +
                                           " --rawlog " + rawlog + " --ground-truth " + truth +
                                           " --no-plots --outputs all --out " +
                                           (dir / "out").string());
@@ -227,11 +227,11 @@ std::vector<std::string> tableRows(const std::string& report) {
 }
 }  // namespace
 
-// The mock-up's first 40 rawlog entries: the whole rawlog is mapped at UTM coordinates by the
+// The mock-up's first 20 rawlog entries: the whole rawlog is mapped at UTM coordinates by the
 // library above; here the program's evaluation and rasters (three runs of the whole took three
 // minutes under the sanitizers).
 TEST(Georeferenced, TheMapperGivesTheSameEvaluationAndRastersAtUtmCoordinates) {
-    const std::string rawlog = mapper_run::mockupRawlogPrefix(40);
+    const std::string rawlog = mapper_run::mockupRawlogPrefix(20);
     const std::string truth = kSource + "/rawlogs/mockup_gt.asc";
     const fs::path d0 = scratchDir("mapper_original");
     const mapper_run::RunResult r0 = runMapper(d0, rawlog, truth);

@@ -133,11 +133,11 @@ void plantSymlinks(const fs::path& out, const fs::path& victims, pid_t pid) {
         ec);
 }
 
-/** The mock-up's first 20 rawlog entries, evaluated against its ground truth (every output and
- * figure is written; the whole rawlog took a minute a run under the sanitizers). */
+/** The mock-up's first 20 rawlog entries, not filled, evaluated against its ground truth (every
+ * output and figure is written; the whole rawlog took a minute a run under the sanitizers). */
 std::vector<std::string> mockupArgs(const fs::path& out) {
     const fs::path src = MULTIBIN_SOURCE_DIR;
-    return {"--config",       mapper_run::mockupIniWithFewDraws(),
+    return {"--config",       mapper_run::mockupQuickIni(false),
             "--rawlog",       mapper_run::mockupRawlogPrefix(20),
             "--ground-truth", (src / "rawlogs" / "mockup_gt.asc").string(),
             "--out",          out.string()};
