@@ -25,9 +25,21 @@ export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/tests/reliability/lsan.su
 # - label slow: minutes even without sanitizers (the gcc stage skips them too);
 # - label install: builds doc/example-consumer with the default flags against this ASan library;
 # - MrptTools.*: preloads the ASan-built library into MRPT's stock observations2map, which is not
-#   built with ASan (the runtime would have to come first in the process); the gcc stage runs it.
+#   built with ASan (the runtime would have to come first in the process); the gcc stage runs it;
+# - HeadlineFigures.*: the mapper on the whole mock-up and walk against their measured figures
+#   (RMSE, coverage), a minute each here. Its subject is the numbers, which the gcc stage checks;
+#   the code it runs (reading, mapping, filling, the evaluation, the outputs) runs here through
+#   Georeferenced.TheMapperGivesTheSameEvaluationAndRastersAtUtmCoordinates, HostilePaths.* and
+#   the library's own tests (doc/reliability.md, section 3).
+# Longest first: the gcc stage's test times (when this stage follows it) order the tests, so a
+# long one does not start last and leave one core idle at the end.
+release_costs=${MULTIBIN_BUILD_DIR:-$root/build}/Testing/Temporary/CTestCostData.txt
+if [ -f "$release_costs" ] && [ ! -f "$build_dir/Testing/Temporary/CTestCostData.txt" ]; then
+  mkdir -p "$build_dir/Testing/Temporary"
+  cp "$release_costs" "$build_dir/Testing/Temporary/"
+fi
 ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -LE 'slow|install' \
-  -E '^MrptTools\.'
+  -E '^(MrptTools|HeadlineFigures)\.'
 
 # Fuzz targets: replay the committed corpora (every input once), then fuzz each for a while.
 # New inputs go to a scratch corpus in the build tree; the committed ones stay as they are. A

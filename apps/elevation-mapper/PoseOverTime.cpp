@@ -1,6 +1,9 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #include "PoseOverTime.h"
 
+#include <algorithm>
+#include <cstdio>
+
 #include <mrpt/system/datetime.h>
 
 #include <Eigen/Dense>
@@ -48,4 +51,32 @@ PoseOverTime::Pose PoseOverTime::at(mrpt::Clock::time_point time) {
     else
         m_counts.robotPose++;
     return p;
+}
+
+void PoseReach::add(const mrpt::poses::CPose3D& p) {
+    if (!m_any) {
+        m_minX_m = m_maxX_m = p.x();
+        m_minY_m = m_maxY_m = p.y();
+        m_any = true;
+    }
+    m_minX_m = std::min(m_minX_m, p.x());
+    m_maxX_m = std::max(m_maxX_m, p.x());
+    m_minY_m = std::min(m_minY_m, p.y());
+    m_maxY_m = std::max(m_maxY_m, p.y());
+}
+
+std::string PoseReach::beyondSupportedRange(double originX_m, double originY_m) const {
+    if (!m_any) return {};
+    const double absolute_m = std::max({-m_minX_m, m_maxX_m, -m_minY_m, m_maxY_m});
+    const double fromOrigin_m = std::max(
+        {originX_m - m_minX_m, m_maxX_m - originX_m, originY_m - m_minY_m, m_maxY_m - originY_m});
+    if (absolute_m <= kMaxAbsolute_m && fromOrigin_m <= kMaxFromOrigin_m) return {};
+    char b[320];
+    std::snprintf(b, sizeof b,
+                  "the robot poses reach x %.6g..%.6g m, y %.6g..%.6g m (%.3g m from the map "
+                  "origin), beyond the supported range (|x|, |y| <= %.0e m, within %.0f km of the "
+                  "map origin; doc/frames.md)",
+                  m_minX_m, m_maxX_m, m_minY_m, m_maxY_m, fromOrigin_m, kMaxAbsolute_m,
+                  kMaxFromOrigin_m / 1000);
+    return b;
 }

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <string>
 
 /** How the observations of a rawlog got their pose. */
 struct PoseCounts {
@@ -44,4 +45,22 @@ private:
     mrpt::poses::CPose3DPDFGaussian m_sinceAnchor;  //!< odometry composed since it
     bool m_moved = false, m_sinceAnchorCovKnown = true;
     PoseCounts m_counts;
+};
+
+/** How far the robot poses of a run reach, against the coordinate range the map supports
+ * (doc/frames.md): |x|, |y| <= kMaxAbsolute_m, and within kMaxFromOrigin_m of the map origin
+ * (the map's geometry is single precision relative to it). A run whose poses lie beyond was
+ * blamed on the map's window ("does not hold the data"), or mapped without a word. */
+class PoseReach {
+public:
+    static constexpr double kMaxAbsolute_m = 1e7, kMaxFromOrigin_m = 2000;
+    void add(const mrpt::poses::CPose3D& robotPose);
+    /** Empty when every pose lies within the range; else what lies beyond it, e.g. "the robot
+     * poses reach x 1e+12 m, beyond the supported range (|x|, |y| <= 1e7 m, within 2 km of the
+     * map origin; doc/frames.md)". `originX_m`, `originY_m`: the map origin. */
+    std::string beyondSupportedRange(double originX_m, double originY_m) const;
+
+private:
+    bool m_any = false;
+    double m_minX_m = 0, m_maxX_m = 0, m_minY_m = 0, m_maxY_m = 0;
 };

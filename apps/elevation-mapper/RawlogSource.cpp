@@ -2,10 +2,12 @@
 #include "RawlogSource.h"
 
 #include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/lazy_load_path.h>
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CActionRobotMovement3D.h>
+#include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CObservationRobotPose.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/rtti/CObject.h>
@@ -16,6 +18,9 @@
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <vector>
+
+#include <zlib.h>
 
 #include "PoseOverTime.h"
 #include "RawlogSourceGuard.h"
@@ -23,13 +28,24 @@
 #include "multibin/io/ErrorMessage.h"
 
 namespace {
-/** deflate expands at most 1032:1, so a gz file holds at most this many bytes per stored byte. */
-constexpr uint64_t kMaxDeflateRatio = 1032;
-
 struct FileSize {
-    uint64_t progress_bytes;  // uncompressed size for the progress bar (gz trailer, mod 4 GiB)
-    uint64_t bound_bytes;     // an upper bound on the uncompressed bytes (for the read budget)
+    uint64_t progress_bytes;  // the bytes MRPT will read, for the progress bar
+    uint64_t bound_bytes;     // the bytes MRPT will read (for the read budget)
 };
+
+/** The bytes a gz file decompresses to, counted by inflating it as MRPT's stream does (gzread):
+ * what follows the gzip members (padding, junk) does not count. An upper bound from the file's
+ * size (deflate's 1032:1) grew with such padding: 1 MB of zeros after a small member let an entry
+ * ask for 17 GB. */
+uint64_t gzDecompressedBytes(const std::string& path) {
+    gzFile f = gzopen(path.c_str(), "rb");
+    if (!f) throw std::runtime_error("cannot open '" + path + "'");
+    std::vector<char> buf(1 << 16);
+    uint64_t total = 0;
+    for (int n; (n = gzread(f, buf.data(), unsigned(buf.size()))) > 0;) total += uint64_t(n);
+    gzclose(f);
+    return total;
+}
 
 FileSize fileSize(const std::string& path) {
     std::ifstream f(path, std::ios::binary);
@@ -39,12 +55,9 @@ FileSize fileSize(const std::string& path) {
     f.clear();
     f.seekg(0, std::ios::end);
     const auto size = static_cast<uint64_t>(f.tellg());
-    if (magic[0] != 0x1f || magic[1] != 0x8b || size < 18) return {size, size};
-    unsigned char t[4];
-    f.seekg(-4, std::ios::end);
-    f.read(reinterpret_cast<char*>(t), 4);
-    return {uint64_t(t[0]) | uint64_t(t[1]) << 8 | uint64_t(t[2]) << 16 | uint64_t(t[3]) << 24,
-            size * kMaxDeflateRatio};
+    if (magic[0] != 0x1f || magic[1] != 0x8b) return {size, size};
+    const uint64_t inflated = gzDecompressedBytes(path);
+    return {inflated, inflated};
 }
 
 void openOrThrow(mrpt::io::CFileGZInputStream& in, const std::string& path,
@@ -187,6 +200,42 @@ mrpt::maps::CSimpleMap readSimplemapVersion0(mrpt::serialization::CArchive& arch
     return sm;
 }
 
+/** A point cloud stored outside the rawlog (MRPT's external storage), loaded here before the map
+ * would load it: from a regular file only (a device never ends), under the read budget of that
+ * file's bytes (MRPT's deserializer allocates the point count the file declares: a 180-byte file
+ * declaring 2^28 points took gigabytes). Throws naming `where`, the label and the file. */
+void loadExternalPointCloud(const mrpt::obs::CObservationPointCloud& pc, const std::string& where) {
+    if (!pc.isExternallyStored() || pc.pointcloud) return;
+    const std::string path = mrpt::io::lazy_load_absolute_path(pc.getExternalStorageFile());
+    const std::string what =
+        where + ": point cloud '" + pc.sensorLabel + "' stored in '" + path + "'";
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+        throw RefusedEntry(what + " cannot be read: no such file");
+    if (!std::filesystem::is_regular_file(path, ec))
+        throw RefusedEntry(what + ": not a regular file");
+    const uint64_t bound = fileSize(path).bound_bytes;
+    uint64_t asked = 0;
+    std::string failure;
+    {
+        ReadBudget budget(ReadBudget::limitFor(bound));
+        try {
+            pc.load();
+        } catch (const std::exception& e) {
+            asked = ReadBudget::largestRefused();
+            if (asked == 0) failure = e.what();
+        }
+    }
+    if (asked > 0)
+        throw RefusedEntry(what + " declares more data than the file holds: loading it asked for " +
+                           gigabytes(asked) + " in all, more than 64 MiB + 16 x its " +
+                           std::to_string(bound) + " bytes");
+    if (!failure.empty())
+        throw RefusedEntry(
+            what + " cannot be read: " + multibin::oneLineMessage(std::runtime_error(failure)));
+    if (!pc.pointcloud) throw RefusedEntry(what + " holds no point cloud");
+}
+
 bool finitePose(const mrpt::poses::CPose3D& p) {
     for (int i = 0; i < 6; i++)
         if (!std::isfinite(p[i])) return false;
@@ -196,7 +245,7 @@ bool finitePose(const mrpt::poses::CPose3D& p) {
 
 size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& visit,
                                      const Progress& progress, double robotPoseMaxDt_s,
-                                     PoseCounts* counts) {
+                                     PoseCounts* counts, MrptWarnings* warnings) {
     mrpt::io::CFileGZInputStream in;
     openOrThrow(in, path, "rawlog");
     const FileSize size = fileSize(path);
@@ -206,13 +255,13 @@ size_t RawlogSource::forEachInRawlog(const std::string& path, const Visitor& vis
         [&](double, size_t n) {
             if (progress) progress(double(in.getPosition()) / total, n);
         },
-        robotPoseMaxDt_s, counts);
+        robotPoseMaxDt_s, counts, warnings);
 }
 
 size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& name,
                                      uint64_t sizeBound_bytes, const Visitor& visit,
                                      const Progress& progress, double robotPoseMaxDt_s,
-                                     PoseCounts* counts) {
+                                     PoseCounts* counts, MrptWarnings* warnings) {
     RawlogStreamGuard guard(in);
     auto arch = mrpt::serialization::archiveFrom(guard);
     const uint64_t start = in.getPosition();
@@ -220,6 +269,8 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
     size_t entries = 0;
     auto entryName = [&] { return name + ": entry " + std::to_string(entries); };
     auto visitObs = [&](const mrpt::obs::CObservation::Ptr& obs) {
+        if (const auto* pc = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(obs.get()))
+            loadExternalPointCloud(*pc, entryName());
         if (const auto rp = std::dynamic_pointer_cast<mrpt::obs::CObservationRobotPose>(obs)) {
             if (!finitePose(rp->pose.mean))
                 throw std::runtime_error(entryName() + ": robot pose '" + rp->sensorLabel +
@@ -246,6 +297,7 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
         try {
             const RawlogStreamGuard::Header h = guard.peekHeader();
             if (h.bytes == 0) break;  // clean end, between two entries
+            const MrptWarnings::Capture capture(warnings, entryName());
             obj = readBounded(guard, left, entryName(), [&] {
                 return isOfClass(h, CLASS_ID(mrpt::obs::CActionCollection))
                            ? readActionCollection(arch, guard, h, left, entryName())
@@ -316,18 +368,21 @@ size_t RawlogSource::forEachInStream(mrpt::io::CStream& in, const std::string& n
     return entries;
 }
 
-mrpt::maps::CSimpleMap RawlogSource::loadSimplemap(const std::string& path) {
+mrpt::maps::CSimpleMap RawlogSource::loadSimplemap(const std::string& path,
+                                                   MrptWarnings* warnings) {
     mrpt::io::CFileGZInputStream in;
     openOrThrow(in, path, "simplemap");
-    return readSimplemap(in, "simplemap '" + path + "'", fileSize(path).bound_bytes);
+    return readSimplemap(in, "simplemap '" + path + "'", fileSize(path).bound_bytes, warnings);
 }
 
 mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const std::string& name,
-                                                   uint64_t sizeBound_bytes) {
+                                                   uint64_t sizeBound_bytes,
+                                                   MrptWarnings* warnings) {
     mrpt::maps::CSimpleMap sm;
     uint64_t asked = 0;
     RawlogStreamGuard guard(in);
     try {
+        const MrptWarnings::Capture capture(warnings, name);
         ReadBudget budget(ReadBudget::limitFor(sizeBound_bytes));
         try {
             auto arch = mrpt::serialization::archiveFrom(guard);
@@ -364,6 +419,8 @@ mrpt::maps::CSimpleMap RawlogSource::readSimplemap(mrpt::io::CStream& in, const 
             if (!obs)
                 throw std::runtime_error(where + ": observation " + std::to_string(k) +
                                          " is null or an object that is not an observation");
+            if (const auto* pc = dynamic_cast<const mrpt::obs::CObservationPointCloud*>(obs.get()))
+                loadExternalPointCloud(*pc, where);
             k++;
         }
         if (!finitePose(posePdf->getMeanVal()))

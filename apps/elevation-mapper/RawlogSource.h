@@ -12,6 +12,7 @@
 #include <string>
 
 #include "PoseOverTime.h"
+#include "RawlogSourceWarnings.h"
 
 /** Streams the observations of a rawlog (either format: actions + sensory frames, or
  * observations only), each with the robot pose PDF it was taken at (PoseOverTime): the latest
@@ -37,22 +38,25 @@ public:
      * truncated, corrupt or hostile file, and on an error of `visit` (prefixed with the file and
      * the entry). Returns the number of entries read. `robotPoseMaxDt_s`: how long a
      * CObservationRobotPose stays valid without odometry (the map's robot_pose_max_dt_s);
-     * `counts`, if given, receives how the observations got their pose. */
+     * `counts`, if given, receives how the observations got their pose; `warnings`, if given,
+     * what MRPT prints on std::cerr while an entry is read (else it reaches std::cerr). */
     static size_t forEachInRawlog(const std::string& path, const Visitor& visit,
                                   const Progress& progress, double robotPoseMaxDt_s = 0.5,
-                                  PoseCounts* counts = nullptr);
+                                  PoseCounts* counts = nullptr, MrptWarnings* warnings = nullptr);
     /** The same on an open stream of uncompressed rawlog bytes; `name` names it in errors,
      * `sizeBound_bytes` bounds the bytes it holds from its current position. */
     static size_t forEachInStream(mrpt::io::CStream& in, const std::string& name,
                                   uint64_t sizeBound_bytes, const Visitor& visit,
                                   const Progress& progress, double robotPoseMaxDt_s = 0.5,
-                                  PoseCounts* counts = nullptr);
+                                  PoseCounts* counts = nullptr, MrptWarnings* warnings = nullptr);
 
     /** Loads a simplemap file (gz-compressed or not); throws std::runtime_error naming the file
      * (and the keyframe) if it is missing, truncated, corrupt or holds a null keyframe pose,
-     * sensory frame or observation. */
-    static mrpt::maps::CSimpleMap loadSimplemap(const std::string& path);
+     * sensory frame or observation; `warnings` as for forEachInRawlog. */
+    static mrpt::maps::CSimpleMap loadSimplemap(const std::string& path,
+                                                MrptWarnings* warnings = nullptr);
     /** The same on an open stream (see forEachInStream). */
     static mrpt::maps::CSimpleMap readSimplemap(mrpt::io::CStream& in, const std::string& name,
-                                                uint64_t sizeBound_bytes);
+                                                uint64_t sizeBound_bytes,
+                                                MrptWarnings* warnings = nullptr);
 };

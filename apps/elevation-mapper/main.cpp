@@ -288,9 +288,11 @@ int run(const Arguments& args, std::string& stage) {
     ObservationTally tally;
     RunFacts facts;
     PoseCounts poseCounts;  // a rawlog's: how its observations got their pose
+    PoseReach reach;        // how far the robot poses go, against the supported range
     auto insertTimed = [&](const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& pose, bool poseHasCov) {
         tally.before(*elevation);
+        reach.add(pose.mean);
         const auto t0 = Clock::now();
         const bool inserted = poseHasCov ? elevation->insertObservation(obs, pose)
                                          : elevation->insertObservation(obs, pose.mean);
@@ -300,6 +302,7 @@ int run(const Arguments& args, std::string& stage) {
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
     stage = "mapping " + inputName;
+    MrptWarnings mrptWarnings;  // MRPT's own lines while reading: once each, after the bar
     ProgressBar bar("mapping");
     if (!args.rawlog.empty()) {
         RawlogSource::forEachInRawlog(
@@ -314,9 +317,10 @@ int run(const Arguments& args, std::string& stage) {
                 }
             },
             [&](double f, size_t n) { bar.update(f, std::to_string(n) + " entries"); },
-            elevation->insertionOptions.robot_pose_max_dt_s, &poseCounts);
+            elevation->insertionOptions.robot_pose_max_dt_s, &poseCounts, &mrptWarnings);
     } else {
-        const mrpt::maps::CSimpleMap sm = RawlogSource::loadSimplemap(args.simplemap);
+        const mrpt::maps::CSimpleMap sm =
+            RawlogSource::loadSimplemap(args.simplemap, &mrptWarnings);
         for (const auto& m : maps.maps)
             if (m.get() != elevation.get()) m->loadFromSimpleMap(sm);
         CMultiBinElevationMap::forEachObservationWithPosePdf(
@@ -329,8 +333,15 @@ int run(const Arguments& args, std::string& stage) {
             });
     }
     bar.finish("done");
+    for (const std::string& w : mrptWarnings.summary())
+        std::cerr << "elevation-mapper: warning: " << w << "\n";
     std::cout << tally.report();
     const multibin::InsertStats& fused = elevation->insertStats();
+    const std::string beyond =
+        reach.beyondSupportedRange(elevation->mapOrigin().x, elevation->mapOrigin().y);
+    if (fused.accepted == 0 && !beyond.empty())
+        throw std::runtime_error(inputName + ": " + beyond + "; " + tally.whyNothingFused(fused));
+    if (!beyond.empty()) std::cerr << "elevation-mapper: warning: " << beyond << "\n";
     if (fused.accepted == 0 && fused.outsideMap > 0)
         throw std::runtime_error(inputName + ": the map's window (" + windowText(*elevation) +
                                  ") does not hold the data: " + std::to_string(fused.outsideMap) +

@@ -3,12 +3,15 @@
  * code 1 and one line naming the file and the entry, within a second, and read every memory-bomb
  * under a 1 GB address-space limit. */
 #include <gtest/gtest.h>
+#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CActionRobotMovement3D.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationPointCloud.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3D.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
@@ -369,6 +372,80 @@ TEST(HostileFiles, FilesDeclaringMoreThanTheyHoldAreRefusedUnderAOneGigabyteLimi
     // Control: the shipped walk maps under the same limit.
     const fs::path walk = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog";
     EXPECT_EQ(runMapper("--rawlog", walk, dir).exitCode, 0);
+}
+
+// Padding after the gzip member (issue 37, kind 3): the budget was 16 x an upper bound of the
+// bytes a gz file holds, its size x 1032, so 64 kB of zeros after a small member let an entry ask
+// for 1.1 GB. The bound is now the bytes the members inflate to: a rawlog entry declaring 2^26
+// beams and a simplemap declaring 2^23 keyframes (0.3 GB each, taken and then found missing
+// before) are refused before the allocation.
+TEST(HostileFiles, PaddingAfterACompressedFileDoesNotRaiseTheReadBudget) {
+    const fs::path dir = scratchDir("hostile_gz_padding");
+    const Bytes beamBomb =
+        declaring(sensoryFrameWith(scan(12345)), "CObservation2DRangeScan", 12345, 1u << 26, 16);
+    mrpt::maps::CSimpleMap sm;
+    auto sf = mrpt::obs::CSensoryFrame::Create();
+    sf->insert(scan(50));
+    sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), sf);
+    const Bytes smBomb = declaring(bytesOf(sm), "CSimpleMap", 1, 1u << 23, 0);
+    for (const auto& [name, flag, bytes] :
+         {std::tuple{"beams.rawlog", "--rawlog", sensoryFrameWith(scan(3)) + beamBomb},
+          std::tuple{"keyframes.simplemap", "--simplemap", smBomb}}) {
+        SCOPED_TRACE(name);
+        const fs::path f = dir / name;
+        {
+            mrpt::io::CFileGZOutputStream gz(f.string());
+            gz.Write(bytes.data(), bytes.size());
+        }
+        std::ofstream(f, std::ios::binary | std::ios::app) << std::string(64 << 10, '\0');
+        expectOneLineError(runMapper(flag, f, dir), f, "declares more data than the file holds");
+    }
+}
+
+// A point cloud stored outside the rawlog (MRPT's external storage; issue 37, kind 3): MRPT
+// loads it on the map's behalf, from any file and with no bound. The reading path loads it first,
+// from a regular file only and under the read budget of that file's bytes: a device, a missing
+// file and a 50-byte file declaring 2^25 points (0.4 GB) are one-line errors naming the file,
+// from a rawlog and from a simplemap; (control) a real cloud maps.
+TEST(HostileFiles, APointCloudStoredOutsideTheRawlogIsReadOnlyFromARegularFileUnderTheBudget) {
+    const fs::path dir = scratchDir("hostile_external_cloud");
+    mrpt::maps::CSimplePointsMap points;
+    for (int i = 0; i < 100; i++) points.insertPoint(0.5f + 0.01f * i, 0.01f * (i % 10), -0.3f);
+    write(dir / "cloud.bin", bytesOf(points));
+    write(dir / "bomb.bin", declaring(bytesOf(points), "CSimplePointsMap", 100, 1u << 25, 16));
+    auto frameWithCloud = [&](const fs::path& file) {
+        auto pc = mrpt::obs::CObservationPointCloud::Create();
+        pc->sensorLabel = "CLOUD";
+        pc->setAsExternalStorage(
+            file.string(),
+            mrpt::obs::CObservationPointCloud::ExternalStorageFormat::MRPT_Serialization);
+        auto sf = mrpt::obs::CSensoryFrame::Create();
+        sf->insert(pc);
+        return sf;
+    };
+    for (const auto& [file, what] :
+         {std::pair{fs::path("/dev/zero"), std::string("not a regular file")},
+          {dir / "missing.bin", std::string("cannot be read: no such file")},
+          {dir / "bomb.bin", std::string("declares more data than the file holds")}}) {
+        SCOPED_TRACE(file.string());
+        const std::string where = "point cloud 'CLOUD' stored in '" + file.string() + "'";
+        const fs::path rawlog = dir / "external.rawlog";
+        write(rawlog, bytesOf(*frameWithCloud(file)));
+        const RunResult r = runMapper("--rawlog", rawlog, dir);
+        expectOneLineError(r, rawlog, what);
+        EXPECT_NE(r.stderrText.find(where), std::string::npos) << r.stderrText;
+        mrpt::maps::CSimpleMap sm;
+        sm.insert(mrpt::poses::CPose3DPDFGaussian::Create(posePdf()), frameWithCloud(file));
+        const fs::path simplemap = dir / "external.simplemap";
+        write(simplemap, bytesOf(sm));
+        const RunResult m = runMapper("--simplemap", simplemap, dir);
+        expectOneLineError(m, simplemap, what);
+        EXPECT_NE(m.stderrText.find(where), std::string::npos) << m.stderrText;
+    }
+    write(dir / "good.rawlog", bytesOf(*frameWithCloud(dir / "cloud.bin")));
+    const RunResult good = runMapper("--rawlog", dir / "good.rawlog", dir);
+    EXPECT_EQ(good.exitCode, 0) << good.stderrText;
+    EXPECT_NE(readAll(dir / "stdout.txt").find("100 points fused"), std::string::npos);
 }
 
 TEST(HostileFiles, ADirectoryGivenAsTheRawlogOrTheIniIsAOneLineError) {

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "../apps/mapper_run.h"
 #include "multibin/io/OutputFile.h"
 #include "reliability_helpers.h"
 
@@ -71,7 +72,8 @@ int runPlanted(const fs::path& cwd, const std::vector<std::string>& args,
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-/** The names the mapper writes with --outputs all, --export-resolution and --ground-truth. */
+/** The names the mapper writes with --outputs all, --export-resolution and --ground-truth (a run
+ * that writes any other name fails expectNothingOutsideChanges: it was not planted). */
 std::vector<std::string> outputNames() {
     return {"elevation_map.bin",
             "elevation_height.tif",
@@ -84,10 +86,18 @@ std::vector<std::string> outputNames() {
             "elevation_sigma.asc",
             "elevation_certainty.asc",
             "elevation_source.asc",
+            "elevation_untraversable.asc",
+            "elevation_untraversable.png",
+            "elevation_step.asc",
+            "elevation_slope.asc",
+            "elevation_roughness.asc",
+            "elevation_foothold.asc",
+            "elevation_traversability.gridmap.gz",
             "elevation.ply",
             "elevation_height_supersampled.asc",
             "elevation_sigma_supersampled.asc",
             "report.json",
+            "traversability.json",
             "profile.csv",
             "eval_truth.asc",
             "eval_raw_all.asc",
@@ -96,6 +106,10 @@ std::vector<std::string> outputNames() {
             "eval_multibin.asc",
             "eval_multibin_filled.asc",
             "eval_mrpt_height_grid.asc",
+            "eval_untraversable_truth.asc",
+            "eval_untraversable_truth.png",
+            "eval_untraversable_multibin.asc",
+            "eval_untraversable_multibin.png",
             "fig_pi.png",
             "fig_profile.png",
             "layers.png"};
@@ -119,10 +133,12 @@ void plantSymlinks(const fs::path& out, const fs::path& victims, pid_t pid) {
         ec);
 }
 
+/** The mock-up's first 20 rawlog entries, not filled, evaluated against its ground truth (every
+ * output and figure is written; the whole rawlog took a minute a run under the sanitizers). */
 std::vector<std::string> mockupArgs(const fs::path& out) {
     const fs::path src = MULTIBIN_SOURCE_DIR;
-    return {"--config",       (src / "ini" / "mockup.ini").string(),
-            "--rawlog",       (src / "rawlogs" / "mockup.rawlog").string(),
+    return {"--config",       mapper_run::mockupQuickIni(false),
+            "--rawlog",       mapper_run::mockupRawlogPrefix(20),
             "--ground-truth", (src / "rawlogs" / "mockup_gt.asc").string(),
             "--out",          out.string()};
 }
@@ -153,8 +169,12 @@ void expectNothingOutsideChanges(const std::string& name, const std::vector<std:
     after.erase((dir / "stdout.txt").string());
     after.erase((dir / "stderr.txt").string());
     EXPECT_EQ(after, before) << "a file outside the output folder changed";
+    const std::vector<std::string> planted = outputNames();
     for (const auto& e : fs::directory_iterator(out)) {
         const std::string n = e.path().filename().string();
+        if (n[0] != '.')
+            EXPECT_TRUE(std::find(planted.begin(), planted.end(), n) != planted.end())
+                << n << " is written but no symlink was planted there (add it to outputNames)";
         if (n[0] == '.') {
             // Only the planted temporary-name symlinks may remain, untouched.
             EXPECT_TRUE(e.is_symlink()) << n << " left behind";
@@ -173,8 +193,10 @@ TEST(HostilePaths, SymlinksAtEveryOutputAndTemporaryPathChangeNothingOutside) {
     expectNothingOutsideChanges(
         "paths_default", {},
         {"elevation_height.asc", "elevation_sigma.asc", "elevation_certainty.asc",
-         "elevation_source.asc", "elevation.ply", "elevation_height_supersampled.asc",
-         "elevation_sigma_supersampled.asc"});
+         "elevation_source.asc", "elevation_untraversable.asc", "elevation_untraversable.png",
+         "elevation_step.asc", "elevation_slope.asc", "elevation_roughness.asc",
+         "elevation_foothold.asc", "elevation_traversability.gridmap.gz", "elevation.ply",
+         "elevation_height_supersampled.asc", "elevation_sigma_supersampled.asc"});
 }
 
 // Every output group, the supersampled rasters and the evaluation.

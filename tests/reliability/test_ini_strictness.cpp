@@ -18,6 +18,7 @@
 #include <tuple>
 #include <vector>
 
+#include "../apps/mapper_run.h"
 #include "multibin/io/ErrorMessage.h"
 #include "reliability_helpers.h"
 
@@ -136,7 +137,7 @@ TEST(IniStrictness, TheMapperBuildsNoOtherMapType) {
         std::ofstream(dir / "maps.ini") << withOther;
         const std::string cmd = std::string(kAddressSpaceLimit ? "ulimit -v 2000000; " : "") +
                                 ELEVATION_MAPPER_EXE + " --config " + (dir / "maps.ini").string() +
-                                " --rawlog " + (src / "rawlogs" / "mockup.rawlog").string() +
+                                " --rawlog " + mapper_run::mockupRawlogPrefix(20) +
                                 " --outputs map --no-plots --out " + (dir / "out").string() +
                                 " > " + (dir / "log.txt").string() + " 2>&1";
         const int status = std::system(("/bin/sh -c '" + cmd + "'").c_str());
