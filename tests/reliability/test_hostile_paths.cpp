@@ -78,6 +78,9 @@ std::vector<std::string> outputNames() {
     return {"elevation_map.bin",
             "elevation_height.tif",
             "elevation_height.tfw",
+            "elevation_sigma.tif",
+            "elevation_certainty.tif",
+            "elevation_source.tif",
             "elevation.3Dscene",
             "elevation_height.png",
             "elevation_sigma.png",
@@ -196,7 +199,8 @@ TEST(HostilePaths, SymlinksAtEveryOutputAndTemporaryPathChangeNothingOutside) {
          "elevation_source.asc", "elevation_untraversable.asc", "elevation_untraversable.png",
          "elevation_step.asc", "elevation_slope.asc", "elevation_roughness.asc",
          "elevation_foothold.asc", "elevation_traversability.gridmap.gz", "elevation.ply",
-         "elevation_height_supersampled.asc", "elevation_sigma_supersampled.asc"});
+         "elevation_height_supersampled.asc", "elevation_sigma_supersampled.asc",
+         "elevation_sigma.tif", "elevation_certainty.tif", "elevation_source.tif"});
 }
 
 // Every output group, the supersampled rasters and the evaluation.
