@@ -646,3 +646,24 @@ TEST(BinGrid, PoseVariancesFewerThanThePointsAreAnErrorNamingThem) {
         EXPECT_EQ(b.poseHorizontalSigmaCode, multibin::poseSigmaCode(4e-6f));
     });
 }
+
+TEST(BinGrid, TwoPlacesAContinentApartCostTwoTiles) {
+    // The store's memory follows the tiles written, not their bounding box: one point at the
+    // origin and one 5000 km away on both axes (2.5e8 cells at 2 cm) take two tiles and two
+    // groups of the directory, not the 6e10 directory entries of the box.
+    BinGrid g(0.02);
+    const int half = BinStore::kGrowthLimitCells;
+    g.reset(0.02, CellWindow{-half, -half, 2 * half, 2 * half});
+    const size_t empty = g.memoryBytes();
+    const BinUpdateParams p;
+    for (const double at_m : {0.0, 5.0e6, -5.0e6, 3.3e6})
+        g.insertPoints({pointAt(at_m + 0.01, at_m + 0.01, 0.2 + 1e-8 * at_m, 0.003)}, p);
+    EXPECT_EQ(g.store().tileCount(), 4u);
+    EXPECT_LT(g.memoryBytes() - empty, size_t(1) << 20);
+    for (const double at_m : {0.0, 5.0e6, -5.0e6, 3.3e6}) {
+        const Bin* b = g.winningBin(g.cellIndex(at_m + 0.01), g.cellIndex(at_m + 0.01));
+        ASSERT_NE(b, nullptr) << at_m;
+        EXPECT_FLOAT_EQ(b->height_m, float(0.2 + 1e-8 * at_m));
+    }
+    EXPECT_EQ(g.winningBin(g.cellIndex(1.0), g.cellIndex(1.0)), nullptr);
+}

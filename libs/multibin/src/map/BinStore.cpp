@@ -21,8 +21,8 @@ void BinStore::reset(double cellSize_m, const CellWindow& window) {
     m_heads.assign(kTileSlots, kNoBin);  // the empty tile
     m_tileXY.assign(1, TileKey{});
     m_freeTiles.clear();
-    m_directory.clear();
-    m_dirX0 = m_dirY0 = m_dirNx = m_dirNy = 0;
+    m_groupTable.assign(16, GroupKey{});
+    m_groupHashShift = 64 - 4;
     m_groups.assign(1, TileGroup{});  // value-initialised: all zero
     m_pool.clear();
     m_freeHead = kNoBin;
@@ -45,39 +45,25 @@ bool BinStore::growToInclude(const CellWindow& w) {
     return true;
 }
 
-uint32_t& BinStore::groupEntry(int gx, int gy) {
-    const bool inside =
-        unsigned(gx - m_dirX0) < unsigned(m_dirNx) && unsigned(gy - m_dirY0) < unsigned(m_dirNy);
-    if (!inside) {
-        int x0 = m_dirX0, y0 = m_dirY0, x1 = m_dirX0 + m_dirNx, y1 = m_dirY0 + m_dirNy;
-        if (m_dirNx == 0) {  // the first group: a directory of 4 x 4 groups around it
-            x0 = gx - 2, y0 = gy - 2, x1 = gx + 2, y1 = gy + 2;
-        } else {
-            // At least half the current size on each side that must grow: amortised constant
-            // cost per group added, whatever the route's length.
-            const int growX = std::max(2, m_dirNx / 2), growY = std::max(2, m_dirNy / 2);
-            if (gx < x0) x0 = std::min(gx, x0 - growX);
-            if (gx >= x1) x1 = std::max(gx + 1, x1 + growX);
-            if (gy < y0) y0 = std::min(gy, y0 - growY);
-            if (gy >= y1) y1 = std::max(gy + 1, y1 + growY);
-        }
-        std::vector<uint32_t> dir(size_t(x1 - x0) * size_t(y1 - y0), 0);
-        for (int dy = 0; dy < m_dirNy; dy++)
-            for (int dx = 0; dx < m_dirNx; dx++)
-                dir[size_t(m_dirX0 + dx - x0) + size_t(m_dirY0 + dy - y0) * size_t(x1 - x0)] =
-                    m_directory[size_t(dx) + size_t(dy) * size_t(m_dirNx)];
-        m_directory.swap(dir);
-        m_dirX0 = x0, m_dirY0 = y0, m_dirNx = x1 - x0, m_dirNy = y1 - y0;
+uint32_t BinStore::addGroup(int gx, int gy) {
+    size_t h = groupSlot(gx, gy);
+    if (m_groupTable[h].group != 0) return m_groupTable[h].group;
+    if (2 * m_groups.size() > m_groupTable.size()) {  // load above 1/2 with this one: rehash
+        std::vector<GroupKey> old(2 * m_groupTable.size());
+        old.swap(m_groupTable);
+        m_groupHashShift--;
+        for (const GroupKey& k : old)
+            if (k.group != 0) m_groupTable[groupSlot(k.gx, k.gy)] = k;
+        h = groupSlot(gx, gy);
     }
-    return m_directory[size_t(gx - m_dirX0) + size_t(gy - m_dirY0) * size_t(m_dirNx)];
+    const uint32_t group = static_cast<uint32_t>(m_groups.size());
+    m_groups.emplace_back().fill(0);
+    m_groupTable[h] = GroupKey{gx, gy, group};
+    return group;
 }
 
 uint32_t BinStore::addTile(int tx, int ty) {
-    uint32_t& group = groupEntry(tx >> kGroupShift, ty >> kGroupShift);
-    if (group == 0) {
-        group = static_cast<uint32_t>(m_groups.size());
-        m_groups.emplace_back().fill(0);
-    }
+    addGroup(tx >> kGroupShift, ty >> kGroupShift);
     uint32_t t;
     if (!m_freeTiles.empty()) {
         t = m_freeTiles.back();
@@ -95,7 +81,7 @@ uint32_t BinStore::addTile(int tx, int ty) {
 }
 
 uint32_t& BinStore::tileEntry(int tx, int ty) {
-    return m_groups[groupEntry(tx >> kGroupShift, ty >> kGroupShift)]
+    return m_groups[groupNumber(tx >> kGroupShift, ty >> kGroupShift)]
                    [size_t(ty & (kGroupTiles - 1)) * kGroupTiles + size_t(tx & (kGroupTiles - 1))];
 }
 

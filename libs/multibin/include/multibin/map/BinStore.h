@@ -20,13 +20,13 @@ namespace multibin {
  * grid, or the growing cover of the data). It is bookkeeping only: growing it costs nothing.
  * Cells: tiles of kTileCells x kTileCells cells, allocated on the first write into them and found
  * through a two-level directory (groups of kGroupTiles x kGroupTiles tiles, 4 KB each, allocated
- * when a tile of theirs is; one 4-byte entry per group of the groups' bounding box, grown
- * geometrically), so memory follows the ground seen, not the window. A cell's slot is its tile's
+ * when a tile of theirs is, found in a hash table of the groups), so memory follows the ground
+ * seen, not the window: two places a continent apart cost two groups. A cell's slot is its tile's
  * number times kTileSlots plus its place in the tile (row-major); tile 0 is the empty tile, never
  * written, that every cell of an unallocated tile reads. Bins: one pool shared by all cells,
  * chained per cell in insertion order and addressed by a BinId, so callers hold ids, never pointers
- * (the pool may reallocate). Memory: 16 KB per tile (4 B per cell), 4 KB per group of tiles
- * touched, 4 B per 2048 x 2048 cells of the bounding box and 64 B per bin. */
+ * (the pool may reallocate). Memory: 16 KB per tile (4 B per cell), 4 KB and at most 48 B of hash
+ * table per group of tiles touched, and 64 B per bin. */
 class BinStore {
 public:
     using BinId = uint32_t;
@@ -119,10 +119,7 @@ public:
     }
     /** The number of the tile (tx, ty): 0 (the empty tile) if it is not allocated. */
     uint32_t tileNumber(int tx, int ty) const {
-        const unsigned dx = unsigned((tx >> kGroupShift) - m_dirX0),
-                       dy = unsigned((ty >> kGroupShift) - m_dirY0);
-        if (dx >= unsigned(m_dirNx) || dy >= unsigned(m_dirNy)) return 0;
-        const uint32_t group = m_directory[size_t(dx) + size_t(dy) * size_t(m_dirNx)];
+        const uint32_t group = groupNumber(tx >> kGroupShift, ty >> kGroupShift);
         return m_groups[group][size_t(ty & (kGroupTiles - 1)) * kGroupTiles +
                                size_t(tx & (kGroupTiles - 1))];
     }
@@ -174,7 +171,7 @@ public:
     /** Memory held [bytes]: the tiles' cell heads, the directory and the bin pool with its spare
      * capacity. */
     size_t memoryBytes() const {
-        return m_heads.capacity() * sizeof(BinId) + m_directory.capacity() * sizeof(uint32_t) +
+        return m_heads.capacity() * sizeof(BinId) + m_groupTable.capacity() * sizeof(GroupKey) +
                m_groups.capacity() * sizeof(TileGroup) + m_tileXY.capacity() * sizeof(TileKey) +
                m_pool.capacity() * sizeof(Bin);
     }
@@ -189,9 +186,23 @@ private:
     uint32_t addTile(int tx, int ty);
     /** Frees an allocated tile whose cells hold no bin. */
     void freeTile(uint32_t t);
-    /** The slot of the directory's entry for group (gx, gy), growing the directory (by at least
-     * half its size on that side) to hold it. */
-    uint32_t& groupEntry(int gx, int gy);
+    /** A group of tiles in the hash table: its coordinates and number (0: an empty entry). */
+    struct GroupKey {
+        int32_t gx = 0, gy = 0;
+        uint32_t group = 0;
+    };
+    /** The entry of m_groupTable where group (gx, gy) is, or the empty one where it would be. */
+    size_t groupSlot(int gx, int gy) const {
+        const uint64_t key = uint64_t(uint32_t(gx)) << 32 | uint32_t(gy);
+        size_t h = size_t((key * 0x9E3779B97F4A7C15ull) >> m_groupHashShift);  // Fibonacci hashing
+        while (m_groupTable[h].group != 0 && (m_groupTable[h].gx != gx || m_groupTable[h].gy != gy))
+            h = (h + 1) & (m_groupTable.size() - 1);  // linear probing; never full (load <= 1/2)
+        return h;
+    }
+    /** The number of group (gx, gy) in m_groups: 0 (the empty group) if none. */
+    uint32_t groupNumber(int gx, int gy) const { return m_groupTable[groupSlot(gx, gy)].group; }
+    /** The number of group (gx, gy), added (all its tiles absent) if missing. */
+    uint32_t addGroup(int gx, int gy);
     /** The entry of tile (tx, ty) in its group, which must exist. */
     uint32_t& tileEntry(int tx, int ty);
     /** Tile numbers of a group of tiles, row-major; group 0 is all zero (no tile). */
@@ -207,13 +218,13 @@ private:
     double m_cellSize_m;
     double m_invCellSize = 1.0;  //!< 1 / cell size [1/m]
     CellWindow m_window;
-    std::vector<BinId> m_heads;         //!< per slot: the cell's first bin, or kNoBin
-    std::vector<TileKey> m_tileXY;      //!< per tile number: its tile coordinates (0: empty tile)
-    std::vector<uint32_t> m_freeTiles;  //!< tile numbers freed, reused first
-    std::vector<uint32_t> m_directory;  //!< group number of (m_dirX0 + dx, m_dirY0 + dy), or 0
-    int m_dirX0 = 0, m_dirY0 = 0, m_dirNx = 0, m_dirNy = 0;  //!< in groups
-    std::vector<TileGroup> m_groups;                         //!< [0]: the empty group
-    std::vector<Bin> m_pool;  //!< all bins; free ones chained from m_freeHead
+    std::vector<BinId> m_heads;          //!< per slot: the cell's first bin, or kNoBin
+    std::vector<TileKey> m_tileXY;       //!< per tile number: its tile coordinates (0: empty tile)
+    std::vector<uint32_t> m_freeTiles;   //!< tile numbers freed, reused first
+    std::vector<GroupKey> m_groupTable;  //!< open addressing, a power of two in size
+    int m_groupHashShift = 60;           //!< 64 - log2(m_groupTable.size())
+    std::vector<TileGroup> m_groups;     //!< [0]: the empty group
+    std::vector<Bin> m_pool;             //!< all bins; free ones chained from m_freeHead
     BinId m_freeHead = kNoBin;
     size_t m_freeCount = 0;
 };
