@@ -109,9 +109,11 @@ constexpr uint64_t kWindowCellsPerNonEmptyCell = 1024;
  * index within what BinStore can index (its clamp of coordinates), so that ix0 + nx cannot
  * overflow. */
 void checkWindow(const multibin::CellWindow& w, double maxSideCells) {
-    if (w.nx < 0 || w.ny < 0 || double(w.nx) > maxSideCells || double(w.ny) > maxSideCells)
-        corrupt("window of " + std::to_string(w.nx) + " x " + std::to_string(w.ny) +
-                " cells, beyond the stored options' limit of " +
+    const std::string sides = std::to_string(w.nx) + " x " + std::to_string(w.ny) + " cells";
+    if (w.nx < 0 || w.ny < 0) corrupt("window of " + sides + ", a negative side");
+    // maxSideCells is infinite for a growing grid: only a finite limit is ever printed.
+    if (double(w.nx) > maxSideCells || double(w.ny) > maxSideCells)
+        corrupt("window of " + sides + ", beyond the stored options' limit of " +
                 std::to_string(int64_t(maxSideCells)) + " per side");
     const double maxIndex =
         multibin::BinStore::clampedCellCoordinate(std::numeric_limits<double>::infinity());
