@@ -4,7 +4,10 @@
  * refused and why, insertion time per point, peak memory of the process and the map's own, tiles,
  * and the serialized map's size. One route per process, so the peak memory is the route's.
  *
- *   route-scale LENGTH_M [SPACING_M]      e.g. route-scale 1000
+ *   route-scale LENGTH_M [SPACING_M [BUDGET_MB]]      e.g. route-scale 1000
+ *
+ * BUDGET_MB: memory_budget_mb (0: none); the peak while mapping is printed apart from the
+ * process's peak, which includes saving the map (a read: every tile back in memory).
  *
  * scripts/evaluate-route-scale.sh runs it for 50, 200 and 1000 m (doc/route-scale.md). */
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -34,7 +37,8 @@ double peakResidentMB() {
 
 int main(int argc, char** argv) {
     try {
-        if (argc < 2) throw std::invalid_argument("usage: route-scale LENGTH_M [SPACING_M]");
+        if (argc < 2)
+            throw std::invalid_argument("usage: route-scale LENGTH_M [SPACING_M [BUDGET_MB]]");
         multibin::test::RouteOptions o;
         o.length_m = std::stod(argv[1]);
         if (argc > 2) o.spacing_m = std::stod(argv[2]);
@@ -42,6 +46,7 @@ int main(int argc, char** argv) {
             throw std::invalid_argument("route-scale: LENGTH_M > 0 and SPACING_M > 0.005 m");
         mrpt::maps::CMultiBinElevationMap::TCreationOptions c;
         c.resolution_m = 0.05;
+        if (argc > 3) c.memory_budget_mb = std::stod(argv[3]);
         mrpt::maps::CMultiBinElevationMap map(c);
         size_t seen = 0;
         double insert_s = 0;
@@ -53,6 +58,8 @@ int main(int argc, char** argv) {
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             seen += points;
         });
+        const double mappingPeak_mb = peakResidentMB();
+        const mrpt::maps::CMultiBinElevationMap::TileStoreStats tiles = map.tileStoreStats();
         const multibin::InsertStats& s = map.insertStats();
         const std::string file = "route-scale-" + std::string(argv[1]) + "m.mbmap.gz";
         {
@@ -75,6 +82,11 @@ int main(int argc, char** argv) {
             double(map.grid().store().tileCount() * multibin::BinStore::kTileSlots) / 1e6,
             map.grid().binCount(), double(map.grid().memoryBytes()) / 1e6, peakResidentMB(),
             double(written.tellg()) / 1e6, file.c_str());
+        std::printf(
+            "while mapping: process peak %.1f MB, grid peak %.1f MB; tiles written to disk %zu, "
+            "read back %zu\n",
+            mappingPeak_mb, double(tiles.peakResidentBytes) / 1e6, tiles.tilesWritten,
+            tiles.tilesRead);
         std::remove(file.c_str());
         return 0;
     } catch (const std::exception& e) {

@@ -32,11 +32,64 @@ void BinGrid::reset(double cellSize_m, const CellWindow& window) {
 size_t BinGrid::writableSlotInNewTile(int ix, int iy) {
     bool tileAdded;
     const size_t s = m_store.writableSlot(ix, iy, tileAdded);
-    if (tileAdded) m_index.tileAdded(uint32_t(s / BinStore::kTileSlots), m_store.slotCount());
+    if (tileAdded) {
+        const uint32_t t = uint32_t(s / BinStore::kTileSlots);
+        m_index.tileAdded(t, m_store.slotCount());
+        m_store.reloadTile(t, [this](size_t slot, int x, int y, const Bin& b) {
+            m_index.noteHeight(slot, x, y, b.height_m);
+        });
+    }
     m_lastTileX = BinStore::tileOf(ix);
     m_lastTileY = BinStore::tileOf(iy);
     m_lastTileBase = s - BinStore::slotInTile(ix, iy);
     return s;
+}
+
+namespace {
+/** Distance from (x_m, y_m) to the square of tile (tx, ty) [m]. */
+double distanceToTile_m(double x_m, double y_m, int tx, int ty, double tileSide_m) {
+    const double dx = std::max({tx * tileSide_m - x_m, 0.0, x_m - (tx + 1) * tileSide_m});
+    const double dy = std::max({ty * tileSide_m - y_m, 0.0, y_m - (ty + 1) * tileSide_m});
+    return std::hypot(dx, dy);
+}
+}  // namespace
+
+size_t BinGrid::spillFarTiles(double x_m, double y_m, double reach_m, size_t targetBytes,
+                              const std::shared_ptr<TileStoreFile>& file) {
+    if (residentBytes() <= targetBytes) return 0;
+    const double side_m = BinStore::kTileCells * cellSize_m();
+    std::vector<std::pair<double, uint32_t>> far;  // (distance, tile number)
+    m_store.forEachTileNumber([&](uint32_t t, int tx, int ty) {
+        const double d_m = distanceToTile_m(x_m, y_m, tx, ty, side_m);
+        if (d_m > reach_m) far.emplace_back(d_m, t);
+    });
+    // Farthest first; ties by tile number, so the order does not depend on the sort.
+    std::sort(far.begin(), far.end(), [](const auto& a, const auto& b) {
+        return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    size_t spilled = 0;
+    for (const auto& [d_m, t] : far) {
+        if (residentBytes() <= targetBytes) break;
+        for (size_t s = BinStore::tileBase(t); s < BinStore::tileBase(t + 1); s++)
+            m_index.forgetSlot(s);
+        m_store.spillTile(t, file);
+        spilled++;
+    }
+    forgetLastTile();
+    return spilled;
+}
+
+size_t BinGrid::reloadTilesNear(double x_m, double y_m, double reach_m) {
+    if (!m_store.hasSpilledTiles()) return 0;
+    const double side_m = BinStore::kTileCells * cellSize_m();
+    std::vector<std::pair<int, int>> near;
+    m_store.forEachSpilledTile([&](int tx, int ty) {
+        if (distanceToTile_m(x_m, y_m, tx, ty, side_m) <= reach_m) near.emplace_back(tx, ty);
+    });
+    // A write into the tile brings it back (writableSlotInNewTile).
+    for (const auto& [tx, ty] : near)
+        writableSlot(tx * BinStore::kTileCells, ty * BinStore::kTileCells);
+    return near.size();
 }
 
 void BinGrid::appendBin(int ix, int iy, const BinEstimate& bin) {

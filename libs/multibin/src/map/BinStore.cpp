@@ -2,6 +2,7 @@
 #include "multibin/map/BinStore.h"
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -27,6 +28,10 @@ void BinStore::reset(double cellSize_m, const CellWindow& window) {
     m_pool.clear();
     m_freeHead = kNoBin;
     m_freeCount = 0;
+    m_spilled.clear();
+    m_spilledBins = 0;
+    m_tilesSpilled = m_tilesReloaded = 0;
+    m_tileFile.reset();
 }
 
 bool BinStore::growToInclude(const CellWindow& w) {
@@ -132,6 +137,52 @@ BinStore::BinId BinStore::appendBin(size_t s, const BinEstimate& estimate) {
     while (m_pool[last].next != kNoBin) last = m_pool[last].next;
     m_pool[last].next = b;
     return b;
+}
+
+size_t BinStore::spillTile(uint32_t t, const std::shared_ptr<TileStoreFile>& file) {
+    // One record: bins per cell, then the bins in cell and chain order.
+    std::vector<uint32_t> counts(kTileSlots, 0);
+    std::vector<BinEstimate> bins;
+    BinId* heads = m_heads.data() + tileBase(t);
+    for (size_t place = 0; place < kTileSlots; place++) {
+        for (BinId b = heads[place]; b != kNoBin; b = m_pool[b].next) {
+            bins.push_back(m_pool[b]);
+            counts[place]++;
+        }
+    }
+    std::vector<char> record(kTileSlots * sizeof(uint32_t) + bins.size() * sizeof(BinEstimate));
+    std::memcpy(record.data(), counts.data(), kTileSlots * sizeof(uint32_t));
+    if (!bins.empty())
+        std::memcpy(record.data() + kTileSlots * sizeof(uint32_t), bins.data(),
+                    bins.size() * sizeof(BinEstimate));
+    const uint64_t offset = file->append(record.data(), record.size());  // throws: tile kept
+    for (size_t place = 0; place < kTileSlots; place++) {
+        releaseChain(heads[place]);
+        heads[place] = kNoBin;
+    }
+    const TileKey k = m_tileXY[t];
+    m_spilled[tileKey(k.tx, k.ty)] = SpilledTile{offset, uint32_t(bins.size())};
+    m_spilledBins += bins.size();
+    m_tilesSpilled++;
+    m_tileFile = file;
+    freeTile(t);
+    return bins.size();
+}
+
+void BinStore::readSpilled(const SpilledTile& record, std::vector<uint32_t>& counts,
+                           std::vector<BinEstimate>& bins) const {
+    counts.resize(kTileSlots);
+    bins.resize(record.bins);
+    m_tileFile->read(record.offset, counts.data(), kTileSlots * sizeof(uint32_t));
+    uint64_t total = 0;
+    for (uint32_t c : counts) total += c;
+    if (total != record.bins)
+        throw std::runtime_error(
+            "CMultiBinElevationMap: a tile read back from the tile store in '" +
+            m_tileFile->directory() + "' does not hold the bins written");
+    if (record.bins > 0)
+        m_tileFile->read(record.offset + kTileSlots * sizeof(uint32_t), bins.data(),
+                         bins.size() * sizeof(BinEstimate));
 }
 
 }  // namespace multibin

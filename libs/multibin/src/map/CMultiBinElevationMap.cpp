@@ -154,6 +154,8 @@ void visitCreationKeys(Options& o, Visit&& visit) {
     visit("origin_auto", o.origin_auto);
     visit("origin_x_m", o.origin_x_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
     visit("origin_y_m", o.origin_y_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
+    visit("memory_budget_mb", o.memory_budget_mb, atLeast(0, "MB"));
+    visit("tile_store_dir", o.tile_store_dir);
 }
 
 using HeightQuery = CMultiBinElevationMap::TInsertionOptions::HeightQuery;
@@ -385,11 +387,17 @@ CMultiBinElevationMap& CMultiBinElevationMap::operator=(const CMultiBinElevation
 
 CMultiBinElevationMap::~CMultiBinElevationMap() = default;
 
-const multibin::BinGrid& CMultiBinElevationMap::grid() const { return m_impl->grid; }
-const multibin::BinGrid& CMultiBinElevationMap::localGrid() const { return m_impl->local; }
+const multibin::BinGrid& CMultiBinElevationMap::grid() const {
+    prepareForReading();
+    return m_impl->grid;
+}
+const multibin::BinGrid& CMultiBinElevationMap::localGrid() const {
+    prepareForReading();
+    return m_impl->local;
+}
 bool CMultiBinElevationMap::fillIsStale() const { return m_impl->fillStale; }
 const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const {
-    fillIfLoaded();
+    prepareForReading();
     return m_impl->fill;
 }
 const multibin::InsertStats& CMultiBinElevationMap::insertStats() const { return m_impl->stats; }
@@ -490,11 +498,13 @@ bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, d
 
 bool CMultiBinElevationMap::heightAt(double x_m, double y_m, double& height_m,
                                      double& sigma_m) const {
+    prepareForReading();
     return surfaceQuery(true, x_m, y_m, height_m, sigma_m);
 }
 
 bool CMultiBinElevationMap::cellHeight(double x_m, double y_m, double& height_m,
                                        double& sigma_m) const {
+    prepareForReading();
     return surfaceQuery(false, x_m, y_m, height_m, sigma_m);
 }
 

@@ -77,7 +77,7 @@ void CMultiBinElevationMap::heights(const double* x_m, const double* y_m, size_t
         out[0] = height(x_m[0], y_m[0]);
         return;
     }
-    fillIfLoaded();
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (insertionOptions.height_query != TInsertionOptions::HeightQuery::Plane) {
         for (size_t i = 0; i < n; i++) out[i] = height(x_m[i], y_m[i]);  // one cell each

@@ -16,6 +16,7 @@ using namespace mrpt::maps;
 
 void CMultiBinElevationMap::dem_update_map() {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
+    m_impl->grid.reloadTilesNear(0, 0, std::numeric_limits<double>::infinity());
     if (m_impl->fillStale) fillNow();
 }
 
@@ -68,7 +69,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         double& height_m,
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
-    fillIfLoaded();
+    prepareForReading();
     return elevationQuery(insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane,
                           x_m, y_m, height_m, sigma_m, includeFilled);
 }
@@ -77,7 +78,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double 
                                                                          double& height_m,
                                                                          double& sigma_m,
                                                                          bool includeFilled) const {
-    fillIfLoaded();
+    prepareForReading();
     return elevationQuery(false, x_m, y_m, height_m, sigma_m, includeFilled);
 }
 
@@ -110,7 +111,7 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::filledQuery(double x_
 
 bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
                                               double& z_out) const {
-    fillIfLoaded();
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (cx >= dem_get_size_x() || cy >= dem_get_size_y()) return false;
     const multibin::CellWindow& w = m_impl->grid.window();
@@ -119,7 +120,7 @@ bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,
 }
 
 CMultiBinElevationMap::HeightAnswer CMultiBinElevationMap::height(double x_m, double y_m) const {
-    fillIfLoaded();
+    prepareForReading();
     HeightAnswer a;
     double h = 0, s = 0;
     a.source =

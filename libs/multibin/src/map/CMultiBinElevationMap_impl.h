@@ -39,6 +39,11 @@ struct CMultiBinElevationMap::Impl {
     bool fillStale = true;
     /** One writer or concurrent readers: every public entry point takes it (MapLock.h). */
     multibin::MapLock lock;
+    /** The memory budget (CMultiBinElevationMap_budget.cpp): the scratch file of the tiles on
+     * disk, created on the first tile written; the most the grid took; warned once. */
+    std::shared_ptr<multibin::TileStoreFile> tileFile;
+    size_t peakResidentBytes = 0;
+    bool budgetWarned = false;
     /** The traversability layers (CMultiBinElevationMap_traversability.cpp). */
     multibin::TraversabilityCache traversability;
 };

@@ -383,6 +383,7 @@ void CMultiBinElevationMap::growToCoverPoints(const PointsWithCov& mapPoints,
 multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     multibin::BinGrid& grid, const multibin::BinUpdateParams& params, const FuseIntoGrid& fuse,
     const std::optional<Eigen::Vector3d>& sensorOrigin_m, bool cameraFrame) {
+    if (sensorOrigin_m) reloadTilesInReach(grid, *sensorOrigin_m);
     grid.beginCycle();
     grid.setInsertionThreads(insertionOptions.insertion_threads);
     m_impl->fillStale = true;
@@ -396,6 +397,7 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
         m_impl->visibilityStats.cellsVisited += v.cellsVisited;
         m_impl->visibilityStats.binsRemoved += v.binsRemoved;
         m_impl->visibilityStats.binsWeakened += v.binsWeakened;
+        keepWithinMemoryBudget(*sensorOrigin_m);
     }
     return s;
 }

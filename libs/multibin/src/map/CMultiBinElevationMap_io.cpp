@@ -283,6 +283,7 @@ constexpr size_t kPayloadChunkBytes = size_t(1) << 20;
 }  // namespace
 
 void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     mrpt::io::CMemoryStream mem;
     {
@@ -375,7 +376,7 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer,
 
 std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     const std::vector<RasterLayer>& layers, const multibin::CellWindow& w) const {
-    fillIfLoaded();  // a loaded map's rasters hold its filled cells, as the writer's did
+    prepareForReading();  // a loaded map's rasters hold its filled cells, as the writer's did
     const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::BinGrid& grid = m_impl->grid;
     multibin::EsriAsciiGrid g =
@@ -442,7 +443,7 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
     if (tileCells < 1)
         throw std::invalid_argument("occupiedTiles: tileCells " + std::to_string(tileCells) +
                                     " must be at least 1");
-    fillIfLoaded();
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     std::set<std::pair<int, int>> corners;  // (iy0, ix0): ordered row by row from the south
     const auto add = [&](int ix, int iy) {
@@ -473,7 +474,7 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
 }
 
 void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const {
-    fillIfLoaded();
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     const RasterLayer layer = sigma ? RasterLayer::Sigma : RasterLayer::Height;
     // A long route's window is drawn in blocks, each read tile by tile.
@@ -511,7 +512,7 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
 
 void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     const std::string& filNamePrefix) const {
-    fillIfLoaded();
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     // What elevation-mapper writes by default (doc/user-guide.md), read tile by tile: sparse
     // GeoTIFF layers, downsampled previews, the 3D view. ESRI ASCII and PLY are dense over the

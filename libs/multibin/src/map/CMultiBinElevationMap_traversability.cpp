@@ -109,6 +109,7 @@ void sampleCell(const multibin::BinGrid& grid, const multibin::BinGrid* local,
 }  // namespace
 
 TraversabilityLayers CMultiBinElevationMap::traversabilityLayers() const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     updateTraversability();
     const std::lock_guard<std::mutex> cacheLock(m_impl->traversability.mutex);
@@ -116,6 +117,7 @@ TraversabilityLayers CMultiBinElevationMap::traversabilityLayers() const {
 }
 
 void CMultiBinElevationMap::updateTraversability() const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     multibin::TraversabilityCache& cache = m_impl->traversability;
     const std::lock_guard<std::mutex> cacheLock(cache.mutex);
@@ -203,6 +205,7 @@ void CMultiBinElevationMap::updateTraversability() const {
 
 multibin::EsriAsciiGrid CMultiBinElevationMap::traversabilityRaster(
     TraversabilityLayer layer) const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     const TraversabilityLayers t = traversabilityLayers();
     multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(t.lattice);
@@ -219,6 +222,7 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::traversabilityRaster(
 }
 
 void CMultiBinElevationMap::getAsOccupancyGrid(mrpt::maps::COccupancyGridMap2D& out) const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     const TraversabilityLayers t = traversabilityLayers();
     const std::vector<double> a = t.lattice.area_m();
@@ -241,6 +245,7 @@ void CMultiBinElevationMap::getAsOccupancyGrid(mrpt::maps::COccupancyGridMap2D& 
 
 void CMultiBinElevationMap::getUntraversablePoints(mrpt::maps::CSimplePointsMap& points,
                                                    double minProbability) const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     const TraversabilityLayers t = traversabilityLayers();
     const Eigen::Vector2d& o = m_impl->origin_m;
@@ -259,6 +264,7 @@ void CMultiBinElevationMap::getUntraversablePoints(mrpt::maps::CSimplePointsMap&
 
 CMultiBinElevationMap::TFoothold CMultiBinElevationMap::bestFoothold(double x_m, double y_m,
                                                                      double searchRadius_m) const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     const TraversabilityLayers t = traversabilityLayers();
     const Eigen::Vector2d& o = m_impl->origin_m;

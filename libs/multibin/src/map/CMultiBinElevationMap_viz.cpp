@@ -203,7 +203,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
 }  // namespace multibin
 
 void CMultiBinElevationMap::getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const {
-    fillIfLoaded();
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (!genericMapParams.enableSaveAs3DObject) return;
     multibin::buildTerrainView(*this,

@@ -137,6 +137,16 @@ public:
          * [m] as given. Every coordinate that enters or leaves the map is in the pose frame. */
         bool origin_auto = true;
         double origin_x_m = 0, origin_y_m = 0;
+        /** Memory budget of the grid's tiles and bins [MB] (key `memory_budget_mb`; 0: none).
+         * Beyond it, after an insertion, the tiles farthest from the sensor and beyond
+         * `max_range_m` of it are written to a scratch file in `tile_store_dir` and freed; one
+         * comes back when an insertion reaches it, and all come back before the map is read
+         * (queries, filling, outputs, saving). The same bins as without a budget
+         * (doc/route-scale.md). */
+        double memory_budget_mb = 0;
+        /** Directory of that scratch file (key `tile_store_dir`; empty: $TMPDIR, else /tmp). It
+         * has no name there: no other process can open it, and it goes with the process. */
+        std::string tile_store_dir;
         /** The automatic origin for data at (x, y) [m]: the nearest whole kilometre, rounded to
          * whole cells of the (global) grid so the cells stay on multiples of the cell size. */
         mrpt::math::TPoint2D originNear(double x_m, double y_m) const;
@@ -279,6 +289,14 @@ public:
     void heights(const double* x_m, const double* y_m, size_t n, HeightAnswer* out) const;
 
     const multibin::BinGrid& grid() const;
+    /** The memory budget's work so far (TCreationOptions::memory_budget_mb). */
+    struct TileStoreStats {
+        size_t tilesWritten = 0;       //!< tiles written to the scratch file
+        size_t tilesRead = 0;          //!< tiles read back
+        size_t tilesOnDisk = 0;        //!< tiles there now
+        size_t peakResidentBytes = 0;  //!< the most the grid's tiles and bins took [bytes]
+    };
+    TileStoreStats tileStoreStats() const;
     multibin::BinUpdateParams binUpdateParams() const;
     /** Variant of height(): height [m] and sigma [m] at (x, y): measured (the cell surface, as
      * getHeight()) or, with includeFilled, the result of the last gap filling (dem_update_map())
@@ -480,6 +498,16 @@ private:
      * query that may answer a filled height: it answers as the map that wrote it did. Called
      * first by those queries; a no-op inside another entry point. */
     void fillIfLoaded() const;
+    /** Before a read: the tiles a memory budget put on disk back in memory, then
+     * fillIfLoaded(). Called first by every entry point that reads cells; a no-op inside
+     * another entry point. */
+    void prepareForReading() const;
+    /** After an insertion seen from sensor_m [m, grid frame]: within memory_budget_mb, by
+     * writing far tiles to disk. */
+    void keepWithinMemoryBudget(const Eigen::Vector3d& sensor_m);
+    /** Before an insertion into `grid` from sensor_m [m, grid frame]: the tiles on disk it may
+     * reach back in memory. */
+    void reloadTilesInReach(multibin::BinGrid& grid, const Eigen::Vector3d& sensor_m);
     /** Observation -> sensor-frame points -> map frame -> grid. */
     bool insertWithPosePdf(const mrpt::obs::CObservation& obs,
                            const mrpt::poses::CPose3DPDFGaussian& robotPose);

@@ -79,6 +79,25 @@ public:
     void moveWindowTo(int ix0, int iy0) {
         moveWindowTo(ix0, iy0, [](int, int) {});
     }
+    /** @} */
+
+    /** @name A memory budget: tiles on disk (BinStore::spillTile)
+     * A tile on disk reads as empty: it comes back on the first write into it, and by
+     * reloadTilesNear before anything reads it.
+     * @{ */
+    /** Memory the allocated tiles, their index and the bins in use take [bytes]. */
+    size_t residentBytes() const {
+        return m_store.residentBytes() + m_store.tileCount() * VisibilityIndex::kBytesPerTile;
+    }
+    /** Writes tiles farther than `reach_m` from (x_m, y_m) [m, grid frame] to `file`, farthest
+     * first, until residentBytes() <= targetBytes; returns the tiles written. */
+    size_t spillFarTiles(double x_m, double y_m, double reach_m, size_t targetBytes,
+                         const std::shared_ptr<TileStoreFile>& file);
+    /** Reads back every tile on disk within `reach_m` of (x_m, y_m) (all with an infinite
+     * reach); returns the tiles read. */
+    size_t reloadTilesNear(double x_m, double y_m, double reach_m);
+    bool hasSpilledTiles() const { return m_store.spilledTileCount() > 0; }
+    size_t spilledTileCount() const { return m_store.spilledTileCount(); }
 
     /** @name The insertion core
      * @{ */

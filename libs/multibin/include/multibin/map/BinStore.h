@@ -6,10 +6,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "multibin/geometry/Lattice.h"
 #include "multibin/map/Bin.h"
+#include "multibin/map/TileStoreFile.h"
 
 namespace multibin {
 
@@ -26,7 +29,9 @@ namespace multibin {
  * written, that every cell of an unallocated tile reads. Bins: one pool shared by all cells,
  * chained per cell in insertion order and addressed by a BinId, so callers hold ids, never pointers
  * (the pool may reallocate). Memory: 16 KB per tile (4 B per cell), 4 KB and at most 48 B of hash
- * table per group of tiles touched, and 64 B per bin. */
+ * table per group of tiles touched, and 64 B per bin. Tiles on disk: a tile may be written to a
+ * TileStoreFile and freed (spillTile), its bins' pool entries reused; it reads as empty until
+ * reloadTile brings it back (BinGrid does on the first write into it, the map before a read). */
 class BinStore {
 public:
     using BinId = uint32_t;
@@ -107,9 +112,10 @@ public:
     /** The slot of cell (ix, iy): in the empty tile (slots 0 .. kTileSlots - 1, read only) if
      * its tile holds nothing. Any cell, in the window or not. */
     size_t slot(int ix, int iy) const {
-        return (size_t(tileNumber(tileOf(ix), tileOf(iy))) << (2 * kTileShift)) +
-               slotInTile(ix, iy);
+        return tileBase(tileNumber(tileOf(ix), tileOf(iy))) + slotInTile(ix, iy);
     }
+    /** The first slot of tile number t. */
+    static size_t tileBase(uint32_t t) { return size_t(t) << (2 * kTileShift); }
     /** The slot of cell (ix, iy) in its tile, allocated if it had none (`tileAdded` tells), for
      * a write. */
     size_t writableSlot(int ix, int iy, bool& tileAdded);
@@ -133,6 +139,43 @@ public:
     void forEachTile(F&& f) const {
         for (size_t t = 1; t < m_tileXY.size(); t++)
             if (m_tileXY[t].allocated) f(m_tileXY[t].tx, m_tileXY[t].ty);
+    }
+    /** Calls f(t, tx, ty) for every allocated tile: its number and coordinates. */
+    template <typename F>
+    void forEachTileNumber(F&& f) const {
+        for (uint32_t t = 1; t < m_tileXY.size(); t++)
+            if (m_tileXY[t].allocated) f(t, m_tileXY[t].tx, m_tileXY[t].ty);
+    }
+    /** @} */
+
+    /** @name Tiles on disk
+     * @{ */
+    /** Writes the bins of allocated tile number t to `file` (in chain order, so reloadTile
+     * restores each cell as it was) and frees the tile and its bins. Returns the bins written. */
+    size_t spillTile(uint32_t t, const std::shared_ptr<TileStoreFile>& file);
+    /** Whether tile (tx, ty) is on disk. */
+    bool isSpilled(int tx, int ty) const {
+        return !m_spilled.empty() && m_spilled.count(tileKey(tx, ty)) > 0;
+    }
+    size_t spilledTileCount() const { return m_spilled.size(); }
+    /** Tiles written to disk and read back since the last reset. */
+    size_t tilesSpilled() const { return m_tilesSpilled; }
+    size_t tilesReloaded() const { return m_tilesReloaded; }
+    bool hasSpilledTiles() const { return !m_spilled.empty(); }
+    /** Calls f(tx, ty) for every tile on disk. */
+    template <typename F>
+    void forEachSpilledTile(F&& f) const {
+        for (const auto& [key, record] : m_spilled) f(int32_t(key >> 32), int32_t(key));
+    }
+    /** If allocated tile number t (just added, empty) is on disk, reads its bins back into it
+     * and calls onBin(slot, ix, iy, const Bin&) for each; false if it was not on disk. */
+    template <typename OnBin>
+    bool reloadTile(uint32_t t, OnBin&& onBin);
+    /** Memory the allocated tiles and the bins in use take [bytes]: what a memory budget
+     * bounds (the pool keeps its capacity, reused by the next bins). */
+    size_t residentBytes() const {
+        return tileCount() * kTileSlots * sizeof(BinId) +
+               (binCount() - m_spilledBins) * sizeof(Bin) + m_groups.size() * sizeof(TileGroup);
     }
     /** @} */
 
@@ -165,8 +208,8 @@ public:
     size_t editBins(int ix, int iy, F&& f);
     /** Removes every bin of one cell. */
     void clearCell(int ix, int iy);
-    /** Number of bins in use, over all cells. */
-    size_t binCount() const { return m_pool.size() - m_freeCount; }
+    /** Number of bins in use, over all cells, those of tiles on disk included. */
+    size_t binCount() const { return m_pool.size() - m_freeCount + m_spilledBins; }
     bool empty() const { return binCount() == 0; }
     /** Memory held [bytes]: the tiles' cell heads, the directory and the bin pool with its spare
      * capacity. */
@@ -182,6 +225,15 @@ private:
         int32_t tx = 0, ty = 0;
         bool allocated = false;
     };
+    static uint64_t tileKey(int tx, int ty) { return uint64_t(uint32_t(tx)) << 32 | uint32_t(ty); }
+    /** Where a tile on disk is: its record's offset in m_tileFile and its bin count. */
+    struct SpilledTile {
+        uint64_t offset = 0;
+        uint32_t bins = 0;
+    };
+    /** Reads the record of a tile on disk: bins per cell (kTileSlots uint32), then the bins. */
+    void readSpilled(const SpilledTile& record, std::vector<uint32_t>& counts,
+                     std::vector<BinEstimate>& bins) const;
     /** Allocates tile (tx, ty) (reusing a freed one if any); returns its number. */
     uint32_t addTile(int tx, int ty);
     /** Frees an allocated tile whose cells hold no bin. */
@@ -227,14 +279,43 @@ private:
     std::vector<Bin> m_pool;             //!< all bins; free ones chained from m_freeHead
     BinId m_freeHead = kNoBin;
     size_t m_freeCount = 0;
+    std::shared_ptr<TileStoreFile> m_tileFile;            //!< where spilled tiles are
+    std::unordered_map<uint64_t, SpilledTile> m_spilled;  //!< tiles on disk, by tileKey
+    size_t m_spilledBins = 0;                             //!< their bins
+    size_t m_tilesSpilled = 0, m_tilesReloaded = 0;
 };
+
+template <typename OnBin>
+bool BinStore::reloadTile(uint32_t t, OnBin&& onBin) {
+    if (m_spilled.empty()) return false;
+    const TileKey k = m_tileXY[t];
+    const auto it = m_spilled.find(tileKey(k.tx, k.ty));
+    if (it == m_spilled.end()) return false;
+    std::vector<uint32_t> counts;
+    std::vector<BinEstimate> bins;
+    readSpilled(it->second, counts, bins);
+    m_spilledBins -= it->second.bins;
+    m_spilled.erase(it);
+    m_tilesReloaded++;
+    size_t next = 0;
+    for (size_t place = 0; place < kTileSlots; place++) {
+        const int ix = k.tx * kTileCells + int(place & (kTileCells - 1));
+        const int iy = k.ty * kTileCells + int(place >> kTileShift);
+        const size_t s = tileBase(t) + place;
+        for (uint32_t j = 0; j < counts[place]; j++) {
+            const BinId b = appendBin(s, bins[next++]);
+            onBin(s, ix, iy, m_pool[b]);
+        }
+    }
+    return true;
+}
 
 inline size_t BinStore::writableSlot(int ix, int iy, bool& tileAdded) {
     const int tx = tileOf(ix), ty = tileOf(iy);
     uint32_t t = tileNumber(tx, ty);
     tileAdded = t == 0;
     if (tileAdded) t = addTile(tx, ty);
-    return (size_t(t) << (2 * kTileShift)) + slotInTile(ix, iy);
+    return tileBase(t) + slotInTile(ix, iy);
 }
 
 inline BinStore::BinId BinStore::findOrAddBin(size_t s, int16_t n, bool& added) {
@@ -275,7 +356,7 @@ void BinStore::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave, OnCleared&& onC
                     continue;
                 }
                 if (!oldW.contains(ix, iy)) continue;
-                const size_t s = (size_t(t) << (2 * kTileShift)) + slotInTile(ix, iy);
+                const size_t s = tileBase(t) + slotInTile(ix, iy);
                 if (m_heads[s] != kNoBin) {
                     onLeave(ix, iy);
                     releaseChain(m_heads[s]);
@@ -293,7 +374,7 @@ void BinStore::forEachStoredBin(F&& f) const {
     for (size_t t = 1; t < m_tileXY.size(); t++) {
         if (!m_tileXY[t].allocated) continue;
         const int cx0 = m_tileXY[t].tx * kTileCells, cy0 = m_tileXY[t].ty * kTileCells;
-        const BinId* heads = m_heads.data() + (t << (2 * kTileShift));
+        const BinId* heads = m_heads.data() + tileBase(uint32_t(t));
         for (int r = 0; r < kTileCells; r++)
             for (int c = 0; c < kTileCells; c++)
                 for (BinId b = heads[r * kTileCells + c]; b != kNoBin; b = m_pool[b].next)

@@ -84,6 +84,8 @@ public:
     }
     /** @} */
 
+    /** Memory per allocated tile of the store [bytes]: its stamps and block bounds. */
+    static const size_t kBytesPerTile;
     /** Memory held [bytes]: stamps, the list of updated cells, the block bounds. */
     size_t memoryBytes() const {
         return m_stamps.capacity() * sizeof(CellStamp) +
@@ -110,6 +112,9 @@ private:
     double m_maxHeight_m = -std::numeric_limits<double>::infinity();
     std::vector<float> m_blocks;  //!< per tile of the store, its blocks' bounds, row-major
 };
+
+inline const size_t VisibilityIndex::kBytesPerTile =
+    BinStore::kTileSlots * sizeof(CellStamp) + kBlocksPerTile * kBlocksPerTile * sizeof(float);
 
 inline void VisibilityIndex::noteUpdate(size_t s, int ix, int iy, double height_m,
                                         uint32_t points) {
