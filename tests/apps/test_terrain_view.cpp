@@ -293,9 +293,6 @@ TEST(TerrainViewLegend, FacesTheDefaultCameraAndScalesWithTheMap) {
         const Eigen::Matrix3d R = bar->getPoseRef().getRotationMatrix().asEigen();
         EXPECT_GT(R.col(2).dot(towardsCamera), 0.999) << "the bar faces the camera";
         EXPECT_GT(R.col(1).dot(screenUp), 0.999) << "its long side is the screen's up";
-        barHeight_m[side_m] = bar->getyMax() - bar->getyMin();
-        EXPECT_NEAR(barHeight_m[side_m], 0.5 * std::hypot(side_m, side_m) * 51 / 50, 1e-3 * side_m)
-            << "half the diagonal of the view: the known cells and a margin of one cell";
 
         // The value labels, bottom to top along the screen's up, read low to high.
         std::vector<std::pair<double, double>> upAndValue;
@@ -310,6 +307,10 @@ TEST(TerrainViewLegend, FacesTheDefaultCameraAndScalesWithTheMap) {
         std::sort(upAndValue.begin(), upAndValue.end());
         for (size_t k = 1; k < upAndValue.size(); k++)
             EXPECT_GT(upAndValue[k].second, upAndValue[k - 1].second);
+        // The labels span the bar: as tall as half the view's diagonal (the known cells and a
+        // margin of one cell), as seen by the default camera (the bar faces it).
+        barHeight_m[side_m] = upAndValue.back().first - upAndValue.front().first;
+        EXPECT_NEAR(barHeight_m[side_m], 0.5 * std::hypot(side_m, side_m) * 51 / 50, 1e-3 * side_m);
         EXPECT_NEAR(upAndValue.front().second, 0.1 * 0.5 * side_m / 50, 0.002 * side_m);
         EXPECT_NEAR(upAndValue.back().second, 0.1 * 49.5 * side_m / 50, 0.002 * side_m);
     }
@@ -348,7 +349,8 @@ TEST(TerrainViewCamera, SavedSceneFramesTheMapOnItsDefaultCamera) {
         const auto bar =
             std::dynamic_pointer_cast<mrpt::opengl::CMesh>(byName(*view, "colour bar"));
         ASSERT_TRUE(bar);
-        for (const double up : {bar->getyMin(), bar->getyMax()}) {
+        const double step_m = (bar->getyMax() - bar->getyMin()) / 65;  // 2 masked rows
+        for (const double up : {bar->getyMin() + step_m, bar->getyMax() - step_m}) {
             const auto e = bar->getPoseRef().composePoint(mrpt::math::TPoint3D(0, up, 0));
             EXPECT_LE(screen.ndc({e.x, e.y, e.z}).cwiseAbs().maxCoeff(), 1.0) << "the legend";
         }

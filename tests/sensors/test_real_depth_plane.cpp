@@ -44,19 +44,6 @@ mrpt::obs::CObservation3DRangeScan wallOnly(const mrpt::obs::CObservation3DRange
     return wall;
 }
 
-/** The frame's valid points in the map frame. */
-std::vector<Eigen::Vector3d> mapFramePoints(const mrpt::obs::CObservation3DRangeScan& frame) {
-    const mrpt::poses::CPose3D camera = kLookingDown + frame.sensorPose;
-    std::vector<Eigen::Vector3d> P;
-    for (size_t i = 0; i < frame.points3D_x.size(); i++) {
-        if (!(frame.points3D_x[i] > 0)) continue;
-        double x, y, z;
-        camera.composePoint(frame.points3D_x[i], frame.points3D_y[i], frame.points3D_z[i], x, y, z);
-        P.emplace_back(x, y, z);
-    }
-    return P;
-}
-
 /** RANSAC's plane refined by least squares (z = a x + b y + c) on the points within 5 cm of it. */
 Eigen::Vector3d robustPlane(const std::vector<Eigen::Vector3d>& P) {
     const multibin::test::FloorPlane ransac = multibin::test::fitFloorPlane(P);
@@ -95,7 +82,8 @@ TEST(RealDepthPlane, WallAsGroundHasAtMostHalfAPercentOfCellsOff50mm) {
     pose.mean = kLookingDown;
     ASSERT_TRUE(map.insertObservation(wall, pose));
 
-    const std::vector<Eigen::Vector3d> P = mapFramePoints(wall);
+    std::vector<Eigen::Vector3d> P;
+    for (const auto& f : multibin::test::depthFramePoints(wall, kLookingDown)) P.push_back(f.p_m);
     ASSERT_GT(P.size(), 50000u);
     const Eigen::Vector3d plane = robustPlane(P);
     const double res = map.creationOptions.resolution_m;

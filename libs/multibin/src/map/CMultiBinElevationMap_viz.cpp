@@ -6,6 +6,7 @@
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/CMesh.h>
 #include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CPointCloudColoured.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CText.h>
 #include "CMultiBinElevationMap_impl.h"
@@ -159,6 +160,41 @@ mrpt::opengl::CMesh::Ptr terrainMesh(const EsriAsciiGrid& heights, const EsriAsc
     return mesh;
 }
 
+/** The known cells the mesh does not draw (it draws a quad only between four known vertices:
+ * a cell with no such quad around it, on a thin wall or alone, would not show), as points of
+ * their colour, 2 pixels wide at any distance. */
+mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
+                                                 const EsriAsciiGrid& values,
+                                                 SceneColouring colouring, const ViewRanges& r) {
+    const int nx = heights.cols(), ny = heights.rows();
+    auto known = [&](int ix, int iy) {
+        return ix >= 0 && iy >= 0 && ix < nx && iy < ny && std::isfinite(heights.heights_m(iy, ix));
+    };
+    auto inAQuad = [&](int ix, int iy) {
+        for (int qx = ix - 1; qx <= ix; qx++)
+            for (int qy = iy - 1; qy <= iy; qy++)
+                if (known(qx, qy) && known(qx + 1, qy) && known(qx, qy + 1) &&
+                    known(qx + 1, qy + 1))
+                    return true;
+        return false;
+    };
+    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    auto points = mrpt::opengl::CPointCloudColoured::Create();
+    points->setName("cells outside the mesh");
+    points->setPointSize(2);
+    for (int iy = 0; iy < ny; iy++)
+        for (int ix = 0; ix < nx; ix++) {
+            if (!known(ix, iy) || inAQuad(ix, iy)) continue;
+            const float v = values.heights_m(iy, ix);
+            const mrpt::img::TColor c = std::isfinite(v) ? cellColour(v, colouring, lut, r)
+                                                         : mrpt::img::TColor(128, 128, 128);
+            points->push_back(float(heights.xllcenter_m + ix * heights.cellsize_m),
+                              float(heights.yllcenter_m + iy * heights.cellsize_m),
+                              heights.heights_m(iy, ix), c.R / 255.f, c.G / 255.f, c.B / 255.f);
+        }
+    return points;
+}
+
 mrpt::opengl::CText::Ptr label(const std::string& text, const mrpt::math::TPoint3D& at,
                                mrpt::img::TColor colour = mrpt::img::TColor(30, 30, 30)) {
     auto t = mrpt::opengl::CText::Create(text);
@@ -212,24 +248,39 @@ LegendFrame legendFrame(const EsriAsciiGrid& heights, const ViewRanges& r) {
 }
 
 /** The colour bar: a CMesh of 2 x 64 vertices in the legend's plane, the layer's colour map from
- * its low end (bottom) to its high end (top), unlit so its colours are the map's. */
+ * its low end (bottom) to its high end (top), unlit so its colours are the map's. One more row of
+ * vertices at each end, masked out, keeps the renderer's texture wrap (the top colour blended with
+ * the bottom one) off the drawn bar. */
 mrpt::opengl::CMesh::Ptr colourBar(const LegendFrame& f, SceneColouring colouring) {
-    constexpr int kSteps = 64;
+    constexpr int kSteps = 64, kRows = kSteps + 2;
+    const double step_m = f.height_m / (kSteps - 1);
     const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
-    mrpt::math::CMatrixDynamic<float> Z(2, kSteps), mask(2, kSteps);
+    mrpt::math::CMatrixDynamic<float> Z(2, kRows), mask(2, kRows);
     Z.setZero(), mask.fill(1.f);
-    mrpt::img::CImage texture(kSteps, 2, mrpt::img::CH_RGB);
-    for (int i = 0; i < 2; i++)
-        for (int j = 0; j < kSteps; j++)
-            texture.setPixel(j, i, toColor(colourAt(lut, float(j) / (kSteps - 1))));
+    mrpt::img::CImage texture(kRows, 2, mrpt::img::CH_RGB);
+    for (int i = 0; i < 2; i++) {
+        mask(i, 0) = mask(i, kRows - 1) = 0.f;
+        for (int j = 0; j < kRows; j++) {
+            const int k = std::clamp(j - 1, 0, kSteps - 1);
+            texture.setPixel(j, i, toColor(colourAt(lut, float(k) / (kSteps - 1))));
+        }
+    }
     auto bar = mrpt::opengl::CMesh::Create();
     bar->setName("colour bar");
-    bar->setGridLimits(0.0, f.width_m, 0.0, f.height_m);
+    bar->setGridLimits(0.0, f.width_m, -step_m, f.height_m + step_m);
     bar->assignImageAndZ(texture, Z);
     bar->setMask(mask);
     bar->enableLight(false);
     bar->setPose(f.pose);
     return bar;
+}
+
+/** The labels' format: three decimals, more when five labels over [lo, hi] would repeat one. */
+std::string valueFormat(SceneColouring colouring, const ViewRanges& r) {
+    if (colouring == SceneColouring::Certainty) return "%.0f";
+    const double step = (r.hi - r.lo) / 4;
+    const int decimals = step > 0 ? std::clamp(int(std::ceil(-std::log10(step))) + 1, 3, 6) : 3;
+    return "%." + std::to_string(decimals) + "f m";
 }
 
 /** A colour bar with five values and the layer's name, or the categories of the source layer,
@@ -248,10 +299,10 @@ void addLegend(const LegendFrame& f, SceneColouring colouring, const ViewRanges&
         return;
     }
     into.insert(colourBar(f, colouring));
-    const char* format = colouring == SceneColouring::Certainty ? "%.0f" : "%.3f m";
+    const std::string format = valueFormat(colouring, r);
     char buf[64];
-    for (int k = 0; k <= 4; k++) {
-        std::snprintf(buf, sizeof buf, format, r.lo + (r.hi - r.lo) * k / 4.0);
+    for (int k = 0; k <= (r.hi > r.lo ? 4 : 0); k++) {  // one label for a single value
+        std::snprintf(buf, sizeof buf, format.c_str(), r.lo + (r.hi - r.lo) * k / 4.0);
         into.insert(label(buf, at(1.5 * f.width_m, f.height_m * k / 4.0)));
     }
     std::snprintf(buf, sizeof buf, "%s%s", sceneColouringName(colouring),
@@ -296,6 +347,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
 
     const ViewRanges r = viewRanges(heights, values, colouring);
     into.insert(terrainMesh(heights, values, colouring, r));
+    if (auto lone = loneCells(heights, values, colouring, r); lone->size() > 0) into.insert(lone);
     addScaleGrid(heights, r.zLo_m, into);
     addLegend(legendFrame(heights, r), colouring, r, into);
     if (!atZero) out.insert(placed);
