@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Makes the figures of doc/user-guide.md into doc/user-guide/: maps the shipped mock-up with
-# elevation-mapper (previews, evaluation figures, 3D scenes), then takes screenshots of MRPT's
-# RawLogViewer (the rawlog) and SceneViewer3D (the map) on a virtual X display (Xvfb).
+# elevation-mapper (previews, evaluation figures, 3D scenes), the shipped walk and MRPT's Malaga
+# building (a horizontal laser: walls) for the 3D view at two sizes, then takes screenshots of
+# MRPT's RawLogViewer (the rawlog) and SceneViewer3D (the maps, from the camera each scene
+# carries) on a virtual X display (Xvfb).
 # Rerun it after changing the mapper or the data; it installs what it needs (Debian packages).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -22,6 +24,10 @@ for colour in sigma source; do
   "$mapper" --config ini/mockup.ini --rawlog rawlogs/mockup.rawlog --outputs scene \
     --scene-colour "$colour" --out "$work/scene-$colour" >/dev/null
 done
+"$mapper" --config ini/walk.ini --rawlog rawlogs/walk.rawlog --outputs scene \
+  --out "$work/walk" >/dev/null
+"$mapper" --config ini/lidar-2d.ini --outputs scene --out "$work/malaga" \
+  --simplemap /usr/share/mrpt/datasets/malaga-cs-fac-building.simplemap.gz >/dev/null 2>&1
 cp "$work/map/elevation_height.png" "$work/map/elevation_sigma.png" \
   "$work/map/elevation_source.png" "$work/map/fig_pi.png" "$work/map/fig_profile.png" \
   "$work/map/layers.png" "$figures/"
@@ -30,7 +36,8 @@ sed "s|$work/|OUT/|" "$work/map.txt" > "$figures/elevation-mapper-output.txt"
 
 # screenshot OUT.png ZOOM PROGRAM ARGS...: starts PROGRAM on the virtual display, closes its
 # start-up tip, makes its main window 1280 x 800, turns the mouse wheel ZOOM notches over the
-# view (SceneViewer3D opens at a fixed distance of 20 m) and saves the screen.
+# view (0: the camera the program opened with; a saved map's scene carries one that frames it)
+# and saves the screen.
 cat > "$work/screenshot.sh" <<'SHOT'
 set -euo pipefail
 out=$1; zoom=$2; shift 2
@@ -66,9 +73,11 @@ shot() {
   return 1
 }
 shot "$figures/rawlogviewer.png" 0 RawLogViewer rawlogs/mockup.rawlog
-shot "$figures/sceneviewer3d-height.png" 20 SceneViewer3D "$work/map/elevation.3Dscene"
+shot "$figures/sceneviewer3d-height.png" 0 SceneViewer3D "$work/map/elevation.3Dscene"
 for colour in sigma source; do
-  shot "$figures/sceneviewer3d-$colour.png" 20 SceneViewer3D \
+  shot "$figures/sceneviewer3d-$colour.png" 0 SceneViewer3D \
     "$work/scene-$colour/elevation.3Dscene"
 done
+shot "$figures/sceneviewer3d-walk.png" 0 SceneViewer3D "$work/walk/elevation.3Dscene"
+shot "$figures/sceneviewer3d-malaga.png" 0 SceneViewer3D "$work/malaga/elevation.3Dscene"
 echo "figures in $figures/"

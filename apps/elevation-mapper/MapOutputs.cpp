@@ -359,17 +359,7 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
             auto obj = mrpt::opengl::CSetOfObjects::Create();
             multibin::buildTerrainView(map, sel.sceneColouring, *obj);
             scene.insert(obj);
-            // The first view: the whole map from above at an angle.
-            const multibin::TiledRaster& h = layers.tiled[0];
-            const multibin::CellWindow& w = layers.cells;
-            auto& camera = scene.getViewport("main")->getCamera();
-            camera.setPointingAt(0.5 * (h.cellCenterX_m(w.ix0) + h.cellCenterX_m(w.ix0 + w.nx - 1)),
-                                 0.5 * (h.cellCenterY_m(w.iy0) + h.cellCenterY_m(w.iy0 + w.ny - 1)),
-                                 0.0);
-            camera.setZoomDistance(
-                1.2 * std::max({(w.nx - 1) * h.cellSize_m, (w.ny - 1) * h.cellSize_m, 1.0}));
-            camera.setAzimuthDegrees(-60);
-            camera.setElevationDegrees(45);
+            multibin::frameTerrainScene(scene);  // opens framed in SceneViewer3D
             folder.write("elevation.3Dscene", gzSerialized(scene));
         });
     if (sel.png)

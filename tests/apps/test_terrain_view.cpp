@@ -5,7 +5,6 @@
  * (color_by_sigma used to write a texture of the wrong size). */
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
-#include <mrpt/opengl/CColorBar.h>
 #include <mrpt/opengl/CFBORender.h>
 #include <mrpt/opengl/CMesh.h>
 #include <mrpt/opengl/COpenGLScene.h>
@@ -17,6 +16,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 
 #include "multibin/map/TerrainView.h"
 
@@ -136,7 +136,7 @@ TEST_P(TerrainView, MeshTexelsSpreadOverTheColoursAndALegendIsInTheScene) {
 
     size_t bars = 0, texts = 0;
     for (const auto& o : view) {
-        bars += std::dynamic_pointer_cast<mrpt::opengl::CColorBar>(o) != nullptr;
+        bars += std::dynamic_pointer_cast<mrpt::opengl::CMesh>(o) && o->getName() == "colour bar";
         texts += std::dynamic_pointer_cast<mrpt::opengl::CText>(o) != nullptr;
     }
     if (colouring == SceneColouring::Source)
@@ -215,4 +215,181 @@ TEST(TerrainViewMap, EmptyMapGivesNoObjects) {
     mrpt::opengl::CSetOfObjects view;
     multibin::buildTerrainView(empty, SceneColouring::Height, view);
     EXPECT_EQ(view.size(), 0u);
+}
+
+namespace {
+
+/** A square map of `side_m` (50 x 50 cells) on a slope rising 10 % of the side along x. */
+std::unique_ptr<CMultiBinElevationMap> squareMap(double side_m) {
+    auto map = std::make_unique<CMultiBinElevationMap>();
+    map->creationOptions.resolution_m = side_m / 50;
+    map->setCreationOptions(map->creationOptions);
+    map->insertionOptions.fill.enabled = false;
+    map->insertionOptions.max_elevation_uncertainty_m = 10;
+    mrpt::maps::CHeightGridMap2D_Base::TPointInsertParams p;
+    p.pt_z_std = 0.001;
+    for (int i = 0; i < 50; i++)
+        for (int j = 0; j < 50; j++) {
+            const double x = (i + 0.5) * side_m / 50, y = (j + 0.5) * side_m / 50;
+            map->insertIndividualPoint(x, y, 0.1 * x, p);
+        }
+    map->dem_update_map();
+    return map;
+}
+
+/** An object of a view by name (searched in placed sets too). */
+mrpt::opengl::CRenderizable::Ptr byName(const mrpt::opengl::CSetOfObjects& view,
+                                        const std::string& name) {
+    for (const auto& o : view) {
+        if (o->getName() == name) return o;
+        if (auto set = std::dynamic_pointer_cast<mrpt::opengl::CSetOfObjects>(o))
+            if (auto found = byName(*set, name)) return found;
+    }
+    return {};
+}
+
+/** The screen of an orbit camera as MRPT's COpenGLViewport places it (eye at azimuth and
+ * elevation around the target, z up): normalized device coordinates of a point (-1..1 on each
+ * axis is in view) for a window of width/height `aspect`. */
+struct OrbitScreen {
+    Eigen::Vector3d eye, right, up, forward;
+    double tanHalfFov, aspect;
+    OrbitScreen(const mrpt::opengl::CCamera& c, double aspect_) : aspect(aspect_) {
+        const double a = mrpt::DEG2RAD(c.getAzimuthDegrees()),
+                     e = mrpt::DEG2RAD(c.getElevationDegrees());
+        const Eigen::Vector3d target(c.getPointingAtX(), c.getPointingAtY(), c.getPointingAtZ());
+        eye =
+            target + c.getZoomDistance() * Eigen::Vector3d(std::cos(e) * std::cos(a),
+                                                           std::cos(e) * std::sin(a), std::sin(e));
+        forward = (target - eye).normalized();
+        right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+        up = right.cross(forward);
+        tanHalfFov = std::tan(mrpt::DEG2RAD(0.5 * c.getProjectiveFOVdeg()));
+    }
+    Eigen::Vector2d ndc(const Eigen::Vector3d& p) const {
+        const Eigen::Vector3d q = p - eye;
+        const double depth = q.dot(forward);
+        return {q.dot(right) / (depth * tanHalfFov * aspect), q.dot(up) / (depth * tanHalfFov)};
+    }
+};
+
+}  // namespace
+
+// The legend of a 1 m and a 40 m map, seen from SceneViewer3D's default direction (azimuth and
+// elevation 45 degrees): the colour bar's plane faces the camera (its normal along the view
+// direction, its long side along the screen's up), so its value labels read upright and the low
+// value is at the bottom; the bar is as tall as half the map's diagonal, 40 times taller on the
+// 40 m map. It used to lie flat, a fixed 1 m tall once saved, its labels upside down from there.
+TEST(TerrainViewLegend, FacesTheDefaultCameraAndScalesWithTheMap) {
+    const Eigen::Vector3d towardsCamera(0.5, 0.5, std::sqrt(0.5));  // azimuth, elevation 45 deg
+    const Eigen::Vector3d screenUp = Eigen::Vector3d(-0.5, -0.5, std::sqrt(0.5));
+    std::map<double, double> barHeight_m;
+    for (const double side_m : {1.0, 40.0}) {
+        const auto map = squareMap(side_m);
+        mrpt::opengl::CSetOfObjects view;
+        multibin::buildTerrainView(*map, SceneColouring::Height, view);
+        const auto bar = std::dynamic_pointer_cast<mrpt::opengl::CMesh>(byName(view, "colour bar"));
+        ASSERT_TRUE(bar) << side_m << " m map";
+        const Eigen::Matrix3d R = bar->getPoseRef().getRotationMatrix().asEigen();
+        EXPECT_GT(R.col(2).dot(towardsCamera), 0.999) << "the bar faces the camera";
+        EXPECT_GT(R.col(1).dot(screenUp), 0.999) << "its long side is the screen's up";
+
+        // The value labels, bottom to top along the screen's up, read low to high.
+        std::vector<std::pair<double, double>> upAndValue;
+        for (const auto& o : view)
+            if (auto t = std::dynamic_pointer_cast<mrpt::opengl::CText>(o)) {
+                double v = 0;
+                if (std::sscanf(t->getString().c_str(), "%lf m", &v) != 1) continue;
+                const auto p = t->getPoseRef().translation();
+                upAndValue.emplace_back(Eigen::Vector3d(p.x, p.y, p.z).dot(screenUp), v);
+            }
+        ASSERT_EQ(upAndValue.size(), 5u) << "five value labels";
+        std::sort(upAndValue.begin(), upAndValue.end());
+        for (size_t k = 1; k < upAndValue.size(); k++)
+            EXPECT_GT(upAndValue[k].second, upAndValue[k - 1].second);
+        // The labels span the bar: as tall as half the view's diagonal (the known cells and a
+        // margin of one cell), as seen by the default camera (the bar faces it).
+        barHeight_m[side_m] = upAndValue.back().first - upAndValue.front().first;
+        EXPECT_NEAR(barHeight_m[side_m], 0.5 * std::hypot(side_m, side_m) * 51 / 50, 1e-3 * side_m);
+        EXPECT_NEAR(upAndValue.front().second, 0.1 * 0.5 * side_m / 50, 0.002 * side_m);
+        EXPECT_NEAR(upAndValue.back().second, 0.1 * 49.5 * side_m / 50, 0.002 * side_m);
+    }
+    EXPECT_NEAR(barHeight_m[40.0] / barHeight_m[1.0], 40.0, 1e-6);
+}
+
+// The saved scene of a 1 m and a 40 m map (saveMetricMapRepresentationToFile, as MRPT's tools
+// write it) opens framed: SceneViewer3D follows its camera (followCamera), and from it every
+// corner of the map's box and the colour bar's ends are inside a 4:3 window, the map spanning at
+// least 40 % of the window's width. It used to open at SceneViewer3D's fixed 20 m from the
+// origin: a 40 m map showed in fragments, a 1 m map as a speck.
+TEST(TerrainViewCamera, SavedSceneFramesTheMapOnItsDefaultCamera) {
+    const fs::path dir = fs::path(MULTIBIN_BINARY_DIR) / "test_terrain_view";
+    fs::create_directories(dir);
+    for (const double side_m : {1.0, 40.0}) {
+        const auto map = squareMap(side_m);
+        const std::string prefix = (dir / ("square_" + std::to_string(int(side_m)))).string();
+        map->saveMetricMapRepresentationToFile(prefix);
+        mrpt::opengl::COpenGLScene scene;
+        ASSERT_TRUE(scene.loadFromFile(prefix + ".3Dscene"));
+        EXPECT_TRUE(scene.followCamera()) << "SceneViewer3D takes the scene's camera";
+        const OrbitScreen screen(scene.getViewport("main")->getCamera(), 4.0 / 3.0);
+        EXPECT_NEAR(screen.forward.dot(Eigen::Vector3d(-0.5, -0.5, -std::sqrt(0.5))), 1.0, 1e-6)
+            << "the default direction, which the legend faces";
+        double xLo = 1e9, xHi = -1e9;
+        for (int k = 0; k < 8; k++) {
+            const Eigen::Vector3d corner((k & 1) ? side_m : 0.0, (k & 2) ? side_m : 0.0,
+                                         (k & 4) ? 0.1 * side_m : 0.0);
+            const Eigen::Vector2d p = screen.ndc(corner);
+            EXPECT_LE(p.cwiseAbs().maxCoeff(), 1.0) << side_m << " m map, corner " << k;
+            xLo = std::min(xLo, p.x()), xHi = std::max(xHi, p.x());
+        }
+        EXPECT_GE(xHi - xLo, 0.4 * 2) << side_m << " m map: the map fills the view";
+        const auto view = scene.getByClass<mrpt::opengl::CSetOfObjects>();
+        ASSERT_TRUE(view);
+        const auto bar =
+            std::dynamic_pointer_cast<mrpt::opengl::CMesh>(byName(*view, "colour bar"));
+        ASSERT_TRUE(bar);
+        const double step_m = (bar->getyMax() - bar->getyMin()) / 65;  // 2 masked rows
+        for (const double up : {bar->getyMin() + step_m, bar->getyMax() - step_m}) {
+            const auto e = bar->getPoseRef().composePoint(mrpt::math::TPoint3D(0, up, 0));
+            EXPECT_LE(screen.ndc({e.x, e.y, e.z}).cwiseAbs().maxCoeff(), 1.0) << "the legend";
+        }
+    }
+}
+
+// The PNG preview and the 3D view draw a value in the same colour: every colour of the height
+// scene's known texels is a colour of elevation_height.png (both written by
+// saveMetricMapRepresentationToFile, both spanning the heights' whole range). The scene used to
+// be in jet, the previews in viridis.
+TEST(TerrainViewColours, SceneAndPreviewShareTheColourMap) {
+    const fs::path dir = fs::path(MULTIBIN_BINARY_DIR) / "test_terrain_view";
+    fs::create_directories(dir);
+    const std::string prefix = (dir / "colours").string();
+    rampMap().saveMetricMapRepresentationToFile(prefix);
+    mrpt::img::CImage preview;
+    ASSERT_TRUE(preview.loadFromFile(prefix + "_height.png"));
+    std::set<std::array<int, 3>> previewColours;
+    for (int y = 0; y < int(preview.getHeight()); y++)
+        for (int x = 0; x < int(preview.getWidth()); x++)
+            previewColours.insert({preview.at<uint8_t>(x, y, 2), preview.at<uint8_t>(x, y, 1),
+                                   preview.at<uint8_t>(x, y, 0)});  // B, G, R
+    mrpt::opengl::COpenGLScene scene;
+    ASSERT_TRUE(scene.loadFromFile(prefix + ".3Dscene"));
+    const auto mesh = meshOf(*scene.getByClass<mrpt::opengl::CSetOfObjects>());
+    ASSERT_TRUE(mesh);
+    mrpt::math::CMatrixFloat mask;
+    mesh->getMask(mask);
+    const mrpt::img::CImage& texture = mesh->getTextureImage();
+    std::set<std::array<int, 3>> sceneColours;
+    size_t missing = 0;
+    for (int r = 0; r < int(texture.getHeight()); r++)
+        for (int c = 0; c < int(texture.getWidth()); c++) {
+            if (mask(r, c) == 0) continue;
+            const std::array<int, 3> rgb{texture.at<uint8_t>(c, r, 2), texture.at<uint8_t>(c, r, 1),
+                                         texture.at<uint8_t>(c, r, 0)};
+            sceneColours.insert(rgb);
+            missing += previewColours.count(rgb) == 0;
+        }
+    EXPECT_GE(sceneColours.size(), 20u) << "the ramp spreads over the colour map";
+    EXPECT_EQ(missing, 0u) << "known texels in a colour the preview does not use";
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <mrpt/maps/CPointsMap.h>
 #include <mrpt/obs/CObservation.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CRawlog.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
@@ -50,6 +51,27 @@ inline std::vector<Eigen::Vector3d> pointsOf(const mrpt::maps::CPointsMap& map) 
         P.emplace_back(x, y, z);
     }
     return P;
+}
+
+/** A depth frame's point in the map frame, with its pixel. */
+struct FramePoint {
+    Eigen::Vector3d p_m;
+    int row, col;
+};
+
+/** The valid points (x > 0 in the camera frame) of a depth frame seen from the robot pose
+ * `robot`, in the map frame. */
+inline std::vector<FramePoint> depthFramePoints(const mrpt::obs::CObservation3DRangeScan& frame,
+                                                const mrpt::poses::CPose3D& robot) {
+    const mrpt::poses::CPose3D camera = robot + frame.sensorPose;
+    std::vector<FramePoint> out;
+    for (size_t i = 0; i < frame.points3D_x.size(); i++) {
+        if (!(frame.points3D_x[i] > 0)) continue;
+        double x, y, z;
+        camera.composePoint(frame.points3D_x[i], frame.points3D_y[i], frame.points3D_z[i], x, y, z);
+        out.push_back({{x, y, z}, frame.points3D_idxs_y[i], frame.points3D_idxs_x[i]});
+    }
+    return out;
 }
 
 /** A near-horizontal plane n.p = d (n_z > 0). */

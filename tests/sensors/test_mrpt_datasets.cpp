@@ -27,6 +27,8 @@ using namespace multibin::sensors;
 
 namespace {
 using multibin::test::datasetObservations;
+using multibin::test::depthFramePoints;
+using multibin::test::FramePoint;
 using multibin::test::originPose;
 
 /** Every cell of the map with a measured height has a finite height and sigma; returns how many
@@ -269,17 +271,12 @@ FloorSigmaCheck depthFloorSigma(const mrpt::obs::CObservation3DRangeScan& frame,
     pose.mean = mrpt::poses::CPose3D(0, 0, 1.5, 0, M_PI / 2, 0);
     EXPECT_TRUE(map.insertObservation(frame, pose));
 
-    const mrpt::poses::CPose3D camera = pose.mean + frame.sensorPose;
     std::vector<Eigen::Vector3d> P;
     Eigen::MatrixXd A(0, 3);
     std::vector<Eigen::Vector3d> wall;
-    for (size_t i = 0; i < frame.points3D_x.size(); i++) {
-        if (!(frame.points3D_x[i] > 0)) continue;
-        double x, y, z;
-        camera.composePoint(frame.points3D_x[i], frame.points3D_y[i], frame.points3D_z[i], x, y, z);
-        P.emplace_back(x, y, z);
-        const int row = frame.points3D_idxs_y[i], col = frame.points3D_idxs_x[i];
-        if (row >= 20 && row <= 130 && col >= 30 && col < 590) wall.emplace_back(x, y, z);
+    for (const FramePoint& f : depthFramePoints(frame, pose.mean)) {
+        P.push_back(f.p_m);
+        if (f.row >= 20 && f.row <= 130 && f.col >= 30 && f.col < 590) wall.push_back(f.p_m);
     }
     A.resize(Eigen::Index(wall.size()), 3);
     Eigen::VectorXd h(A.rows());

@@ -19,6 +19,18 @@
 
 namespace multibin {
 
+ColourLut colourLut(int colormap) {
+    cv::Mat ramp(1, 256, CV_8UC1), bgr;
+    for (int i = 0; i < 256; i++) ramp.at<uint8_t>(0, i) = uint8_t(i);
+    cv::applyColorMap(ramp, bgr, colormap);
+    ColourLut lut;
+    for (int i = 0; i < 256; i++) {
+        const cv::Vec3b c = bgr.at<cv::Vec3b>(0, i);
+        lut[size_t(i)] = {c[2], c[1], c[0]};
+    }
+    return lut;
+}
+
 RasterBox knownBox(const EsriAsciiGrid& raster, int margin_cells) {
     int r0 = raster.rows(), r1 = -1, c0 = raster.cols(), c1 = -1;
     for (int r = 0; r < raster.rows(); r++)
@@ -178,9 +190,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         }
     if (!(lo <= hi)) lo = hi = 0;
     const float span = hi > lo ? hi - lo : 1.f;
-    cv::Mat ramp(1, 256, CV_8UC1), lut;
-    for (int i = 0; i < 256; i++) ramp.at<uint8_t>(0, i) = uint8_t(i);
-    cv::applyColorMap(ramp, lut, style.colormap);
+    const ColourLut lut = colourLut(style.colormap);
 
     auto colourOf = [&](float v) -> cv::Vec3b {
         if (!std::isfinite(v)) return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
@@ -189,8 +199,8 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
                 if (int(std::lround(v)) == k.value) return {k.rgb[2], k.rgb[1], k.rgb[0]};
             return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
         }
-        const int k = std::clamp(int((v - lo) / span * 255.f + 0.5f), 0, 255);
-        return lut.at<cv::Vec3b>(0, k);
+        const auto& rgb = colourAt(lut, (v - lo) / span);
+        return {rgb[2], rgb[1], rgb[0]};
     };
     for (int py = 0; py < H; py++) {
         const int r = rows - 1 - std::min(rows - 1, int(py / scale));  // north up
@@ -248,9 +258,8 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     } else {
         const int barH = 200;
         for (int i = 0; i < barH; i++) {
-            const cv::Vec3b c =
-                lut.at<cv::Vec3b>(0, std::clamp(255 - i * 255 / (barH - 1), 0, 255));
-            cv::line(img, {bx, T + i}, {bx + 18, T + i}, cv::Scalar(c[0], c[1], c[2]));
+            const auto& c = lut[size_t(std::clamp(255 - i * 255 / (barH - 1), 0, 255))];
+            cv::line(img, {bx, T + i}, {bx + 18, T + i}, cv::Scalar(c[2], c[1], c[0]));
         }
         cv::rectangle(img, {bx, T}, {bx + 18, T + barH - 1}, kBlack);
         for (int k = 0; k <= 4; k++) {

@@ -18,6 +18,7 @@
 #include "multibin/io/MapLayerFiles.h"
 #include "multibin/io/OutputFile.h"
 #include "multibin/map/CellSurface.h"
+#include "multibin/map/TerrainView.h"
 
 using namespace mrpt::maps;
 
@@ -546,6 +547,7 @@ void CMultiBinElevationMap::saveMetricMapRepresentationToFile(
     auto obj = mrpt::opengl::CSetOfObjects::Create();
     getVisualizationInto(*obj);
     scene.insert(obj);
+    multibin::frameTerrainScene(scene);
     if (!scene.saveToFile(filNamePrefix + ".3Dscene"))
         throw std::runtime_error("CMultiBinElevationMap: cannot write " + filNamePrefix +
                                  ".3Dscene");

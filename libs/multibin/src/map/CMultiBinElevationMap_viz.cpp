@@ -2,14 +2,17 @@
  * CMultiBinElevationMap: 3D visualization with stock mrpt::opengl classes only, so a saved
  * .3Dscene opens in programs that do not load this library. */
 #include <mrpt/img/CImage.h>
-#include <mrpt/opengl/CColorBar.h>
+#include <mrpt/math/geometry.h>
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/CMesh.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CPointCloudColoured.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/opengl/CText.h>
 #include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -74,74 +77,79 @@ const char* sceneColouringName(SceneColouring c) {
     }
 }
 
-void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring,
-                      mrpt::opengl::CSetOfObjects& out) {
-    // Built relative to the map origin and placed at it, so the view's floats stay small at
-    // georeferenced coordinates.
-    const mrpt::math::TPoint2D origin = map.mapOrigin();
-    // Read tile by tile, one vertex per cell up to 2048 a side, else per block.
-    std::vector<TiledRaster> layers = tiledLayers(map, {Layer::Height, layerOf(colouring)});
-    for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
-    auto placed = mrpt::opengl::CSetOfObjects::Create();
-    placed->setName("map origin");
-    placed->setLocation(origin.x, origin.y, 0);
-    const bool atZero = origin.x == 0 && origin.y == 0;
-    mrpt::opengl::CSetOfObjects& into = atZero ? out : *placed;
-    const CellWindow box = knownWindow(layers[0], 1);
-    const std::vector<EsriAsciiGrid> blocks =
-        blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px),
-                     {BlockReduce::Mean, layerBlockReduce(layerOf(colouring))});
-    const EsriAsciiGrid &heights = blocks[0], &values = blocks[1];
-    const int nx = heights.cols(), ny = heights.rows();
-    if (nx < 2 || ny < 2) return;
+namespace {
 
-    float zLo = std::numeric_limits<float>::infinity(), zHi = -zLo;
+/** The rasters a view is drawn from: the heights and the colouring layer, block-reduced to at
+ * most kPreviewMaxSide_px a side, relative to the map origin. */
+std::vector<EsriAsciiGrid> viewRasters(const CMultiBinElevationMap& map, Layer shown) {
+    // Read tile by tile, one vertex per cell up to 2048 a side, else per block.
+    std::vector<TiledRaster> layers = tiledLayers(map, {Layer::Height, shown});
+    for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
+    const CellWindow box = knownWindow(layers[0], 1);
+    return blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px),
+                        {BlockReduce::Mean, layerBlockReduce(shown)});
+}
+
+/** The height range of the known cells and the range the colours span. */
+struct ViewRanges {
+    float zLo_m = 0, zHi_m = 0, lo = 0, hi = 0;
+    float span() const { return hi > lo ? hi - lo : 1.f; }
+};
+
+ViewRanges viewRanges(const EsriAsciiGrid& heights, const EsriAsciiGrid& values,
+                      SceneColouring colouring) {
+    ViewRanges r;
+    r.zLo_m = std::numeric_limits<float>::infinity(), r.zHi_m = -r.zLo_m;
     std::vector<float> known;
-    for (int r = 0; r < ny; r++)
-        for (int c = 0; c < nx; c++) {
-            const float h = heights.heights_m(r, c), v = values.heights_m(r, c);
+    for (int row = 0; row < heights.rows(); row++)
+        for (int c = 0; c < heights.cols(); c++) {
+            const float h = heights.heights_m(row, c), v = values.heights_m(row, c);
             if (!std::isfinite(h)) continue;
-            zLo = std::min(zLo, h), zHi = std::max(zHi, h);
+            r.zLo_m = std::min(r.zLo_m, h), r.zHi_m = std::max(r.zHi_m, h);
             if (std::isfinite(v)) known.push_back(v);
         }
-    float lo = 0, hi = 0;
-    if (!known.empty()) {
-        lo = *std::min_element(known.begin(), known.end());
-        // Heights span their whole range; sigma and certainty are skewed (a few cells far
-        // above the rest), so their colours span up to the 98th percentile.
-        auto at = known.begin() + std::ptrdiff_t(colouring == SceneColouring::Height
-                                                     ? known.size() - 1
-                                                     : known.size() * 98 / 100);
-        std::nth_element(known.begin(), at, known.end());
-        hi = *at;
-    }
-    const float span = hi > lo ? hi - lo : 1.f;
-    const mrpt::img::TColormap cmap = map.insertionOptions.colormap;
+    if (known.empty()) return r;
+    r.lo = *std::min_element(known.begin(), known.end());
+    // Heights span their whole range (as the previews); sigma and certainty are skewed (a few
+    // cells far above the rest), so their colours span up to the 98th percentile.
+    auto at = known.begin() + std::ptrdiff_t(colouring == SceneColouring::Height
+                                                 ? known.size() - 1
+                                                 : known.size() * 98 / 100);
+    std::nth_element(known.begin(), at, known.end());
+    r.hi = *at;
+    return r;
+}
 
-    // CMesh: Z(i, j) with i along x and j along y, vertices at cell centres; its texture has one
-    // texel per vertex (the image's rows follow i, its columns j).
+mrpt::img::TColor toColor(const std::array<uint8_t, 3>& rgb) {
+    return mrpt::img::TColor(rgb[0], rgb[1], rgb[2]);
+}
+
+/** The colour of a known cell's value: its category, or the layer's colour map (the previews'). */
+mrpt::img::TColor cellColour(float v, SceneColouring colouring, const ColourLut& lut,
+                             const ViewRanges& r) {
+    if (colouring != SceneColouring::Source) return toColor(colourAt(lut, (v - r.lo) / r.span()));
+    for (const RasterCategory& k : heightSourceCategories())
+        if (int(std::lround(v)) == k.value) return toColor({k.rgb[0], k.rgb[1], k.rgb[2]});
+    return mrpt::img::TColor(128, 128, 128);
+}
+
+/** The terrain: a CMesh, Z(i, j) with i along x and j along y, vertices at cell centres; its
+ * texture has one texel per vertex (the image's rows follow i, its columns j). */
+mrpt::opengl::CMesh::Ptr terrainMesh(const EsriAsciiGrid& heights, const EsriAsciiGrid& values,
+                                     SceneColouring colouring, const ViewRanges& r) {
+    const int nx = heights.cols(), ny = heights.rows();
+    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
     mrpt::math::CMatrixDynamic<float> Z(nx, ny), mask(nx, ny);
     mrpt::img::CImage texture(ny, nx, mrpt::img::CH_RGB);
     for (int ix = 0; ix < nx; ix++)
         for (int iy = 0; iy < ny; iy++) {
             const float h = heights.heights_m(iy, ix), v = values.heights_m(iy, ix);
             const bool known = std::isfinite(h);
-            Z(ix, iy) = known ? h : zLo;
+            Z(ix, iy) = known ? h : r.zLo_m;
             mask(ix, iy) = known ? 1.f : 0.f;
-            mrpt::img::TColor colour(128, 128, 128);
-            if (known && std::isfinite(v)) {
-                if (colouring == SceneColouring::Source) {
-                    for (const RasterCategory& k : heightSourceCategories())
-                        if (int(std::lround(v)) == k.value)
-                            colour = mrpt::img::TColor(k.rgb[0], k.rgb[1], k.rgb[2]);
-                } else {
-                    float R, G, B;
-                    mrpt::img::colormap(cmap, (v - lo) / span, R, G, B);
-                    colour =
-                        mrpt::img::TColor(uint8_t(255 * R), uint8_t(255 * G), uint8_t(255 * B));
-                }
-            }
-            texture.setPixel(iy, ix, colour);
+            texture.setPixel(iy, ix,
+                             known && std::isfinite(v) ? cellColour(v, colouring, lut, r)
+                                                       : mrpt::img::TColor(128, 128, 128));
         }
     auto mesh = mrpt::opengl::CMesh::Create();
     mesh->setName("CMultiBinElevationMap");
@@ -149,9 +157,54 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
                         heights.yMax_m());
     mesh->assignImageAndZ(texture, Z);
     mesh->setMask(mask);
-    into.insert(mesh);
+    return mesh;
+}
 
-    // Scale: a grid of nice spacing just under the lowest cell, its spacing written beside it.
+/** The known cells the mesh does not draw (it draws a quad only between four known vertices:
+ * a cell with no such quad around it, on a thin wall or alone, would not show), as points of
+ * their colour, 2 pixels wide at any distance. */
+mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
+                                                 const EsriAsciiGrid& values,
+                                                 SceneColouring colouring, const ViewRanges& r) {
+    const int nx = heights.cols(), ny = heights.rows();
+    auto known = [&](int ix, int iy) {
+        return ix >= 0 && iy >= 0 && ix < nx && iy < ny && std::isfinite(heights.heights_m(iy, ix));
+    };
+    auto inAQuad = [&](int ix, int iy) {
+        for (int qx = ix - 1; qx <= ix; qx++)
+            for (int qy = iy - 1; qy <= iy; qy++)
+                if (known(qx, qy) && known(qx + 1, qy) && known(qx, qy + 1) &&
+                    known(qx + 1, qy + 1))
+                    return true;
+        return false;
+    };
+    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    auto points = mrpt::opengl::CPointCloudColoured::Create();
+    points->setName("cells outside the mesh");
+    points->setPointSize(2);
+    for (int iy = 0; iy < ny; iy++)
+        for (int ix = 0; ix < nx; ix++) {
+            if (!known(ix, iy) || inAQuad(ix, iy)) continue;
+            const float v = values.heights_m(iy, ix);
+            const mrpt::img::TColor c = std::isfinite(v) ? cellColour(v, colouring, lut, r)
+                                                         : mrpt::img::TColor(128, 128, 128);
+            points->push_back(float(heights.xllcenter_m + ix * heights.cellsize_m),
+                              float(heights.yllcenter_m + iy * heights.cellsize_m),
+                              heights.heights_m(iy, ix), c.R / 255.f, c.G / 255.f, c.B / 255.f);
+        }
+    return points;
+}
+
+mrpt::opengl::CText::Ptr label(const std::string& text, const mrpt::math::TPoint3D& at,
+                               mrpt::img::TColor colour = mrpt::img::TColor(30, 30, 30)) {
+    auto t = mrpt::opengl::CText::Create(text);
+    t->setLocation(at);
+    t->setColor_u8(colour);
+    return t;
+}
+
+/** Scale: a grid of nice spacing just under the lowest cell, its spacing written beside it. */
+void addScaleGrid(const EsriAsciiGrid& heights, float zLo_m, mrpt::opengl::CSetOfObjects& into) {
     const double xSpan = heights.xMax_m() - heights.xllcenter_m,
                  ySpan = heights.yMax_m() - heights.yllcenter_m;
     const double step = niceStep(std::max(xSpan, ySpan) / 8);
@@ -159,45 +212,186 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
                  y0 = std::floor(heights.yllcenter_m / step) * step;
     const double x1 = std::ceil(heights.xMax_m() / step) * step,
                  y1 = std::ceil(heights.yMax_m() / step) * step;
-    auto grid = mrpt::opengl::CGridPlaneXY::Create(x0, x1, y0, y1, zLo - 0.01, step);
+    auto grid = mrpt::opengl::CGridPlaneXY::Create(x0, x1, y0, y1, zLo_m - 0.01, step);
     grid->setName("grid");
     grid->setColor_u8(mrpt::img::TColor(90, 90, 90));
     into.insert(grid);
-    char buf[96];
+    char buf[64];
     std::snprintf(buf, sizeof buf, "grid: %g m", step);
-    auto gridLabel = mrpt::opengl::CText::Create(buf);
-    gridLabel->setLocation(x0, y0 - 0.5 * step, zLo);
-    gridLabel->setColor_u8(mrpt::img::TColor(40, 40, 40));
-    into.insert(gridLabel);
+    into.insert(label(buf, {x0, y0 - 0.5 * step, zLo_m}));
+}
 
-    // Legend beside the map (+x side), centred on it in y.
-    const double legendH = std::max(step, 0.4 * ySpan);
-    const double lx = x1 + 0.2 * step, ly = 0.5 * (y0 + y1) - 0.5 * legendH;
-    if (colouring == SceneColouring::Source) {
-        double y = ly + legendH;
-        for (const RasterCategory& k : heightSourceCategories()) {
-            auto t = mrpt::opengl::CText::Create(k.name);
-            t->setLocation(lx, y, zHi);
-            t->setColor_u8(mrpt::img::TColor(k.rgb[0], k.rgb[1], k.rgb[2]));
-            into.insert(t);
-            y -= 0.1 * legendH;
+/** Where the legend is: its lower-left corner and axes (x right, y up, z towards the camera). */
+struct LegendFrame {
+    mrpt::poses::CPose3D pose;
+    double width_m = 0, height_m = 0;
+};
+
+/** The legend's frame: beside the map on the default view's right, facing that view, its height
+ * a fixed share of the map's extent (so it reads the same on a 1 m and a 40 m map once framed). */
+LegendFrame legendFrame(const EsriAsciiGrid& heights, const ViewRanges& r) {
+    const TerrainViewDirection d;
+    const double xSpan = heights.xMax_m() - heights.xllcenter_m,
+                 ySpan = heights.yMax_m() - heights.yllcenter_m;
+    const double halfDiagonal_m = 0.5 * std::hypot(xSpan, ySpan);
+    LegendFrame f;
+    f.height_m = halfDiagonal_m;
+    f.width_m = 0.07 * f.height_m;
+    const mrpt::math::TPoint3D centre(0.5 * (heights.xllcenter_m + heights.xMax_m()),
+                                      0.5 * (heights.yllcenter_m + heights.yMax_m()),
+                                      0.5 * (r.zLo_m + r.zHi_m));
+    const mrpt::math::TPoint3D corner =
+        centre + d.right() * (1.1 * halfDiagonal_m) - d.up() * (0.5 * f.height_m);
+    f.pose = mrpt::poses::CPose3D::FromRotationAndTranslation(
+        d.axes(), mrpt::math::CVectorFixedDouble<3>({corner.x, corner.y, corner.z}));
+    return f;
+}
+
+/** The colour bar: a CMesh of 2 x 64 vertices in the legend's plane, the layer's colour map from
+ * its low end (bottom) to its high end (top), unlit so its colours are the map's. One more row of
+ * vertices at each end, masked out, keeps the renderer's texture wrap (the top colour blended with
+ * the bottom one) off the drawn bar. */
+mrpt::opengl::CMesh::Ptr colourBar(const LegendFrame& f, SceneColouring colouring) {
+    constexpr int kSteps = 64, kRows = kSteps + 2;
+    const double step_m = f.height_m / (kSteps - 1);
+    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    mrpt::math::CMatrixDynamic<float> Z(2, kRows), mask(2, kRows);
+    Z.setZero(), mask.fill(1.f);
+    mrpt::img::CImage texture(kRows, 2, mrpt::img::CH_RGB);
+    for (int i = 0; i < 2; i++) {
+        mask(i, 0) = mask(i, kRows - 1) = 0.f;
+        for (int j = 0; j < kRows; j++) {
+            const int k = std::clamp(j - 1, 0, kSteps - 1);
+            texture.setPixel(j, i, toColor(colourAt(lut, float(k) / (kSteps - 1))));
         }
-    } else {
-        const char* unit = colouring == SceneColouring::Certainty ? " c [-]" : "";
-        const std::string format =
-            colouring == SceneColouring::Certainty ? "%.0f" : std::string("%.3f m");
-        auto bar = mrpt::opengl::CColorBar::Create(cmap, 0.1 * legendH, legendH, 0.f, 1.f, lo, hi,
-                                                   format, float(0.035 * legendH));
-        bar->setName("colour bar");
-        bar->setLocation(lx, ly, zHi);
-        into.insert(bar);
-        std::snprintf(buf, sizeof buf, "%s%s", sceneColouringName(colouring), unit);
-        auto title = mrpt::opengl::CText::Create(buf);
-        title->setLocation(lx, ly - 0.1 * legendH, zHi);  // under the bar: its drawn height varies
-        title->setColor_u8(mrpt::img::TColor(40, 40, 40));
-        into.insert(title);
     }
+    auto bar = mrpt::opengl::CMesh::Create();
+    bar->setName("colour bar");
+    bar->setGridLimits(0.0, f.width_m, -step_m, f.height_m + step_m);
+    bar->assignImageAndZ(texture, Z);
+    bar->setMask(mask);
+    bar->enableLight(false);
+    bar->setPose(f.pose);
+    return bar;
+}
+
+/** The labels' format: three decimals, more when five labels over [lo, hi] would repeat one. */
+std::string valueFormat(SceneColouring colouring, const ViewRanges& r) {
+    if (colouring == SceneColouring::Certainty) return "%.0f";
+    const double step = (r.hi - r.lo) / 4;
+    const int decimals = step > 0 ? std::clamp(int(std::ceil(-std::log10(step))) + 1, 3, 6) : 3;
+    return "%." + std::to_string(decimals) + "f m";
+}
+
+/** A colour bar with five values and the layer's name, or the categories of the source layer,
+ * as CText labels (drawn upright, facing the screen, at a fixed size in pixels). */
+void addLegend(const LegendFrame& f, SceneColouring colouring, const ViewRanges& r,
+               mrpt::opengl::CSetOfObjects& into) {
+    auto at = [&](double right_m, double up_m) {
+        return f.pose.composePoint(mrpt::math::TPoint3D(right_m, up_m, 0));
+    };
+    if (colouring == SceneColouring::Source) {
+        double up_m = f.height_m;
+        for (const RasterCategory& k : heightSourceCategories()) {
+            into.insert(label(k.name, at(0, up_m), toColor({k.rgb[0], k.rgb[1], k.rgb[2]})));
+            up_m -= 0.12 * f.height_m;
+        }
+        return;
+    }
+    into.insert(colourBar(f, colouring));
+    const std::string format = valueFormat(colouring, r);
+    char buf[64];
+    for (int k = 0; k <= (r.hi > r.lo ? 4 : 0); k++) {  // one label for a single value
+        std::snprintf(buf, sizeof buf, format.c_str(), r.lo + (r.hi - r.lo) * k / 4.0);
+        into.insert(label(buf, at(1.5 * f.width_m, f.height_m * k / 4.0)));
+    }
+    std::snprintf(buf, sizeof buf, "%s%s", sceneColouringName(colouring),
+                  colouring == SceneColouring::Certainty ? " c [-]" : " [m]");
+    into.insert(label(buf, at(0, 1.08 * f.height_m)));
+}
+
+}  // namespace
+
+mrpt::math::CMatrixDouble33 TerrainViewDirection::axes() const {
+    mrpt::math::CMatrixDouble33 R;
+    const mrpt::math::TVector3D r = right(), u = up(), n = towardsCamera();
+    for (int i = 0; i < 3; i++) R(i, 0) = r[i], R(i, 1) = u[i], R(i, 2) = n[i];
+    return R;
+}
+
+mrpt::math::TVector3D TerrainViewDirection::towardsCamera() const {
+    const double a = mrpt::DEG2RAD(azimuth_deg), e = mrpt::DEG2RAD(elevation_deg);
+    return {std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
+}
+mrpt::math::TVector3D TerrainViewDirection::right() const {
+    const double a = mrpt::DEG2RAD(azimuth_deg);
+    return {-std::sin(a), std::cos(a), 0};
+}
+mrpt::math::TVector3D TerrainViewDirection::up() const {
+    return mrpt::math::crossProduct3D(towardsCamera(), right());
+}
+
+void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring,
+                      mrpt::opengl::CSetOfObjects& out) {
+    const std::vector<EsriAsciiGrid> rasters = viewRasters(map, layerOf(colouring));
+    const EsriAsciiGrid &heights = rasters[0], &values = rasters[1];
+    if (heights.cols() < 2 || heights.rows() < 2) return;
+    // Built relative to the map origin and placed at it, so the view's floats stay small at
+    // georeferenced coordinates.
+    const mrpt::math::TPoint2D origin = map.mapOrigin();
+    auto placed = mrpt::opengl::CSetOfObjects::Create();
+    placed->setName("map origin");
+    placed->setLocation(origin.x, origin.y, 0);
+    const bool atZero = origin.x == 0 && origin.y == 0;
+    mrpt::opengl::CSetOfObjects& into = atZero ? out : *placed;
+
+    const ViewRanges r = viewRanges(heights, values, colouring);
+    into.insert(terrainMesh(heights, values, colouring, r));
+    if (auto lone = loneCells(heights, values, colouring, r); lone->size() > 0) into.insert(lone);
+    addScaleGrid(heights, r.zLo_m, into);
+    addLegend(legendFrame(heights, r), colouring, r, into);
     if (!atZero) out.insert(placed);
+}
+
+TerrainCamera frameTerrainView(const mrpt::math::TBoundingBox& box, double aspect) {
+    const TerrainViewDirection d;
+    TerrainCamera cam;
+    cam.target = 0.5 * (box.min + box.max);
+    // The nearest distance at which every corner of the box is inside 90 % of the field of view:
+    // a corner q (from the target) at depth distance - q.n needs |q.up| <= tan(fov/2) depth.
+    const double t = 0.9 * std::tan(mrpt::DEG2RAD(0.5 * d.fov_deg));
+    double distance_m = 0;
+    for (int k = 0; k < 8; k++) {
+        const mrpt::math::TPoint3D c((k & 1) ? box.max.x : box.min.x,
+                                     (k & 2) ? box.max.y : box.min.y,
+                                     (k & 4) ? box.max.z : box.min.z);
+        const mrpt::math::TVector3D q = c - cam.target;
+        const double depth =
+            q.x * d.towardsCamera().x + q.y * d.towardsCamera().y + q.z * d.towardsCamera().z;
+        const double up = std::abs(q.x * d.up().x + q.y * d.up().y + q.z * d.up().z);
+        const double side = std::abs(q.x * d.right().x + q.y * d.right().y);
+        distance_m = std::max({distance_m, depth + up / t, depth + side / (t * aspect)});
+    }
+    cam.distance_m = std::max(distance_m, 0.1);
+    return cam;
+}
+
+void frameTerrainScene(mrpt::opengl::COpenGLScene& scene) {
+    auto view = scene.getViewport("main");
+    if (!view || view->size() == 0) return;
+    // The text labels' boxes are their anchor points: the margin of 90 % keeps them on screen.
+    const TerrainCamera cam = frameTerrainView(view->getBoundingBox(), kTerrainViewAspect);
+    const TerrainViewDirection d;
+    mrpt::opengl::CCamera& c = view->getCamera();
+    c.setPointingAt(cam.target);
+    c.setZoomDistance(float(cam.distance_m));
+    c.setAzimuthDegrees(float(d.azimuth_deg));
+    c.setElevationDegrees(float(d.elevation_deg));
+    c.setProjectiveFOVdeg(float(d.fov_deg));
+    // SceneViewer3D starts from this camera (instead of its fixed 20 m from the origin).
+    scene.enableFollowCamera(true);
+    // A light background: the labels are dark, as on the PNG previews.
+    view->setCustomBackgroundColor(mrpt::img::TColorf(0.93f, 0.93f, 0.93f));
 }
 
 }  // namespace multibin

@@ -180,7 +180,7 @@ public:
         multibin::VisibilityParams visibility;
         /** Sensor models: laser, stereo, depth camera (keys `laser_*`, `stereo_*`, `depth_*`). */
         multibin::sensors::SensorModelOptions sensors;
-        mrpt::img::TColormap colormap = mrpt::img::cmJET;
+        mrpt::img::TColormap colormap = mrpt::img::cmJET;  //!< getAsImage() only
         bool color_by_sigma = false;  //!< 3D view coloured by sigma instead of height
         /** Gap filling (keys `fill_*`, see multibin::fill::FillOptions); it runs lazily in
          * dem_update_map(). */

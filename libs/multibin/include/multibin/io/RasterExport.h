@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -58,6 +59,18 @@ struct PreviewStyle {
     /** A line under the title, e.g. "1 pixel = 8 x 8 cells (mean)" for a downsampled raster. */
     std::string note;
 };
+
+/** The 256 colours (R, G, B) of an OpenCV colour map (cv::COLORMAP_*, a PreviewStyle's
+ * `colormap`): the one lookup of the PNG previews and the 3D view, so both draw a normalized value
+ * in the same colour. */
+using ColourLut = std::array<std::array<uint8_t, 3>, 256>;
+ColourLut colourLut(int colormap);
+
+/** The colour of a normalized value t (0 = low end, 1 = high end; clamped) in `lut`. */
+inline const std::array<uint8_t, 3>& colourAt(const ColourLut& lut, float t) {
+    const int k = int(t * 255.f + 0.5f);
+    return lut[size_t(k < 0 ? 0 : k > 255 ? 255 : k)];
+}
 
 /** The longest side of encodePreviewPng()'s map panel [px]: rasters beyond it are given
  * downsampled (blockReduced(), TiledRaster.h). */
