@@ -26,6 +26,7 @@
 #include <iterator>
 #include <limits>
 
+#include "../apps/mapper_run.h"
 #include "reliability_helpers.h"
 
 #ifdef ELEVATION_MAPPER_EXE
@@ -378,11 +379,12 @@ TEST(HostileFiles, FilesDeclaringMoreThanTheyHoldAreRefusedUnderAOneGigabyteLimi
 // The read budget itself (issue 37, kind 7): it replaces the allocation functions of the
 // programs that read rawlogs, so it must serve whatever allocator the process runs with. The
 // mapper (a Release build) runs with gcc's AddressSanitizer and ThreadSanitizer runtimes
-// preloaded, each of which replaces malloc and operator new: the walk maps, and a sensory frame
-// declaring 2^30 observations and a scan declaring 2^31 beams are refused by the budget (the
-// one-line error). Before, the budget handed the runtime memory from glibc's allocator and
-// operator new bypassed it: both runtimes stopped the mapper at start-up ("CHECK failed"). The
-// address-space limit is left out (ASan reserves terabytes of shadow); the refusal is the check.
+// preloaded, each of which replaces malloc and operator new: a sensory frame declaring 2^30
+// observations and a scan declaring 2^31 beams are refused by the budget (the one-line error),
+// and the mock-up's first entries map. Before, the budget handed the runtime memory from glibc's
+// allocator and operator new bypassed it: both runtimes stopped the mapper at start-up ("CHECK
+// failed"). The address-space limit is left out (ASan reserves terabytes of shadow); the refusal
+// is the check.
 TEST(HostileFiles, TheReadBudgetServesTheAllocatorTheMapperRunsWith) {
     if (!kAddressSpaceLimit)
         GTEST_SKIP() << "a sanitizer build: its runtime is the allocator (scripts/sanitize*.sh)";
@@ -392,7 +394,8 @@ TEST(HostileFiles, TheReadBudgetServesTheAllocatorTheMapperRunsWith) {
     write(dir / "beams.rawlog", frame + declaring(sensoryFrameWith(scan(12345)),
                                                   "CObservation2DRangeScan", 12345, 1u << 31, 16));
     const fs::path ini = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini";
-    const fs::path walk = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog";
+    // Control: the mock-up's first 20 entries (laser and stereo), without the fill.
+    const fs::path mockup = mapper_run::mockupRawlogPrefix(20);
     for (const std::string runtime : {"libasan.so.8", "libtsan.so.2"}) {
         SCOPED_TRACE(runtime);
         // Leaks and reports of the uninstrumented libraries are not this test's subject.
@@ -404,8 +407,10 @@ TEST(HostileFiles, TheReadBudgetServesTheAllocatorTheMapperRunsWith) {
             EXPECT_EQ(r.stderrText.find("cannot be preloaded"), std::string::npos);
             expectOneLineError(r, dir / bomb, "entry 1 declares more data than the file holds");
         }
-        const RunResult good = runMapper("--rawlog", walk, dir, ini, setUp);
+        const RunResult good =
+            runMapper("--rawlog", mockup, dir, mapper_run::mockupQuickIni(false), setUp);
         EXPECT_EQ(good.exitCode, 0) << good.stderrText;
+        EXPECT_NE(readAll(dir / "stdout.txt").find("points fused"), std::string::npos);
     }
 }
 
