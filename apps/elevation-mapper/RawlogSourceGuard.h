@@ -10,9 +10,11 @@
  * add up to its limit (frees are not subtracted, so the sum bounds the peak); a request beyond
  * it is refused: malloc, calloc, realloc and memalign return null (operator
  * new then throws std::bad_alloc), posix_memalign and aligned_alloc throw std::bad_alloc (MRPT's
- * aligned allocator does not check for null). The allocation functions are replaced in every
- * program that links this file (RawlogSourceGuard.cpp); under ASan they forward to ASan's, under
- * other allocator-replacing sanitizers (TSan, MSan) the guard is off. */
+ * aligned allocator does not check for null). The allocation functions and operator new are
+ * replaced in every program that links this file (RawlogSourceGuard.cpp) and forward to the
+ * allocator the process runs with: a sanitizer runtime's (gcc's or clang's, built in or
+ * preloaded), else the next definition (glibc's, or one preloaded). Before the first ReadBudget
+ * they only forward. In a build instrumented for TSan or MSan the guard is off. */
 class ReadBudget {
 public:
     /** The limit for `bytesLeft` bytes still to read: kFixedBytes + kPerByte * bytesLeft. */
@@ -36,7 +38,7 @@ public:
     /** The largest total (requests so far plus the refused one) refused since construction
      * (0: none). */
     static uint64_t largestRefused();
-    /** Whether this build enforces the limit (false under TSan and MSan). */
+    /** Whether this build enforces the limit (false in TSan and MSan builds). */
     static bool enforced();
 
 private:

@@ -26,6 +26,7 @@
 #include <iterator>
 #include <limits>
 
+#include "../apps/mapper_run.h"
 #include "reliability_helpers.h"
 
 #ifdef ELEVATION_MAPPER_EXE
@@ -89,12 +90,13 @@ struct RunResult {
 const std::string kLimit =
     kAddressSpaceLimit ? "ulimit -v " + std::to_string(kAddressSpaceLimit_bytes >> 10) + "; " : "";
 
-/** elevation-mapper with `ini` (default: the shipped walk.ini) on `input`, under a 1 GB
- * address-space limit. */
+/** elevation-mapper with `ini` (default: the shipped walk.ini) on `input`, after the shell
+ * prefix `setUp` (default: the 1 GB address-space limit). */
 RunResult runMapper(const std::string& flag, const fs::path& input, const fs::path& dir,
-                    const fs::path& ini = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini") {
+                    const fs::path& ini = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini",
+                    const std::string& setUp = kLimit) {
     const fs::path err = dir / "stderr.txt";
-    const std::string cmd = kLimit + ELEVATION_MAPPER_EXE + " --config " + ini.string() + " " +
+    const std::string cmd = setUp + ELEVATION_MAPPER_EXE + " --config " + ini.string() + " " +
                             flag + " " + input.string() + " --no-plots --out " +
                             (dir / "out").string() + " > " + (dir / "stdout.txt").string() +
                             " 2> " + err.string() + " < /dev/null";
@@ -372,6 +374,44 @@ TEST(HostileFiles, FilesDeclaringMoreThanTheyHoldAreRefusedUnderAOneGigabyteLimi
     // Control: the shipped walk maps under the same limit.
     const fs::path walk = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.rawlog";
     EXPECT_EQ(runMapper("--rawlog", walk, dir).exitCode, 0);
+}
+
+// The read budget itself (issue 37, kind 7): it replaces the allocation functions of the
+// programs that read rawlogs, so it must serve whatever allocator the process runs with. The
+// mapper (a Release build) runs with gcc's AddressSanitizer and ThreadSanitizer runtimes
+// preloaded, each of which replaces malloc and operator new: a sensory frame declaring 2^30
+// observations and a scan declaring 2^31 beams are refused by the budget (the one-line error),
+// and the mock-up's first entries map. Before, the budget handed the runtime memory from glibc's
+// allocator and operator new bypassed it: both runtimes stopped the mapper at start-up ("CHECK
+// failed"). The address-space limit is left out (ASan reserves terabytes of shadow); the refusal
+// is the check.
+TEST(HostileFiles, TheReadBudgetServesTheAllocatorTheMapperRunsWith) {
+    if (!kAddressSpaceLimit)
+        GTEST_SKIP() << "a sanitizer build: its runtime is the allocator (scripts/sanitize*.sh)";
+    const fs::path dir = scratchDir("hostile_budget_allocators");
+    const Bytes frame = sensoryFrameWith(scan(3));
+    write(dir / "frames.rawlog", frame + declaring(frame, "CSensoryFrame", 1, 1u << 30, 0));
+    write(dir / "beams.rawlog", frame + declaring(sensoryFrameWith(scan(12345)),
+                                                  "CObservation2DRangeScan", 12345, 1u << 31, 16));
+    const fs::path ini = fs::path(MULTIBIN_SOURCE_DIR) / "rawlogs" / "walk.ini";
+    // Control: the mock-up's first 20 entries (laser and stereo), without the fill.
+    const fs::path mockup = mapper_run::mockupRawlogPrefix(20);
+    for (const std::string runtime : {"libasan.so.8", "libtsan.so.2"}) {
+        SCOPED_TRACE(runtime);
+        // Leaks and reports of the uninstrumented libraries are not this test's subject.
+        const std::string setUp =
+            "LD_PRELOAD=" + runtime + " ASAN_OPTIONS=detect_leaks=0 TSAN_OPTIONS=report_bugs=0 ";
+        for (const std::string bomb : {"frames.rawlog", "beams.rawlog"}) {
+            SCOPED_TRACE(bomb);
+            const RunResult r = runMapper("--rawlog", dir / bomb, dir, ini, setUp);
+            EXPECT_EQ(r.stderrText.find("cannot be preloaded"), std::string::npos);
+            expectOneLineError(r, dir / bomb, "entry 1 declares more data than the file holds");
+        }
+        const RunResult good =
+            runMapper("--rawlog", mockup, dir, mapper_run::mockupQuickIni(false), setUp);
+        EXPECT_EQ(good.exitCode, 0) << good.stderrText;
+        EXPECT_NE(readAll(dir / "stdout.txt").find("points fused"), std::string::npos);
+    }
 }
 
 // Padding after the gzip member (issue 37, kind 3): the budget was 16 x an upper bound of the
