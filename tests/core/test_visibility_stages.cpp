@@ -231,7 +231,8 @@ TEST(VisibilityStages, RaysClearTowardsTheSensorOrByTheFanTestMeetNoConflict) {
         const Region& region = st.region;
         const TowardsSensor& towards = st.towards;
         std::vector<RayState> state;
-        const FanOutcome fan = testFan(s.grid, region, towards, s.sensor_m, bounds, scratch, state);
+        const FanOutcome fan =
+            testRays(RayFan::Test, s.grid, region, towards, s.sensor_m, bounds, scratch, state);
         const auto& updated = s.grid.updatedCells();
         for (size_t i = 0; i < updated.size(); i++) {
             const BinGrid::UpdatedCell& u = updated[i];
@@ -271,7 +272,7 @@ TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
         const TowardsSensor& towards = st.towards;
         std::vector<RayState> state;
         const FanOutcome out =
-            testEnvelope(s.grid, region, towards, s.sensor_m, bounds, scratch, state);
+            testRays(RayFan::Skip, s.grid, region, towards, s.sensor_m, bounds, scratch, state);
         if (!out.ran) return;
         const auto& updated = s.grid.updatedCells();
         size_t sceneClear = 0;
