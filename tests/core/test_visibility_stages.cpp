@@ -295,6 +295,29 @@ TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
     EXPECT_GT(walk, 1000u);
 }
 
+// Stage 3 runs only where its slack covers the rounding of heights (rayTestsApply): from a sensor
+// 2e4 m up (the limit is 1e4 m) neither test runs and every ray is left to the walk, state
+// emptied of an earlier update's; from the scene's own sensor both run, a state per ray.
+TEST(VisibilityStages, RayTestsRunOnlyWhereTheirSlackHolds) {
+    size_t ran = 0;
+    onRandomScenes(20261132, 3, [&](Scene& s, int id) {
+        const Eigen::Vector3d sensor_m = s.sensor_m;
+        for (const double lift_m : {0.0, 2e4})
+            for (const RayFan fan : {RayFan::Test, RayFan::Skip}) {
+                s.sensor_m = sensor_m + Eigen::Vector3d(0, 0, lift_m);
+                FirstStages st(s);
+                std::vector<RayState> state(7, RayState::Clear);  // an earlier update's
+                const FanOutcome out = testRays(fan, s.grid, st.region, st.towards, s.sensor_m,
+                                                st.bounds, st.scratch, state);
+                const bool sane = lift_m == 0.0 && !st.region.empty();
+                ASSERT_EQ(out.ran, sane) << id << " lifted " << lift_m << " m";
+                EXPECT_EQ(state.size(), sane ? s.grid.updatedCells().size() : 0u) << id;
+                ran += out.ran;
+            }
+    });
+    EXPECT_GT(ran, 20u);
+}
+
 TEST(VisibilityStages, ColumnStretchesHoldEveryConflictAndTheirWalkEditsAsTheRule) {
     size_t conflicts = 0, rays = 0;
     onRandomScenes(20261130, 25, [&](Scene& s, int id) {
