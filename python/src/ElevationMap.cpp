@@ -20,6 +20,7 @@
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace py = pybind11;
 namespace fs = std::filesystem;
@@ -338,7 +339,7 @@ py::tuple ElevationMap::extent_m() const {
     return py::make_tuple(m_map->getXMin(), m_map->getXMax(), m_map->getYMin(), m_map->getYMax());
 }
 
-py::dict ElevationMap::insertStats() const { return insertStatsDict(m_map->insertStats()); }
+py::dict ElevationMap::insertStats() const { return insertStatsDict(m_map->statistics().insert); }
 
 std::string ElevationMap::describe() const { return m_map->asString(); }
 

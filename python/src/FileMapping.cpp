@@ -9,6 +9,7 @@
 #include "ElevationMap.h"
 #include "ObservationTally.h"
 #include "RawlogSource.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace py = pybind11;
 using mrpt::maps::CMultiBinElevationMap;
@@ -26,7 +27,7 @@ py::dict mapTallied(CMultiBinElevationMap& map, const std::string& inputName,
                     const std::function<size_t(const Insert&)>& read) {
     ObservationTally tally;
     size_t entries = 0;
-    const size_t fused0 = map.insertStats().accepted;
+    const size_t fused0 = map.statistics().insert.accepted;
     {
         py::gil_scoped_release nogil;
         entries = read([&](const mrpt::obs::CObservation& obs,
@@ -37,8 +38,9 @@ py::dict mapTallied(CMultiBinElevationMap& map, const std::string& inputName,
             tally.after(obs, inserted, map);
         });
     }
-    if (map.insertStats().accepted == fused0)
-        throw std::runtime_error(inputName + ": " + tally.whyNothingFused(map.insertStats()));
+    const multibin::MapStatistics stats = map.statistics();
+    if (stats.insert.accepted == fused0)
+        throw std::runtime_error(inputName + ": " + tally.whyNothingFused(stats.insert));
     py::dict byClass;
     for (const auto& [name, c] : tally.byClass()) {
         py::dict d;
@@ -55,8 +57,8 @@ py::dict mapTallied(CMultiBinElevationMap& map, const std::string& inputName,
     out["entries"] = entries;
     out["observations"] = tally.observations();
     out["by_class"] = byClass;
-    out["points"] = insertStatsDict(map.insertStats());
-    out["default_pose_covariance"] = map.poseFallbackCount();
+    out["points"] = insertStatsDict(stats.insert);
+    out["default_pose_covariance"] = stats.poseFallbacks;
     out["report"] = tally.report();
     return out;
 }

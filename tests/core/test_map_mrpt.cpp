@@ -20,6 +20,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/map/BinGrid.h"
+#include "multibin/map/MapStatistics.h"
 #include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
@@ -415,6 +416,59 @@ TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
     EXPECT_EQ(map.insertStats().tooUncertain, 1u);
     EXPECT_EQ(map.insertStats().outsideMap, 0u);
     EXPECT_EQ(map.insertStats().outOfRange, 1u);  // 50 m away: beyond max_range
+}
+
+// statistics(): one snapshot of every count, each part from its own counter (distinct counts, so
+// that parts swapped or left out show), the deprecated accessors its parts, clear() zeroes it.
+TEST(CMultiBinElevationMap, StatisticsSnapshotHoldsEveryCountOnce) {
+    CMultiBinElevationMap map;
+    map.insertionOptions.sensor_labels = {"CLOUD"};
+    const auto cloud = [](const std::string& label) {
+        auto obs = mrpt::obs::CObservationPointCloud::Create();
+        auto pts = mrpt::maps::CSimplePointsMap::Create();
+        for (int i = -10; i <= 10; i++)  // 21 x 21 points of a plane z = -1 in the sensor frame
+            for (int j = -10; j <= 10; j++) pts->insertPoint(0.05f * i, 0.05f * j, -1.0f);
+        pts->insertPoint(15.f, 0.f, -1.f);  // too uncertain with the default pose covariance
+        pts->insertPoint(50.f, 0.f, -1.f);  // beyond max_range
+        obs->pointcloud = pts;
+        obs->sensorPose = CPose3D(0, 0, 1.0, 0, 0, 0);
+        obs->sensorLabel = label;
+        return obs;
+    };
+    EXPECT_EQ(map.statistics().insert.accepted + map.statistics().insert.rejected(), 0u);
+    // Two insertions without a pose PDF: two fallbacks to the default pose covariance.
+    ASSERT_TRUE(map.insertObservation(*cloud("CLOUD"), CPose3D(10, 5, 0, 0, 0, 0)));
+    ASSERT_TRUE(map.insertObservation(*cloud("CLOUD"), CPose3D(10, 5, 0, 0, 0, 0)));
+    // With a pose PDF (no fallback): one skipped by its label, three refused for a NaN pose.
+    mrpt::poses::CPose3DPDFGaussian pdf(CPose3D(10, 5, 0, 0, 0, 0));
+    pdf.cov.setIdentity();
+    pdf.cov *= 1e-6;
+    EXPECT_FALSE(map.insertObservation(*cloud("OTHER"), pdf));
+    pdf.mean.x(std::numeric_limits<double>::quiet_NaN());
+    for (int k = 0; k < 3; k++) EXPECT_ANY_THROW(map.insertObservation(*cloud("CLOUD"), pdf));
+
+    const multibin::MapStatistics s = map.statistics();
+    EXPECT_EQ(s.poseFallbacks, 2u);
+    EXPECT_EQ(s.skippedByLabel, 1u);
+    EXPECT_EQ(s.nonFinitePoses, 3u);
+    EXPECT_EQ(s.insert.accepted + s.insert.rejected(), 2u * (21 * 21 + 2));  // every point once
+    EXPECT_EQ(s.insert.tooUncertain, 2u);
+    EXPECT_EQ(s.insert.outOfRange, 2u);
+    EXPECT_EQ(s.sensorModels.depth.points, 2u * (21 * 21 + 2));  // a cloud: the depth model
+    EXPECT_GT(s.visibility.raysCast, 0u);
+    // The deprecated accessors: the snapshot's parts.
+    EXPECT_EQ(map.insertStats().accepted, s.insert.accepted);
+    EXPECT_EQ(map.visibilityStats().raysCast, s.visibility.raysCast);
+    EXPECT_EQ(map.sensorModelStats().depth.kept, s.sensorModels.depth.kept);
+    EXPECT_EQ(map.poseFallbackCount(), 2u);
+    EXPECT_EQ(map.skippedByLabelCount(), 1u);
+    EXPECT_EQ(map.nonFinitePoseCount(), 3u);
+
+    map.clear();
+    const multibin::MapStatistics z = map.statistics();
+    EXPECT_EQ(z.insert.accepted + z.insert.rejected() + z.visibility.raysCast, 0u);
+    EXPECT_EQ(z.poseFallbacks + z.skippedByLabel + z.nonFinitePoses, 0u);
+    EXPECT_EQ(z.sensorModels.depth.points, 0u);
 }
 
 TEST(CMultiBinElevationMap, GrowsForOnePointJustOutsideAmongManyInside) {

@@ -231,7 +231,8 @@ TEST(VisibilityStages, RaysClearTowardsTheSensorOrByTheFanTestMeetNoConflict) {
         const Region& region = st.region;
         const TowardsSensor& towards = st.towards;
         std::vector<RayState> state;
-        const FanOutcome fan = testFan(s.grid, region, towards, s.sensor_m, bounds, scratch, state);
+        const FanOutcome fan =
+            testRays(RayFan::Test, s.grid, region, towards, s.sensor_m, bounds, scratch, state);
         const auto& updated = s.grid.updatedCells();
         for (size_t i = 0; i < updated.size(); i++) {
             const BinGrid::UpdatedCell& u = updated[i];
@@ -271,7 +272,7 @@ TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
         const TowardsSensor& towards = st.towards;
         std::vector<RayState> state;
         const FanOutcome out =
-            testEnvelope(s.grid, region, towards, s.sensor_m, bounds, scratch, state);
+            testRays(RayFan::Skip, s.grid, region, towards, s.sensor_m, bounds, scratch, state);
         if (!out.ran) return;
         const auto& updated = s.grid.updatedCells();
         size_t sceneClear = 0;
@@ -292,6 +293,29 @@ TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
     std::cout << clear << " rays clear by the envelope test, " << walk << " to walk\n";
     EXPECT_GT(clear, 10000u);
     EXPECT_GT(walk, 1000u);
+}
+
+// Stage 3 runs only where its slack covers the rounding of heights (rayTestsApply): from a sensor
+// 2e4 m up (the limit is 1e4 m) neither test runs and every ray is left to the walk, state
+// emptied of an earlier update's; from the scene's own sensor both run, a state per ray.
+TEST(VisibilityStages, RayTestsRunOnlyWhereTheirSlackHolds) {
+    size_t ran = 0;
+    onRandomScenes(20261132, 3, [&](Scene& s, int id) {
+        const Eigen::Vector3d sensor_m = s.sensor_m;
+        for (const double lift_m : {0.0, 2e4})
+            for (const RayFan fan : {RayFan::Test, RayFan::Skip}) {
+                s.sensor_m = sensor_m + Eigen::Vector3d(0, 0, lift_m);
+                FirstStages st(s);
+                std::vector<RayState> state(7, RayState::Clear);  // an earlier update's
+                const FanOutcome out = testRays(fan, s.grid, st.region, st.towards, s.sensor_m,
+                                                st.bounds, st.scratch, state);
+                const bool sane = lift_m == 0.0 && !st.region.empty();
+                ASSERT_EQ(out.ran, sane) << id << " lifted " << lift_m << " m";
+                EXPECT_EQ(state.size(), sane ? s.grid.updatedCells().size() : 0u) << id;
+                ran += out.ran;
+            }
+    });
+    EXPECT_GT(ran, 20u);
 }
 
 TEST(VisibilityStages, ColumnStretchesHoldEveryConflictAndTheirWalkEditsAsTheRule) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapStatistics.h"
 #include "reliability_helpers.h"
 
 using namespace reliability;
@@ -29,6 +30,7 @@ void write(Map& map, int scans, std::atomic<bool>& done, const std::atomic<int>&
 void read(const Map& map, const std::atomic<bool>& done, std::atomic<int>& started,
           std::atomic<long>& queries, std::atomic<long>& bad) {
     started++;
+    multibin::MapStatistics last;
     while (!done) {
         for (double x = -0.5; x < 1.5; x += 0.1) {
             double h = 0, s = 0, z = 0;
@@ -42,6 +44,15 @@ void read(const Map& map, const std::atomic<bool>& done, std::atomic<int>& start
         // The extent getters read the window growth moves (a race before they took the lock).
         if (!(map.getXMax() >= map.getXMin()) || !(map.getYMax() >= map.getYMin())) bad++;
         queries += 4;
+        // The counts: one snapshot copied under the lock (read as references, a race); they
+        // only grow while the writer inserts.
+        const multibin::MapStatistics now = map.statistics();
+        if (now.insert.accepted < last.insert.accepted ||
+            now.visibility.raysCast < last.visibility.raysCast ||
+            now.sensorModels.laser.beams < last.sensorModels.laser.beams)
+            bad++;
+        last = now;
+        queries++;
         const auto raster = map.toRaster(Map::RasterLayer::Height);
         if (raster.rows() < 0) bad++;
         mrpt::io::CMemoryStream mem;

@@ -86,9 +86,8 @@ void FillOptions::read(StrictConfigSection& s) {
 
 void FillOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                      const std::string& section) {
-    StrictConfigSection s(source, section);
-    read(s);
-    s.finish();
+    loadStrictly(source, section, *this,
+                 [&](StrictConfigSection& s) { visitKeys(*this, OptionReader{s}); });
 }
 
 void FillOptions::write(mrpt::config::CConfigFileBase& c, const std::string& section) const {

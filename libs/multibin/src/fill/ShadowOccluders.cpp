@@ -44,90 +44,124 @@ double slopeAlong(const HeightRaster& r, int x, int y, double ux, double uy, boo
     return island ? std::hypot(gx, gy) : std::abs(ux * gx + uy * gy);
 }
 
-}  // namespace
+/** One gap of a raster: which cells are in it, and how far across it a look may go. */
+struct Gap {
+    const HeightRaster& r;
+    const std::vector<int>& cells;
+    std::vector<char> isGap;
+    double maxDist = 0;  //!< its bounding box's diagonal, plus one [cells]
 
-ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int>& cells,
-                                    const FillOptions& o) {
-    ShadowOccluders out;
-    const int nx = r.nx(), ny = r.ny(), reach = o.shadowReach_cells;
-    std::vector<char> isGap(r.size(), 0);
-    int x0 = nx, x1 = -1, y0 = ny, y1 = -1;
-    for (int k : cells) {
-        isGap[size_t(k)] = 1;
-        const int x = k % nx, y = k / nx;
-        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    Gap(const HeightRaster& raster, const std::vector<int>& gapCells)
+        : r(raster), cells(gapCells), isGap(raster.size(), 0) {
+        const int nx = r.nx();
+        int x0 = nx, x1 = -1, y0 = r.ny(), y1 = -1;
+        for (int k : cells) {
+            isGap[size_t(k)] = 1;
+            const int x = k % nx, y = k / nx;
+            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+        }
+        maxDist = std::hypot(x1 - x0 + 1, y1 - y0 + 1) + 1;
     }
-    // Across the gap: no further than its bounding box's diagonal.
-    const double maxDist = std::hypot(x1 - x0 + 1, y1 - y0 + 1) + 1;
-    auto inGap = [&](int x, int y) { return r.inside(x, y) && isGap[r.index(x, y)]; };
-    auto measured = [&](int x, int y) { return r.inside(x, y) && r.isMeasured(r.index(x, y)); };
+    bool inGap(int x, int y) const { return r.inside(x, y) && isGap[r.index(x, y)]; }
+    bool measured(int x, int y) const { return r.inside(x, y) && r.isMeasured(r.index(x, y)); }
+};
 
-    // The measured cells touching the gap (8-neighbours), once each.
+/** The measured cells touching the gap (8-neighbours), once each. */
+std::vector<int> rimOf(const Gap& g) {
+    const HeightRaster& r = g.r;
     std::vector<char> seen(r.size(), 0);
     std::vector<int> rim;
-    for (int k : cells) {
-        const int x = k % nx, y = k / nx;
+    for (int k : g.cells) {
+        const int x = k % r.nx(), y = k / r.nx();
         for (int dy = -1; dy <= 1; dy++)
             for (int dx = -1; dx <= 1; dx++)
-                if (measured(x + dx, y + dy) && !seen[r.index(x + dx, y + dy)]) {
+                if (g.measured(x + dx, y + dy) && !seen[r.index(x + dx, y + dy)]) {
                     seen[r.index(x + dx, y + dy)] = 1;
                     rim.push_back(int(r.index(x + dx, y + dy)));
                 }
     }
+    return rim;
+}
 
-    struct Occluder {
-        int k;
-        double threshold_m;  // halfway down its step
-    };
-    std::vector<Occluder> occluders;
+/** Rim cell (ox, oy)'s inward normal (ux, uy): the gap cells of the 5 x 5 window, weighted by
+ * 1 / distance. Returns true for an island: a cell with the gap all around it (a stray return
+ * inside a shadow) has no inward side, and gets (1, 0). */
+bool inwardNormal(const Gap& g, int ox, int oy, double& ux, double& uy) {
+    ux = uy = 0;
+    for (int dy = -2; dy <= 2; dy++)
+        for (int dx = -2; dx <= 2; dx++)
+            if ((dx || dy) && g.inGap(ox + dx, oy + dy)) {
+                const double d2 = dx * dx + dy * dy;
+                ux += dx / d2, uy += dy / d2;
+            }
+    // A straight rim gives a norm of about 4.
+    const double norm = std::hypot(ux, uy);
+    const bool island = norm < 1.0;
+    if (island)
+        ux = 1, uy = 0;
+    else
+        ux /= norm, uy /= norm;
+    return island;
+}
+
+/** A measured cell beyond the gap, seen from a rim cell. */
+struct Hit {
+    double h_m, sigma_m, dist;  //!< its height and sigma [m], distance from the rim cell [cells]
+    int x, y;
+};
+
+/** The first measured cells beyond the gap from rim cell (ox, oy), looking along its inward
+ * normal (nxv, nyv): a fan of five directions within +-30 degrees, or eight all round for an
+ * island. A look that meets a measured cell before the gap, another gap or the raster's edge
+ * finds nothing. */
+void lookAcross(const Gap& g, int ox, int oy, double nxv, double nyv, bool island,
+                std::vector<Hit>& hits) {
+    const HeightRaster& r = g.r;
     constexpr double kPi = 3.14159265358979323846;
     const double fan_rad[5] = {-kPi / 6, -kPi / 12, 0, kPi / 12, kPi / 6};
-    struct Hit {
-        double h_m, sigma_m, dist;
-        int x, y;
-    };
+    hits.clear();
+    for (int q = 0; q < (island ? 8 : 5); q++) {
+        const double a = island ? q * kPi / 4 : fan_rad[q];
+        const double ux = std::cos(a) * nxv - std::sin(a) * nyv;
+        const double uy = std::sin(a) * nxv + std::cos(a) * nyv;
+        int px = ox, py = oy;
+        bool enteredGap = false;
+        for (double t = 0.5; t <= g.maxDist; t += 0.5) {
+            const int x = int(std::lround(ox + t * ux)), y = int(std::lround(oy + t * uy));
+            if (x == px && y == py) continue;
+            px = x, py = y;
+            if (g.inGap(x, y)) {
+                enteredGap = true;
+                continue;
+            }
+            if (enteredGap && g.measured(x, y)) {
+                const size_t f = r.index(x, y);
+                hits.push_back({r.height_m[f], r.sigma_m[f], t, x, y});
+            }
+            break;
+        }
+    }
+}
+
+/** An occluder rim cell, and the height halfway down its step [m]. */
+struct Occluder {
+    int k;
+    double threshold_m;
+};
+
+/** The rim cells that stand above the far side by a step the sigmas and slopes do not explain
+ * (ShadowOccluders.h). */
+std::vector<Occluder> occluderRimCells(const Gap& g, const std::vector<int>& rim,
+                                       const FillOptions& o) {
+    const HeightRaster& r = g.r;
+    std::vector<Occluder> occluders;
     std::vector<Hit> hits;
     std::vector<double> hitSigma;
     for (int k : rim) {
-        const int ox = k % nx, oy = k / nx;
-        // Inward normal: the gap cells of the 5 x 5 window, weighted by 1 / distance.
-        double nxv = 0, nyv = 0;
-        for (int dy = -2; dy <= 2; dy++)
-            for (int dx = -2; dx <= 2; dx++)
-                if ((dx || dy) && inGap(ox + dx, oy + dy)) {
-                    const double d2 = dx * dx + dy * dy;
-                    nxv += dx / d2, nyv += dy / d2;
-                }
-        // A straight rim gives a norm of about 4; a cell with the gap all around (a stray return
-        // inside a shadow) has no inward side: it looks in eight directions instead.
-        const double norm = std::hypot(nxv, nyv);
-        const bool island = norm < 1.0;
-        if (island)
-            nxv = 1, nyv = 0;
-        else
-            nxv /= norm, nyv /= norm;
-        hits.clear();
-        for (int q = 0; q < (island ? 8 : 5); q++) {
-            const double a = island ? q * kPi / 4 : fan_rad[q];
-            const double ux = std::cos(a) * nxv - std::sin(a) * nyv;
-            const double uy = std::sin(a) * nxv + std::cos(a) * nyv;
-            int px = ox, py = oy;
-            bool enteredGap = false;
-            for (double t = 0.5; t <= maxDist; t += 0.5) {
-                const int x = int(std::lround(ox + t * ux)), y = int(std::lround(oy + t * uy));
-                if (x == px && y == py) continue;
-                px = x, py = y;
-                if (inGap(x, y)) {
-                    enteredGap = true;
-                    continue;
-                }
-                if (enteredGap && measured(x, y)) {
-                    const size_t f = r.index(x, y);
-                    hits.push_back({r.height_m[f], r.sigma_m[f], t, x, y});
-                }
-                break;  // a measured cell before the gap, another gap, or the raster's edge
-            }
-        }
+        const int ox = k % r.nx(), oy = k / r.nx();
+        double nxv, nyv;
+        const bool island = inwardNormal(g, ox, oy, nxv, nyv);
+        lookAcross(g, ox, oy, nxv, nyv, island, hits);
         if (hits.size() < 3) continue;  // the fan mostly does not see across
         // The far side: the hit of median height, with the hits' median sigma (one stray cell
         // must not hide the step, nor fake one).
@@ -145,14 +179,16 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
             std::sqrt(so * so + sf * sf + (far.dist * slope) * (far.dist * slope));
         if (drop > o.shadowStepSigmas * explained) occluders.push_back({k, ho - 0.5 * drop});
     }
-    // A shadow is a strip behind its edge: area ~ length x width, and at least as long as wide,
-    // so its occluder's rim is at least sqrt(area) cells long. A few cells that see lower
-    // ground across a compact gap are a step the gap hides, not the edge that hid it.
-    if (occluders.empty() || double(occluders.size()) < std::sqrt(double(cells.size()))) return out;
-    // A step that runs through the gap is seen where it enters and where it leaves: an occluder
-    // rim cell next to a rim cell below its halfway height. A shadow's edge bounds the gap and
-    // shows so at one end at most. Two places or more (more than 2 cells apart): not a shadow,
-    // the gap is filled as any other.
+    return occluders;
+}
+
+/** Whether a step runs through the gap: it is seen where it enters and where it leaves, as an
+ * occluder rim cell next to a rim cell below its halfway height. A shadow's edge bounds the gap
+ * and shows so at one end at most; two places or more (more than 2 cells apart) are a step. */
+bool stepRunsThrough(const Gap& g, const std::vector<int>& rim,
+                     const std::vector<Occluder>& occluders) {
+    const HeightRaster& r = g.r;
+    const int nx = r.nx();
     std::vector<char> isRim(r.size(), 0);
     for (int k : rim) isRim[size_t(k)] = 1;
     std::vector<int> contacts;  // one occluder rim cell per place
@@ -161,19 +197,23 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
         bool seen = false;
         for (int dy = -1; dy <= 1; dy++)
             for (int dx = -1; dx <= 1; dx++)
-                seen |= (dx || dy) && measured(x + dx, y + dy) && isRim[r.index(x + dx, y + dy)] &&
+                seen |= (dx || dy) && g.measured(x + dx, y + dy) &&
+                        isRim[r.index(x + dx, y + dy)] &&
                         r.height_m[r.index(x + dx, y + dy)] < oc.threshold_m;
         if (!seen) continue;
         bool known = false;
         for (int c : contacts) known |= std::max(std::abs(c % nx - x), std::abs(c / nx - y)) <= 2;
         if (!known) contacts.push_back(oc.k);
     }
-    if (contacts.size() >= 2) return out;
-    out.rimCells = int(occluders.size());
+    return contacts.size() >= 2;
+}
 
-    // Each occluder's top: measured cells joined to its rim cell through cells above halfway
-    // down its step, within `reach` cells (Chebyshev) of it.
-    std::vector<char> mark(r.size(), 0);
+/** Marks each occluder's top: measured cells joined to its rim cell through cells above halfway
+ * down its step, within `reach` cells (Chebyshev) of it. */
+void markOccluderTops(const Gap& g, const std::vector<Occluder>& occluders, int reach,
+                      std::vector<char>& mark) {
+    const HeightRaster& r = g.r;
+    const int nx = r.nx();
     std::vector<int> stamp(r.size(), -1), queue;
     for (size_t q = 0; q < occluders.size(); q++) {
         const auto& oc = occluders[q];
@@ -187,7 +227,7 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
                 for (int dx = -1; dx <= 1; dx++) {
                     const int xx = x + dx, yy = y + dy;
                     if (std::max(std::abs(xx - ox), std::abs(yy - oy)) > reach) continue;
-                    if (!measured(xx, yy)) continue;
+                    if (!g.measured(xx, yy)) continue;
                     const size_t kk = r.index(xx, yy);
                     if (stamp[kk] == int(q) || !(r.height_m[kk] > oc.threshold_m)) continue;
                     stamp[kk] = int(q);
@@ -195,9 +235,14 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
                 }
         }
     }
-    // Stray returns inside the shadow: measured islands of at most kIsland cells with nothing but
-    // this gap around them (a mixed pixel between the edge and the far ground, an outlier). One
-    // or two returns do not describe the hidden surface; they stay measured, but are not its data.
+}
+
+/** Marks the stray returns inside the shadow: measured islands of at most kIsland cells with
+ * nothing but this gap around them (a mixed pixel between the edge and the far ground, an
+ * outlier). One or two returns do not describe the hidden surface; they stay measured, but are
+ * not its data. */
+void markStrayIslands(const Gap& g, const std::vector<int>& rim, std::vector<char>& mark) {
+    const HeightRaster& r = g.r;
     constexpr size_t kIsland = 2;
     std::vector<int> component;
     for (int k : rim) {
@@ -205,11 +250,11 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
         component.assign(1, k);
         bool enclosed = true;
         for (size_t head = 0; head < component.size() && enclosed; head++) {
-            const int x = component[head] % nx, y = component[head] / nx;
+            const int x = component[head] % r.nx(), y = component[head] / r.nx();
             for (int dy = -1; dy <= 1 && enclosed; dy++)
                 for (int dx = -1; dx <= 1 && enclosed; dx++) {
-                    if ((!dx && !dy) || inGap(x + dx, y + dy)) continue;
-                    if (!measured(x + dx, y + dy)) {
+                    if ((!dx && !dy) || g.inGap(x + dx, y + dy)) continue;
+                    if (!g.measured(x + dx, y + dy)) {
                         enclosed = false;  // the raster's edge or another unknown cell
                         continue;
                     }
@@ -222,16 +267,21 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
         if (enclosed)
             for (int kk : component) mark[size_t(kk)] = 1;
     }
-    // Stray returns on the far rim: a rim cell standing off the median of its measured
-    // 8-neighbours by more than their spread (1.4826 MAD) and the sigmas explain.
+}
+
+/** Marks the stray returns on the far rim: a rim cell standing off the median of its measured
+ * 8-neighbours by more than their spread (1.4826 MAD) and the sigmas explain. */
+void markStrayRimCells(const Gap& g, const std::vector<int>& rim, const FillOptions& o,
+                       std::vector<char>& mark) {
+    const HeightRaster& r = g.r;
     std::vector<double> nb, nbSigma;
     for (int k : rim) {
         if (mark[size_t(k)]) continue;
-        const int x = k % nx, y = k / nx;
+        const int x = k % r.nx(), y = k / r.nx();
         nb.clear(), nbSigma.clear();
         for (int dy = -1; dy <= 1; dy++)
             for (int dx = -1; dx <= 1; dx++)
-                if ((dx || dy) && measured(x + dx, y + dy)) {
+                if ((dx || dy) && g.measured(x + dx, y + dy)) {
                     nb.push_back(r.height_m[r.index(x + dx, y + dy)]);
                     nbSigma.push_back(r.sigma_m[r.index(x + dx, y + dy)]);
                 }
@@ -244,6 +294,26 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
             o.shadowStepSigmas * std::sqrt(s * s + medSigma * medSigma + spread * spread))
             mark[size_t(k)] = 1;
     }
+}
+
+}  // namespace
+
+ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int>& cells,
+                                    const FillOptions& o) {
+    ShadowOccluders out;
+    const Gap gap(r, cells);
+    const std::vector<int> rim = rimOf(gap);
+    const std::vector<Occluder> occluders = occluderRimCells(gap, rim, o);
+    // A shadow is a strip behind its edge: area ~ length x width, and at least as long as wide,
+    // so its occluder's rim is at least sqrt(area) cells long. A few cells that see lower
+    // ground across a compact gap are a step the gap hides, not the edge that hid it.
+    if (occluders.empty() || double(occluders.size()) < std::sqrt(double(cells.size()))) return out;
+    if (stepRunsThrough(gap, rim, occluders)) return out;  // filled as any other gap
+    out.rimCells = int(occluders.size());
+    std::vector<char> mark(r.size(), 0);
+    markOccluderTops(gap, occluders, o.shadowReach_cells, mark);
+    markStrayIslands(gap, rim, mark);
+    markStrayRimCells(gap, rim, o, mark);
     for (size_t k = 0; k < mark.size(); k++)
         if (mark[k]) out.cells.push_back(int(k));
     return out;

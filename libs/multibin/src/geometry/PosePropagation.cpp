@@ -57,12 +57,7 @@ void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const Point
     for (int e = 0; e < 6; e++) {
         const float* q = k.robot[e];
         const float* s = k.sensor[e];
-        const float* __restrict c0 = in.v[3];
-        const float* __restrict c1 = in.v[4];
-        const float* __restrict c2 = in.v[5];
-        const float* __restrict c3 = in.v[6];
-        const float* __restrict c4 = in.v[7];
-        const float* __restrict c5 = in.v[8];
+        const float(*__restrict c)[kBlock] = in.v + 3;  // the covariance entries xx .. zz
         const float q0 = q[0], q1 = q[1], q2 = q[2], q3 = q[3], q4 = q[4], q5 = q[5], q6 = q[6],
                     q7 = q[7], q8 = q[8], q9 = q[9];
         const float s0 = s[0], s1 = s[1], s2 = s[2], s3 = s[3], s4 = s[4], s5 = s[5];
@@ -72,8 +67,8 @@ void propagateBlock(const PosePropagator::Coefficients& k, size_t n, const Point
             const float robot = q0 + q1 * x[i] + q2 * y[i] + q3 * z[i] + q4 * mono[0][i] +
                                 q5 * mono[1][i] + q6 * mono[2][i] + q7 * mono[3][i] +
                                 q8 * mono[4][i] + q9 * mono[5][i];
-            const float sensor =
-                s0 * c0[i] + s1 * c1[i] + s2 * c2[i] + s3 * c3[i] + s4 * c4[i] + s5 * c5[i];
+            const float sensor = s0 * c[0][i] + s1 * c[1][i] + s2 * c[2][i] + s3 * c[3][i] +
+                                 s4 * c[4][i] + s5 * c[5][i];
             robotPart[i] = robot;
             o[i] = robot + sensor;
         }

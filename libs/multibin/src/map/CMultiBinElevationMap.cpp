@@ -17,6 +17,7 @@
 
 #include "multibin/io/OptionKeys.h"
 #include "multibin/map/CellSurface.h"
+#include "multibin/map/MapStatistics.h"
 
 using namespace mrpt::maps;
 using multibin::atLeast;
@@ -56,20 +57,6 @@ const std::vector<std::string> kGenericMapKeys = {
 /** Creation keys of earlier versions, accepted with a message: `max_size_m` capped the growing
  * window before the storage was tiled. */
 constexpr const char* kRetiredCreationKeys[] = {"max_size_m"};
-
-/** Reads options from one section strictly: `readKeys(StrictConfigSection&)` reads their keys,
- * any other key of the section (but `allowed`) is an error, then options.validate(); every error
- * names the file and the section. */
-template <typename Options, typename ReadKeys>
-void loadStrictly(const mrpt::config::CConfigFileBase& source, const std::string& section,
-                  const Options& options, ReadKeys&& readKeys,
-                  const std::vector<std::string>& allowed = {}) {
-    multibin::StrictConfigSection s(source, section);
-    readKeys(s);
-    s.allow(allowed);
-    s.finish();
-    multibin::validateAsReadFrom(s, options);
-}
 
 /** "ini file 'F'" or "ini" (a source that is not a file). Messages hold no ']': MRPT's exception
  * wrapper takes the text up to one for a source location. */
@@ -222,7 +209,7 @@ void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
                          "grows with the data, with no size limit. Remove the key.\n";
             allowed.push_back(key);
         }
-    loadStrictly(
+    multibin::loadStrictly(
         source, section, *this,
         [&](multibin::StrictConfigSection& s) {
             visitCreationKeys(*this, multibin::OptionReader{s});
@@ -287,7 +274,7 @@ void CMultiBinElevationMap::TCreationOptions::validate() const {
 
 void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
     const mrpt::config::CConfigFileBase& source, const std::string& section) {
-    loadStrictly(source, section, *this, [&](multibin::StrictConfigSection& s) {
+    multibin::loadStrictly(source, section, *this, [&](multibin::StrictConfigSection& s) {
         visitInsertionKeys(*this, multibin::OptionReader{s});
         visibility.read(s);
         fill.read(s);
@@ -400,15 +387,20 @@ const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const {
     prepareForReading();
     return m_impl->fill;
 }
-const multibin::InsertStats& CMultiBinElevationMap::insertStats() const { return m_impl->stats; }
-const multibin::VisibilityStats& CMultiBinElevationMap::visibilityStats() const {
-    return m_impl->visibilityStats;
+multibin::MapStatistics CMultiBinElevationMap::statistics() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    return {m_impl->stats,         m_impl->visibilityStats, m_impl->sensorState.stats,
+            m_impl->poseFallbacks, m_impl->skippedByLabel,  m_impl->nonFinitePoses};
 }
-size_t CMultiBinElevationMap::poseFallbackCount() const { return m_impl->poseFallbacks; }
-size_t CMultiBinElevationMap::skippedByLabelCount() const { return m_impl->skippedByLabel; }
-size_t CMultiBinElevationMap::nonFinitePoseCount() const { return m_impl->nonFinitePoses; }
-const multibin::sensors::SensorModelStats& CMultiBinElevationMap::sensorModelStats() const {
-    return m_impl->sensorState.stats;
+multibin::InsertStats CMultiBinElevationMap::insertStats() const { return statistics().insert; }
+multibin::VisibilityStats CMultiBinElevationMap::visibilityStats() const {
+    return statistics().visibility;
+}
+size_t CMultiBinElevationMap::poseFallbackCount() const { return statistics().poseFallbacks; }
+size_t CMultiBinElevationMap::skippedByLabelCount() const { return statistics().skippedByLabel; }
+size_t CMultiBinElevationMap::nonFinitePoseCount() const { return statistics().nonFinitePoses; }
+multibin::sensors::SensorModelStats CMultiBinElevationMap::sensorModelStats() const {
+    return statistics().sensorModels;
 }
 
 void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation) {

@@ -32,6 +32,18 @@ void VisibilityParams::validate() const {
     visitKeys(*this, OptionChecker("CMultiBinElevationMap insertion option"));
 }
 
+namespace visibility {
+FanOutcome testRays(RayFan fan, const BinGrid& grid, const Region& region,
+                    const TowardsSensor& towards, const Eigen::Vector3d& sensor_m,
+                    const BoundTest& bounds, VisibilityScratch& scratch,
+                    std::vector<RayState>& state) {
+    state.clear();
+    if (!rayTestsApply(grid, region, sensor_m)) return FanOutcome{};
+    const RayTestInputs inputs(grid, region, towards, sensor_m, bounds, scratch);
+    return fan == RayFan::Test ? testFan(inputs, state) : testEnvelope(inputs, state);
+}
+}  // namespace visibility
+
 namespace {
 /** This thread's scratch arrays. Out of line so that the caller holds a plain reference: named
  * directly, a thread_local of this shared library is looked up again (__tls_get_addr) at almost
@@ -66,10 +78,8 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
     const TowardsSensor towards =
         buildTowardsSensor(grid, region, sensor_m, bounds, scratch.towardsSensor);
     std::vector<RayState>& state = scratch.rayState;
-    state.clear();
     const FanOutcome decided =
-        fan == RayFan::Test ? testFan(grid, region, towards, sensor_m, bounds, scratch, state)
-                            : testEnvelope(grid, region, towards, sensor_m, bounds, scratch, state);
+        testRays(fan, grid, region, towards, sensor_m, bounds, scratch, state);
     if (decided.noWalk) stats.raysCast += decided.clearRays;
     scratch.sampleAt.assign({0.0, step});
 

@@ -26,19 +26,9 @@ constexpr unsigned kRings = 32;      // length classes of a group's rays, a bloc
 
 /** The envelope's state for one update: the rays by sector of direction, and per sector the
  * nearest distance of a cell that may conflict with the rays there. */
-class EnvelopeTest {
+class EnvelopeTest : RayTestInputs {
 public:
-    EnvelopeTest(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
-                 const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
-                 VisibilityScratch& scratch)
-        : m_grid(grid),
-          m_region(region),
-          m_towards(towards),
-          m_sensor_m(sensor_m),
-          m_bounds(bounds),
-          m_s(scratch),
-          m_cell(grid.cellSize_m()),
-          m_step(0.5 * m_cell) {}
+    explicit EnvelopeTest(const RayTestInputs& inputs) : RayTestInputs(inputs) {}
 
     FanOutcome run(std::vector<RayState>& state);
 
@@ -59,13 +49,6 @@ private:
     void testCell(int ix, int iy, float bound_m);
     void testBlock(int bx, int by);
 
-    const BinGrid& m_grid;
-    const Region& m_region;
-    const TowardsSensor& m_towards;
-    const Eigen::Vector3d& m_sensor_m;
-    const BoundTest& m_bounds;
-    VisibilityScratch& m_s;
-    const double m_cell, m_step;
     unsigned m_sectors = 1;
     double m_keyToSector = 0;
     double m_invRing = 0;  // 1 / the rings' width [1/m]
@@ -234,8 +217,7 @@ FanOutcome EnvelopeTest::run(std::vector<RayState>& state) {
     size_t raysClear = 0;
     const size_t decided = collectRays(state, raysClear);
     bySector();
-    for (int by = m_region.y0; by < m_region.y0 + int(m_region.ny) && !m_s.envRays.empty(); by++)
-        for (int bx = m_region.x0; bx < m_region.x0 + int(m_region.nx); bx++) testBlock(bx, by);
+    if (!m_s.envRays.empty()) forEachBlock([&](int bx, int by) { testBlock(bx, by); });
     // A ray with a sample in a cell left hot has its sector among the cell's, and reaches it.
     size_t clear = 0;
     for (const EnvRay& r : m_s.envRays) {
@@ -247,12 +229,8 @@ FanOutcome EnvelopeTest::run(std::vector<RayState>& state) {
 }
 }  // namespace
 
-FanOutcome testEnvelope(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
-                        const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
-                        VisibilityScratch& scratch, std::vector<RayState>& state) {
-    state.clear();
-    if (!rayTestsApply(grid, region, sensor_m)) return FanOutcome{};
-    return EnvelopeTest(grid, region, towards, sensor_m, bounds, scratch).run(state);
+FanOutcome testEnvelope(const RayTestInputs& inputs, std::vector<RayState>& state) {
+    return EnvelopeTest(inputs).run(state);
 }
 
 }  // namespace multibin::visibility

@@ -84,19 +84,10 @@ size_t prefix(const std::vector<double>& keys, Before before) {
 }
 
 /** The fan test's state for one update: its inputs, and its arrays in the scratch. */
-class FanTest {
+class FanTest : RayTestInputs {
 public:
-    FanTest(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
-            const Eigen::Vector3d& sensor_m, const BoundTest& bounds, VisibilityScratch& scratch)
-        : m_grid(grid),
-          m_region(region),
-          m_towards(towards),
-          m_sensor_m(sensor_m),
-          m_bounds(bounds),
-          m_s(scratch),
-          m_cell(grid.cellSize_m()),
-          m_step(0.5 * m_cell),
-          m_block_m(BinGrid::kBlockCells * m_cell) {}
+    explicit FanTest(const RayTestInputs& inputs)
+        : RayTestInputs(inputs), m_block_m(BinGrid::kBlockCells * m_cell) {}
 
     FanOutcome run(std::vector<RayState>& state);
 
@@ -109,13 +100,7 @@ private:
     bool mayConflictInBlock(const FanRay& r, unsigned blockSlot, int bx, int by, double blockLow_m);
     void testBlock(int bx, int by);
 
-    const BinGrid& m_grid;
-    const Region& m_region;
-    const TowardsSensor& m_towards;
-    const Eigen::Vector3d& m_sensor_m;
-    const BoundTest& m_bounds;
-    VisibilityScratch& m_s;
-    const double m_cell, m_step, m_block_m;
+    const double m_block_m;
     double m_lowestRay_m = 0, m_longestRay_m = 0;
 };
 
@@ -385,8 +370,7 @@ FanOutcome FanTest::run(std::vector<RayState>& state) {
     orderByKey();
     m_s.unitTableOf.clear();
     m_s.unitLimits.clear();
-    for (int by = m_region.y0; by < m_region.y0 + int(m_region.ny) && !m_s.fan.empty(); by++)
-        for (int bx = m_region.x0; bx < m_region.x0 + int(m_region.nx); bx++) testBlock(bx, by);
+    if (!m_s.fan.empty()) forEachBlock([&](int bx, int by) { testBlock(bx, by); });
     size_t fanClear = 0;
     for (const FanRay& r : m_s.rays) {
         state[r.updatedIndex] = r.clear ? RayState::Clear : RayState::Walk;
@@ -397,12 +381,8 @@ FanOutcome FanTest::run(std::vector<RayState>& state) {
 }
 }  // namespace
 
-FanOutcome testFan(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
-                   const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
-                   VisibilityScratch& scratch, std::vector<RayState>& state) {
-    state.clear();
-    if (!rayTestsApply(grid, region, sensor_m)) return FanOutcome{};
-    return FanTest(grid, region, towards, sensor_m, bounds, scratch).run(state);
+FanOutcome testFan(const RayTestInputs& inputs, std::vector<RayState>& state) {
+    return FanTest(inputs).run(state);
 }
 
 }  // namespace multibin::visibility

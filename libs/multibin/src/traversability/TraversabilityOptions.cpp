@@ -48,9 +48,8 @@ void TraversabilityOptions::read(StrictConfigSection& s) {
 
 void TraversabilityOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                                const std::string& section) {
-    StrictConfigSection s(source, section);
-    read(s);
-    s.finish();
+    loadStrictly(source, section, *this,
+                 [&](StrictConfigSection& s) { visitKeys(*this, OptionReader{s}); });
 }
 
 void TraversabilityOptions::write(mrpt::config::CConfigFileBase& c,

@@ -26,11 +26,11 @@
 
 // The library's internals stay out of this header: these are only named here. Include
 // multibin/map/BinGrid.h to read grid(), multibin/io/EsriAsciiGrid.h to use toRaster(),
-// multibin/fill/HeightRaster.h for lastFill(), multibin/sensors/SensorStats.h for
-// sensorModelStats().
+// multibin/fill/HeightRaster.h for lastFill(), multibin/map/MapStatistics.h for statistics().
 namespace multibin {
 class BinGrid;
 struct CellWindow;
+struct MapStatistics;
 class PosePropagator;
 struct PoseVariances;
 struct EsriAsciiGrid;
@@ -100,7 +100,7 @@ namespace mrpt::maps {
  * Threads: one writer and any number of concurrent readers may share a map. Every public entry
  * point takes a reader-writer lock (insertions, recenter(), dem_update_map() and clear() write;
  * queries, rasters, images and the 3D view read). The accessors that return references into the
- * map (grid(), lastFill(), insertStats(), ...) and the public option structs are not covered: use
+ * map (grid(), lastFill(), ...) and the public option structs are not covered: use
  * them from the writer thread or while no one writes. See doc/reliability.md.
  *
  * Observation likelihood is not implemented: canComputeObservationLikelihood() returns false.
@@ -408,23 +408,21 @@ public:
      * nearest of equals). */
     TFoothold bestFoothold(double x_m, double y_m, double searchRadius_m) const;
     /** @} */
-    /** Sums of what every insertion did with its points. */
-    const multibin::InsertStats& insertStats() const;
-    /** Sums of what the visibility constraint did. */
-    const multibin::VisibilityStats& visibilityStats() const;
-    /** Observations inserted with the default pose covariance because no valid pose PDF was known.
-     */
-    size_t poseFallbackCount() const;
+    /** Everything the map counted since the last clear() (insertions, visibility constraint,
+     * sensor models, observations skipped or refused), copied under the map's lock: safe to call
+     * while another thread inserts. Include multibin/map/MapStatistics.h to call it. */
+    multibin::MapStatistics statistics() const;
     /** True if observations with this sensor label are inserted (insertionOptions.sensor_labels
      * is empty or lists it). */
     bool acceptsLabel(const std::string& label) const;
-    /** Observations skipped because their sensor label is not in insertionOptions.sensor_labels. */
-    size_t skippedByLabelCount() const;
-    /** Observations refused (with an error) because their robot pose has a NaN or infinite
-     * component. */
-    size_t nonFinitePoseCount() const;
-    /** What the sensor models did (per sensor kind), since the last clear(). */
-    const multibin::sensors::SensorModelStats& sensorModelStats() const;
+    /** @name Deprecated: one part of statistics() each (a whole snapshot copied per call). @{ */
+    multibin::InsertStats insertStats() const;                     //!< statistics().insert
+    multibin::VisibilityStats visibilityStats() const;             //!< statistics().visibility
+    size_t poseFallbackCount() const;                              //!< statistics().poseFallbacks
+    size_t skippedByLabelCount() const;                            //!< statistics().skippedByLabel
+    size_t nonFinitePoseCount() const;                             //!< statistics().nonFinitePoses
+    multibin::sensors::SensorModelStats sensorModelStats() const;  //!< statistics().sensorModels
+    /** @} */
     /** @} */
 
     /** @name CMetricMap @{ */

@@ -271,6 +271,20 @@ void validateAsReadFrom(const StrictConfigSection& section, const Options& optio
         throw std::invalid_argument(section.where() + ": " + e.what());
     }
 }
+
+/** Reads options from one section of `source` that holds only theirs: `readKeys(section)` reads
+ * their keys, any other key of the section (but `allowed`) is an error, then options.validate();
+ * every error names the file and the section. */
+template <class Options, class ReadKeys>
+void loadStrictly(const mrpt::config::CConfigFileBase& source, const std::string& section,
+                  const Options& options, ReadKeys&& readKeys,
+                  const std::vector<std::string>& allowed = {}) {
+    StrictConfigSection s(source, section);
+    readKeys(s);
+    s.allow(allowed);
+    s.finish();
+    validateAsReadFrom(s, options);
+}
 /** @} */
 
 }  // namespace multibin

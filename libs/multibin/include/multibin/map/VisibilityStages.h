@@ -25,6 +25,7 @@
 
 #include "multibin/map/BinGrid.h"
 #include "multibin/map/MapTypes.h"
+#include "multibin/map/VisibilityConstraint.h"
 #include "multibin/map/VisibilityRule.h"
 
 namespace multibin::visibility {
@@ -253,24 +254,62 @@ struct FanOutcome {
         return {true, decided + clearByTest == rays, clearFirst + clearByTest};
     }
 };
+/** Stage 3's inputs for one update, and what its two tests (FanTest in VisibilityFan.cpp,
+ * EnvelopeTest in VisibilityEnvelope.cpp, each derived from it) read of them. */
+class RayTestInputs {
+public:
+    RayTestInputs(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
+                  const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
+                  VisibilityScratch& scratch)
+        : m_grid(grid),
+          m_region(region),
+          m_towards(towards),
+          m_sensor_m(sensor_m),
+          m_bounds(bounds),
+          m_s(scratch),
+          m_cell(grid.cellSize_m()),
+          m_step(0.5 * m_cell) {}
+
+protected:
+    /** f(bx, by) for every block of the region, row by row. */
+    template <class F>
+    void forEachBlock(F&& f) const {
+        for (int by = m_region.y0; by < m_region.y0 + int(m_region.ny); by++)
+            for (int bx = m_region.x0; bx < m_region.x0 + int(m_region.nx); bx++) f(bx, by);
+    }
+
+    const BinGrid& m_grid;
+    const Region& m_region;
+    const TowardsSensor& m_towards;
+    const Eigen::Vector3d& m_sensor_m;
+    const BoundTest& m_bounds;
+    VisibilityScratch& m_s;
+    const double m_cell;  //!< cell size [m]
+    const double m_step;  //!< the rule's sample step: half a cell [m]
+};
+
 /** Stage 3: the fan of rays at once (every ray starts at the sensor). A ray is proven clear when
  * nothing it passes over can hold a bin above it by the smallest conflict margin: each block high
  * enough to matter against the rays within its angle from the sensor, at the ray's lowest height
  * over the block's range of distances; where a block is too high for a ray, its units of 4 x 4
- * cells, then their cells. Runs only on a region of sane extent (heights below 1e4 m,
- * coordinates below 1e5 m). `state` gets one RayState per updated cell. */
-FanOutcome testFan(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
-                   const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
-                   VisibilityScratch& scratch, std::vector<RayState>& state);
+ * cells, then their cells. Only where rayTestsApply holds (testRays checks it). `state` gets one
+ * RayState per updated cell. */
+FanOutcome testFan(const RayTestInputs& inputs, std::vector<RayState>& state);
 
 /** Stage 3 for a camera frame's thousands of rays (RayFan::Skip): the rays' lower envelope by
  * direction (sectors of pseudo-angle, about one ray each), tested per block of the region, then
  * per cell of the blocks it does not settle, against the rays within the cell's directions long
  * enough to reach it. A ray is clear unless its sector holds a cell, within its reach, that may
- * hold a bin above the envelope there. Same preconditions and outcome as testFan. */
-FanOutcome testEnvelope(const BinGrid& grid, const Region& region, const TowardsSensor& towards,
-                        const Eigen::Vector3d& sensor_m, const BoundTest& bounds,
-                        VisibilityScratch& scratch, std::vector<RayState>& state);
+ * hold a bin above the envelope there. Same precondition and outcome as testFan. */
+FanOutcome testEnvelope(const RayTestInputs& inputs, std::vector<RayState>& state);
+
+/** Stage 3 as the constraint runs it: `state` emptied, then, on a region of sane extent
+ * (rayTestsApply: heights below 1e4 m, coordinates below 1e5 m), the fan test (RayFan::Test) or
+ * the envelope test (RayFan::Skip); the outcome's `ran` says whether one ran. */
+FanOutcome testRays(RayFan fan, const BinGrid& grid, const Region& region,
+                    const TowardsSensor& towards, const Eigen::Vector3d& sensor_m,
+                    const BoundTest& bounds, VisibilityScratch& scratch,
+                    std::vector<RayState>& state);
 
 /** Stage 4: the stretches [from, to] of distance from the target, in walking order, over block
  * columns (rows if the ray runs more along y) that may hold a bin conflicting with the ray;
