@@ -31,35 +31,9 @@ double secondsSince(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-/** The values of `whole` (on `wholeLattice`) on the cells of `sub`, NaN where it has none. */
-CellArray cutTo(const CellArray& whole, const Lattice& wholeLattice, const Lattice& sub) {
-    CellArray out;
-    out.setConstant(sub.window.ny, sub.window.nx, NAN);
-    for (int r = 0; r < sub.window.ny; r++)
-        for (int c = 0; c < sub.window.nx; c++) {
-            const int wr = sub.window.iy0 + r - wholeLattice.window.iy0;
-            const int wc = sub.window.ix0 + c - wholeLattice.window.ix0;
-            if (wholeLattice.inside(wc, wr)) out(r, c) = whole(wr, wc);
-        }
-    return out;
-}
-
-/** `lattice` grown by `cells` cells each way. */
-Lattice grown(Lattice lattice, int cells) {
-    lattice.window.ix0 -= cells, lattice.window.iy0 -= cells;
-    lattice.window.nx += 2 * cells, lattice.window.ny += 2 * cells;
-    return lattice;
-}
-
-/** Cells each way a traversability disc reaches beyond its own cell. */
-int discReach_cells(const CMultiBinElevationMap& map, double cellSize_m) {
-    return int(std::ceil(map.traversabilityOptions.reach_m() / cellSize_m)) + 1;
-}
-
-/** The truth on the map's lattice, cut to `area_m` when given; and its cell means on that
- * lattice grown by `aroundCells` (NaN beyond the truth). */
+/** The truth on the map's lattice, cut to `area_m` when given. */
 CellArray loadTruth(const std::string& path, double cellSize_m, const std::vector<double>& area_m,
-                    Lattice& lattice, int aroundCells, CellArray& around) {
+                    Lattice& lattice) {
     if (!fs::exists(path)) throw std::runtime_error("ground truth '" + path + "' not found");
     const multibin::EsriAsciiGrid truth = multibin::EsriAsciiGrid::load(path);  // names the file
     CellArray whole;
@@ -70,10 +44,13 @@ CellArray loadTruth(const std::string& path, double cellSize_m, const std::vecto
     } catch (const std::invalid_argument& e) {
         throw std::runtime_error("ground truth '" + path + "': " + e.what());
     }
-    const Lattice wholeLattice = lattice;
-    if (!area_m.empty()) lattice = multibin::eval::subLattice(lattice, area_m);
-    around = cutTo(whole, wholeLattice, grown(lattice, aroundCells));
-    return area_m.empty() ? whole : cutTo(whole, wholeLattice, lattice);
+    if (area_m.empty()) return whole;
+    const Lattice sub = multibin::eval::subLattice(lattice, area_m);
+    const CellArray cut =
+        whole.block(sub.window.iy0 - lattice.window.iy0, sub.window.ix0 - lattice.window.ix0,
+                    sub.window.ny, sub.window.nx);
+    lattice = sub;
+    return cut;
 }
 
 /** Cell size of the evaluated map's (global) grid [m]. */
@@ -113,44 +90,67 @@ std::vector<float> rowMajor(const CellArray& a) {
     return v;
 }
 
+/** The truth's classes of the evaluated cells (and their features): -1 where unknown, and, with an
+ * evaluated area, where a cell's disc reaches beyond it: the class of such a disc describes
+ * surface outside the area (the ground around the boards, which the scenario's sensors never see
+ * behind the boards' edges), not the area scored. */
+std::vector<int8_t> scoredTruth(const multibin::EsriAsciiGrid& truthRaster, const Lattice& lattice,
+                                const std::vector<double>& area_m,
+                                const multibin::traversability::TraversabilityOptions& o,
+                                std::vector<multibin::traversability::DiscFeatures>& features) {
+    std::vector<int8_t> truth =
+        multibin::traversability::truthClasses(truthRaster, lattice, o, &features);
+    if (area_m.empty()) return truth;
+    for (int r = 0; r < lattice.ny(); r++)
+        for (int c = 0; c < lattice.nx(); c++) {
+            const double x = lattice.cellCenterX_m(c), y = lattice.cellCenterY_m(r);
+            if (x - o.radius_m < area_m[0] || x + o.radius_m > area_m[1] ||
+                y - o.radius_m < area_m[2] || y + o.radius_m > area_m[3])
+                truth[lattice.index(c, r)] = -1;
+        }
+    return truth;
+}
+
 /** The traversability layer against the truth's (doc/traversability.md): classes from the
  * ground-truth raster itself (the finer it is, the closer to the surface), scored for the map's
- * probabilities and for the features of other methods' cell heights thresholded. Those heights
- * are given on `around` (the evaluated lattice grown by the disc's reach): a disc at the area's
- * edge reads the surface beyond it, as the truth's disc does. They are thresholded at the limits
- * themselves: the options' calibration is a fit of the map's layer, not of other methods.
+ * probabilities and for the features of other methods' cell heights thresholded at the limits
+ * themselves (the options' calibration is a fit of the map's layer, not of other methods).
  * With an evaluated area (`area_m`), only the cells whose disc lies inside it are scored. Writes
- * traversability.json and eval_untraversable_{truth,multibin}.{asc,png}. */
+ * traversability.json, traversability_cells.csv (the truth's and the layer's features of each
+ * scored cell) and eval_untraversable_{truth,multibin}.{asc,png}. */
 std::string evaluateTraversability(const OutputFolder& out, const CMultiBinElevationMap& map,
                                    const Lattice& lattice, const std::vector<double>& area_m,
-                                   const std::string& truthPath, const Lattice& around,
-                                   const std::vector<MethodEstimate>& heightsAround) {
+                                   const std::string& truthPath,
+                                   const std::vector<MethodEstimate>& heightMethods) {
     namespace trav = multibin::traversability;
     const trav::TraversabilityOptions& o = map.traversabilityOptions;
     const multibin::EsriAsciiGrid truthRaster = multibin::EsriAsciiGrid::load(truthPath);
-    std::vector<int8_t> truth = trav::truthClasses(truthRaster, lattice, o);
-    // A cell counts where its whole disc lies in the evaluated area: the class of a disc that
-    // reaches beyond describes surface outside it (the ground around the boards, which the
-    // scenario's sensors never see behind the boards' edges), not the area scored.
-    if (!area_m.empty())
-        for (int r = 0; r < lattice.ny(); r++)
-            for (int c = 0; c < lattice.nx(); c++) {
-                const double x = lattice.cellCenterX_m(c), y = lattice.cellCenterY_m(r);
-                if (x - o.radius_m < area_m[0] || x + o.radius_m > area_m[1] ||
-                    y - o.radius_m < area_m[2] || y + o.radius_m > area_m[3])
-                    truth[lattice.index(c, r)] = -1;
-            }
+    std::vector<trav::DiscFeatures> truthFeatures;
+    const std::vector<int8_t> truth = scoredTruth(truthRaster, lattice, area_m, o, truthFeatures);
     // The map's layer, looked up at each evaluated cell's centre.
     const trav::TraversabilityLayers layers = map.traversabilityLayers();
     const mrpt::math::TPoint2D origin = map.mapOrigin();
     std::vector<float> p(lattice.cellCount(), NAN);
+    std::ostringstream csv;  // what a calibration is fitted on (scripts/fit-traversability.py)
+    csv << "x_m,y_m,truth_step_m,truth_slope_deg,truth_roughness_m,step_m,slope_deg,roughness_m,"
+           "untraversable\n";
     for (int r = 0; r < lattice.ny(); r++)
         for (int c = 0; c < lattice.nx(); c++) {
             int lc, lr;
-            if (layers.lattice.cellOf(lattice.cellCenterX_m(c) - origin.x,
-                                      lattice.cellCenterY_m(r) - origin.y, lc, lr))
-                p[lattice.index(c, r)] = layers.untraversable[layers.lattice.index(lc, lr)];
+            const size_t k = lattice.index(c, r);
+            if (!layers.lattice.cellOf(lattice.cellCenterX_m(c) - origin.x,
+                                       lattice.cellCenterY_m(r) - origin.y, lc, lr))
+                continue;
+            const size_t l = layers.lattice.index(lc, lr);
+            p[k] = layers.untraversable[l];
+            if (truth[k] < 0 || !layers.known(l)) continue;
+            const trav::DiscFeatures& f = truthFeatures[k];
+            csv << lattice.cellCenterX_m(c) << ',' << lattice.cellCenterY_m(r) << ',' << f.step_m
+                << ',' << f.slope_deg << ',' << f.roughness_m << ',' << layers.step_m[l] << ','
+                << layers.slope_deg[l] << ',' << layers.roughness_m[l] << ','
+                << layers.untraversable[l] << '\n';
         }
+    out.write("traversability_cells.csv", csv.str());
     std::map<std::string, trav::ClassifierScore> scores{
         {"multibin", trav::scoreProbabilities(p, truth)}};
     std::vector<std::string> order{"multibin"};
@@ -162,25 +162,21 @@ std::string evaluateTraversability(const OutputFolder& out, const CMultiBinEleva
     // map's lattice, as a lattice of points rather than cell means.
     MethodEstimate truthPoints;
     truthPoints.name = "truth_at_cell_centres";
-    truthPoints.height_m.setConstant(around.ny(), around.nx(), NAN);
-    for (int r = 0; r < around.ny(); r++)
-        for (int c = 0; c < around.nx(); c++) {
+    truthPoints.height_m.setConstant(lattice.ny(), lattice.nx(), NAN);
+    for (int r = 0; r < lattice.ny(); r++)
+        for (int c = 0; c < lattice.nx(); c++) {
             const double d = truthRaster.cellsize_m;
-            const long tc = std::lround((around.cellCenterX_m(c) - truthRaster.xllcenter_m) / d);
-            const long tr = std::lround((around.cellCenterY_m(r) - truthRaster.yllcenter_m) / d);
+            const long tc = std::lround((lattice.cellCenterX_m(c) - truthRaster.xllcenter_m) / d);
+            const long tr = std::lround((lattice.cellCenterY_m(r) - truthRaster.yllcenter_m) / d);
             if (tc >= 0 && tr >= 0 && tc < truthRaster.cols() && tr < truthRaster.rows())
                 truthPoints.height_m(r, c) = truthRaster.heights_m(int(tr), int(tc));
         }
-    std::vector<MethodEstimate> methods = heightsAround;
+    std::vector<MethodEstimate> methods = heightMethods;
     methods.push_back(truthPoints);
     for (const MethodEstimate& m : methods) {
         trav::TraversabilityLayers t;
-        trav::computeLayers(trav::cellHeightSamples(around, rowMajor(m.height_m)), thresholded, t);
-        const CellArray inside = cutTo(
-            Eigen::Map<const Eigen::Array<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-                t.untraversable.data(), around.ny(), around.nx()),
-            around, lattice);
-        scores[m.name + "_thresholded"] = trav::scoreProbabilities(rowMajor(inside), truth);
+        trav::computeLayers(trav::cellHeightSamples(lattice, rowMajor(m.height_m)), thresholded, t);
+        scores[m.name + "_thresholded"] = trav::scoreProbabilities(t.untraversable, truth);
         order.push_back(m.name + "_thresholded");
     }
     out.write("traversability.json", trav::scoresJson(scores, order, o));
@@ -214,16 +210,12 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
       m_evaluated(evaluated),
       m_laserOnly(evaluated.creationOptions),
       m_truth(loadTruth(options.groundTruthPath, evaluatedCellSize_m(evaluated), options.area_m,
-                        m_lattice, discReach_cells(evaluated, evaluatedCellSize_m(evaluated)),
-                        m_truthAround)),
-      m_travLattice(grown(m_lattice, discReach_cells(evaluated, m_lattice.cellSize_m))),
+                        m_lattice)),
       m_rawLaser(m_lattice),
       m_rawAll(m_lattice),
-      // Over the traversability baselines' lattice: the cells beyond the evaluated area are read
-      // by those discs only; the height scores sample the evaluated cells.
-      m_heightGrid(mrpt::maps::CHeightGridMap2D::mrSimpleAverage, m_travLattice.area_m()[0],
-                   m_travLattice.area_m()[1], m_travLattice.area_m()[2], m_travLattice.area_m()[3],
-                   m_travLattice.cellSize_m) {
+      m_heightGrid(mrpt::maps::CHeightGridMap2D::mrSimpleAverage, m_lattice.area_m()[0],
+                   m_lattice.area_m()[1], m_lattice.area_m()[2], m_lattice.area_m()[3],
+                   m_lattice.cellSize_m) {
     m_laserOnly.insertionOptions = evaluated.insertionOptions;
     // The profile is sampled every half cell: a line beyond the evaluated area would be sampled
     // (billions of times, for a far end point) where there is nothing to draw.
@@ -316,17 +308,17 @@ void EvaluationRun::observe(const mrpt::obs::CObservation& obs,
 }
 
 MethodEstimate EvaluationRun::sampleMap(const std::string& name, const CMultiBinElevationMap& map,
-                                        bool filled, const Lattice& lattice) const {
+                                        bool filled) const {
     MethodEstimate m;
     m.name = name;
-    m.height_m.setConstant(lattice.window.ny, lattice.window.nx, NAN);
-    m.sigma_m.setConstant(lattice.window.ny, lattice.window.nx, NAN);
+    m.height_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
+    m.sigma_m.setConstant(m_lattice.window.ny, m_lattice.window.nx, NAN);
     // The cells' values, as the rasters give them: the table scores one height per cell against
     // the truth raster on the same lattice (the sub-cell surface: doc/sub-cell-surface.md).
-    for (int r = 0; r < lattice.window.ny; r++)
-        for (int c = 0; c < lattice.window.nx; c++) {
+    for (int r = 0; r < m_lattice.window.ny; r++)
+        for (int c = 0; c < m_lattice.window.nx; c++) {
             double h, s;
-            if (map.cellElevation(lattice.cellCenterX_m(c), lattice.cellCenterY_m(r), h, s,
+            if (map.cellElevation(m_lattice.cellCenterX_m(c), m_lattice.cellCenterY_m(r), h, s,
                                   filled) != CMultiBinElevationMap::HeightSource::Unknown) {
                 m.height_m(r, c) = float(h);
                 m.sigma_m(r, c) = float(s);
@@ -346,17 +338,17 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     methods.push_back(rawLaser);
     methods.push_back(rawAll);
 
-    MethodEstimate laserOnly = sampleMap("laser_only", m_laserOnly, false, m_lattice);
+    MethodEstimate laserOnly = sampleMap("laser_only", m_laserOnly, false);
     laserOnly.baseline = "raw_laser";
     laserOnly.insert_s = m_laserOnly_s;
     methods.push_back(laserOnly);
 
-    MethodEstimate multibin = sampleMap("multibin", m_evaluated, false, m_lattice);
+    MethodEstimate multibin = sampleMap("multibin", m_evaluated, false);
     multibin.baseline = "raw_all";
     multibin.insert_s = multibinInsert_s;
     methods.push_back(multibin);
 
-    MethodEstimate filled = sampleMap("multibin_filled", m_evaluated, true, m_lattice);
+    MethodEstimate filled = sampleMap("multibin_filled", m_evaluated, true);
     filled.baseline = "raw_all";
     filled.insert_s = multibin.insert_s;
     filled.fill_s = multibinFill_s;
@@ -395,14 +387,10 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
             multibin::eval::scoreArea("mrf_crop", m_truth, methods, m_lattice, m_mrfLattice));
 
     out.write("report.json", multibin::eval::reportJson(scores, order, m_lattice, areas));
-    // Heights of the traversability baselines over the evaluated cells and the discs' reach
-    // beyond; the truth's own cell means: what thresholded heights at the map's resolution reach.
-    MethodEstimate filledAround = sampleMap("multibin_filled", m_evaluated, true, m_travLattice);
-    MethodEstimate heightGridAround, truthCells;
-    heightGridAround.name = "mrpt_height_grid";
-    heightGridAround.height_m = sampleDem(m_heightGrid, m_travLattice);
+    // The truth's own cell means: what thresholded heights at the map's resolution reach at best.
+    MethodEstimate truthCells;
     truthCells.name = "truth_cell_means";
-    truthCells.height_m = m_truthAround;
+    truthCells.height_m = m_truth;
     auto saveRaster = [&](const std::string& name, const CellArray& values) {
         out.writeWith(name, [&](const std::string& path) {
             rasterOf(m_lattice, values).save(path);
@@ -414,8 +402,7 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     out.write("profile.csv", profileCsv(m_truth, methods));
     return multibin::eval::reportTable(scores, order, areas) +
            evaluateTraversability(out, m_evaluated, m_lattice, m_options.area_m,
-                                  m_options.groundTruthPath, m_travLattice,
-                                  {filledAround, heightGridAround, truthCells});
+                                  m_options.groundTruthPath, {filled, heightGrid, truthCells});
 }
 
 std::string EvaluationRun::profileCsv(const CellArray& truth,

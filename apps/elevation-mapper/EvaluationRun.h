@@ -54,10 +54,9 @@ public:
 private:
     void insertRawPoints(const mrpt::obs::CObservation& obs,
                          const mrpt::poses::CPose3DPDFGaussian& robotPose);
-    /** The map's cell heights at the centres of `lattice`'s cells. */
     multibin::eval::MethodEstimate sampleMap(const std::string& name,
                                              const mrpt::maps::CMultiBinElevationMap& map,
-                                             bool filled, const multibin::Lattice& lattice) const;
+                                             bool filled) const;
     /** profile.csv: the profile line's samples of the truth and the maps. */
     std::string profileCsv(const multibin::eval::CellArray& truth,
                            const std::vector<multibin::eval::MethodEstimate>& methods) const;
@@ -66,11 +65,7 @@ private:
     mrpt::maps::CMultiBinElevationMap& m_evaluated;
     mrpt::maps::CMultiBinElevationMap m_laserOnly;
     multibin::Lattice m_lattice;
-    multibin::eval::CellArray m_truthAround;  //!< the truth's cell means on m_travLattice
-    multibin::eval::CellArray m_truth;        // after m_truthAround: its initializer sets both
-    /** The evaluated lattice grown by the traversability disc's reach: the thresholded baselines'
-     * features of a cell at the area's edge read the heights beyond it, as the truth's do. */
-    multibin::Lattice m_travLattice;
+    multibin::eval::CellArray m_truth;
     multibin::eval::RawPointGrid m_rawLaser, m_rawAll;
     mrpt::maps::CHeightGridMap2D m_heightGrid;
     std::unique_ptr<mrpt::maps::CHeightGridMap2D_MRF> m_mrf;
