@@ -154,10 +154,9 @@ std::string evaluateTraversability(const OutputFolder& out, const CMultiBinEleva
     std::map<std::string, trav::ClassifierScore> scores{
         {"multibin", trav::scoreProbabilities(p, truth)}};
     std::vector<std::string> order{"multibin"};
-    trav::TraversabilityOptions thresholded = o;
+    trav::TraversabilityOptions thresholded = o.uncalibrated();
     thresholded.monte_carlo_draws = 0;
     thresholded.use_bins = false;
-    thresholded.step = thresholded.slope = thresholded.roughness = {};  // identity
     // The truth sampled at the cells' centres (its nearest sample): the exact surface on the
     // map's lattice, as a lattice of points rather than cell means.
     MethodEstimate truthPoints;

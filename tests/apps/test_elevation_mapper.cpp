@@ -382,12 +382,13 @@ double jsonField(const std::string& json, const std::string& method, const std::
 
 // The traversability scores (doc/traversability.md): a truth raster at 5 mm with a 0.085 m step
 // along x = 1.3 m, scored over --eval-area 0.995..1.605 x -0.005..0.605 m at 20 mm cells with
-// the hexapod limits (disc 0.05 m, step 0.08 m) and a calibration that would hide the step
-// (-0.01 m, -90 deg, -0.1 m). By hand: the cells scored are those whose disc lies in the area,
-// centres 1.05..1.55 by 0.05..0.55 m, 26 x 26 = 676; the truth calls the 4 columns of centres
-// 1.27..1.33 untraversable (their discs reach across 1.3; those at 1.25 and 1.35 stop 2.5 mm
-// short of the other side's samples), and so do the truth's own cell means thresholded at the
-// limits themselves (the calibration is the map layer's, not theirs): F1 1.
+// a disc of 0.05 m, the step as the only limit (0.08 m) and a calibration that would hide the
+// step (biases -0.01 m, -90 deg, -0.1 m; the step's slope and roughness terms negative). By hand:
+// the cells scored are those whose disc lies in the area, centres 1.05..1.55 by 0.05..0.55 m, 26 x
+// 26 = 676; the truth calls the 4 columns of centres 1.27..1.33 untraversable (their discs reach
+// across 1.3; those at 1.25 and 1.35 stop 2.5 mm short of the other side's samples), and so do the
+// truth's own cell means thresholded at the limits themselves (the calibration is the map layer's,
+// not theirs): F1 1.
 TEST(ElevationMapperTraversability, BaselinesAreThresholdedAtTheLimitsOnDiscsInsideTheArea) {
     const fs::path d = scratchDir("traversability_scores");
     writePatchRawlog(d / "patch.rawlog", 60);
@@ -395,7 +396,9 @@ TEST(ElevationMapperTraversability, BaselinesAreThresholdedAtTheLimitsOnDiscsIns
     {
         std::ofstream f(d / "maps.ini", std::ios::app);
         f << "[MappingApplication_multiBinElevationMap_00_traversabilityOpts]\n"
-             "step_bias_m = -0.01\nslope_bias_deg = -90\nroughness_bias_m = -0.1\n";
+             "max_slope_deg = 89\nmax_roughness_m = 1\n"  // the step alone decides
+             "step_bias_m = -0.01\nslope_bias_deg = -90\nroughness_bias_m = -0.1\n"
+             "step_slope_gain = -0.01\nstep_roughness_gain = -10\n";
     }
     multibin::EsriAsciiGrid gt;
     gt.cellsize_m = 0.005;

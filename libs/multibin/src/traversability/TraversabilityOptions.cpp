@@ -39,6 +39,13 @@ void visitKeys(Options& o, Visit&& visit) {
 }
 }  // namespace
 
+TraversabilityOptions TraversabilityOptions::uncalibrated() const {
+    TraversabilityOptions o = *this;
+    o.step = o.slope = o.roughness = {};
+    o.step_roughness_gain = o.step_slope_gain = 0;
+    return o;
+}
+
 double TraversabilityOptions::reach_m() const {
     return std::max(radius_m, foot_radius_m + foothold_clearance_m);
 }

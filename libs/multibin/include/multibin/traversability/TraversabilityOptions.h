@@ -69,6 +69,9 @@ struct TraversabilityOptions {
      * outliers do not make) [m/deg]; 0 by default. */
     double step_slope_gain = 0;
 
+    /** These options with the identity calibration (the map's features are the truth's). */
+    TraversabilityOptions uncalibrated() const;
+
     /** The radius of the largest disc any layer reads [m]. */
     double reach_m() const;
 
