@@ -6,10 +6,15 @@
 # the scenario's ini at 20 mm plus ini/traversability-hexapod.ini, scored on the boards alone.
 #
 # Usage: bash scripts/evaluate-traversability.sh [OUTDIR]   (default build/traversability)
-# Needs a configured build; builds terrain-sim and elevation-mapper. About 3 minutes on 2 cores.
+#        bash scripts/evaluate-traversability.sh --tune [OUTDIR]
+# --tune maps only the tuning mock-up (matched and independent noise) with the hexapod preset's
+# limits and no calibration, and fits the calibration on its cells (scripts/fit-traversability.py).
+# Needs a configured build; builds terrain-sim and elevation-mapper. About 2 minutes on 2 cores.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir=${MULTIBIN_BUILD_DIR:-$root/build}
+tune=0
+if [ "${1:-}" = --tune ]; then tune=1; shift; fi
 out=${1:-$build_dir/traversability}
 cmake --build "$build_dir" --target terrain-sim elevation-mapper >/dev/null
 sim="$build_dir/apps/terrain-sim/terrain-sim"
@@ -29,13 +34,21 @@ run() {  # scenario noise
   local s=$1 n=$2 prefix="$out/$1-$2"
   # shellcheck disable=SC2086
   "$sim" ${scenario[$s]} --noise "$n" --gt-cell 0.003 --out "$prefix" | head -1
+  # --tune: the preset without its calibration keys (identity).
   sed 's/^resolution_m = .*/resolution_m = 0.02/' "$prefix.ini" |
-    cat - "$root/ini/traversability-hexapod.ini" >"$prefix-hexapod.ini"
+    cat - <(if [ $tune = 1 ]; then grep -Ev '_(bias|gain|model_sigma)' "$root/ini/traversability-hexapod.ini"
+            else cat "$root/ini/traversability-hexapod.ini"; fi) >"$prefix-hexapod.ini"
   "$mapper" --config "$prefix-hexapod.ini" --rawlog "$prefix.rawlog" \
     --ground-truth "${prefix}_gt.asc" --eval-area "${area[$s]}" --no-plots --outputs map \
     --out "$prefix-boards" >"$prefix-boards.log"
   rm -f "$prefix.simplemap"
 }
+if [ $tune = 1 ]; then
+  run tune-mockup matched
+  run tune-mockup independent
+  python3 "$root/scripts/fit-traversability.py" "$out"/tune-mockup-*-boards/traversability_cells.csv
+  exit 0
+fi
 for s in score-mockup score-walk; do
   for n in matched independent; do run "$s" "$n"; done
 done

@@ -90,35 +90,89 @@ std::vector<float> rowMajor(const CellArray& a) {
     return v;
 }
 
+/** The truth's classes of the evaluated cells (and their features): -1 where unknown, and, with an
+ * evaluated area, where a cell's disc reaches beyond it: the class of such a disc describes
+ * surface outside the area (the ground around the boards, which the scenario's sensors never see
+ * behind the boards' edges), not the area scored. */
+std::vector<int8_t> scoredTruth(const multibin::EsriAsciiGrid& truthRaster, const Lattice& lattice,
+                                const std::vector<double>& area_m,
+                                const multibin::traversability::TraversabilityOptions& o,
+                                std::vector<multibin::traversability::DiscFeatures>& features) {
+    std::vector<int8_t> truth =
+        multibin::traversability::truthClasses(truthRaster, lattice, o, &features);
+    if (area_m.empty()) return truth;
+    for (int r = 0; r < lattice.ny(); r++)
+        for (int c = 0; c < lattice.nx(); c++) {
+            const double x = lattice.cellCenterX_m(c), y = lattice.cellCenterY_m(r);
+            if (x - o.radius_m < area_m[0] || x + o.radius_m > area_m[1] ||
+                y - o.radius_m < area_m[2] || y + o.radius_m > area_m[3])
+                truth[lattice.index(c, r)] = -1;
+        }
+    return truth;
+}
+
 /** The traversability layer against the truth's (doc/traversability.md): classes from the
  * ground-truth raster itself (the finer it is, the closer to the surface), scored for the map's
- * probabilities and for the features of the filled map's and MRPT's heights thresholded.
- * Writes traversability.json and eval_untraversable_{truth,multibin}.{asc,png}. */
+ * probabilities and for the features of other methods' cell heights thresholded at the limits
+ * themselves (the options' calibration is a fit of the map's layer, not of other methods).
+ * With an evaluated area (`area_m`), only the cells whose disc lies inside it are scored. Writes
+ * traversability.json, traversability_cells.csv (the truth's and the layer's features of each
+ * scored cell) and eval_untraversable_{truth,multibin}.{asc,png}. */
 std::string evaluateTraversability(const OutputFolder& out, const CMultiBinElevationMap& map,
-                                   const Lattice& lattice, const std::string& truthPath,
+                                   const Lattice& lattice, const std::vector<double>& area_m,
+                                   const std::string& truthPath,
                                    const std::vector<MethodEstimate>& heightMethods) {
     namespace trav = multibin::traversability;
     const trav::TraversabilityOptions& o = map.traversabilityOptions;
-    const std::vector<int8_t> truth =
-        trav::truthClasses(multibin::EsriAsciiGrid::load(truthPath), lattice, o);
+    const multibin::EsriAsciiGrid truthRaster = multibin::EsriAsciiGrid::load(truthPath);
+    std::vector<trav::DiscFeatures> truthFeatures;
+    const std::vector<int8_t> truth = scoredTruth(truthRaster, lattice, area_m, o, truthFeatures);
     // The map's layer, looked up at each evaluated cell's centre.
     const trav::TraversabilityLayers layers = map.traversabilityLayers();
     const mrpt::math::TPoint2D origin = map.mapOrigin();
     std::vector<float> p(lattice.cellCount(), NAN);
+    std::ostringstream csv;  // what a calibration is fitted on (scripts/fit-traversability.py)
+    csv << "x_m,y_m,truth_step_m,truth_slope_deg,truth_roughness_m,step_m,slope_deg,roughness_m,"
+           "untraversable\n";
     for (int r = 0; r < lattice.ny(); r++)
         for (int c = 0; c < lattice.nx(); c++) {
             int lc, lr;
-            if (layers.lattice.cellOf(lattice.cellCenterX_m(c) - origin.x,
-                                      lattice.cellCenterY_m(r) - origin.y, lc, lr))
-                p[lattice.index(c, r)] = layers.untraversable[layers.lattice.index(lc, lr)];
+            const size_t k = lattice.index(c, r);
+            if (!layers.lattice.cellOf(lattice.cellCenterX_m(c) - origin.x,
+                                       lattice.cellCenterY_m(r) - origin.y, lc, lr))
+                continue;
+            const size_t l = layers.lattice.index(lc, lr);
+            p[k] = layers.untraversable[l];
+            if (truth[k] < 0 || !layers.known(l)) continue;
+            const trav::DiscFeatures& f = truthFeatures[k];
+            csv << lattice.cellCenterX_m(c) << ',' << lattice.cellCenterY_m(r) << ',' << f.step_m
+                << ',' << f.slope_deg << ',' << f.roughness_m << ',' << layers.step_m[l] << ','
+                << layers.slope_deg[l] << ',' << layers.roughness_m[l] << ','
+                << layers.untraversable[l] << '\n';
         }
+    out.write("traversability_cells.csv", csv.str());
     std::map<std::string, trav::ClassifierScore> scores{
         {"multibin", trav::scoreProbabilities(p, truth)}};
     std::vector<std::string> order{"multibin"};
-    trav::TraversabilityOptions thresholded = o;
+    trav::TraversabilityOptions thresholded = o.uncalibrated();
     thresholded.monte_carlo_draws = 0;
     thresholded.use_bins = false;
-    for (const MethodEstimate& m : heightMethods) {
+    // The truth sampled at the cells' centres (its nearest sample): the exact surface on the
+    // map's lattice, as a lattice of points rather than cell means.
+    MethodEstimate truthPoints;
+    truthPoints.name = "truth_at_cell_centres";
+    truthPoints.height_m.setConstant(lattice.ny(), lattice.nx(), NAN);
+    for (int r = 0; r < lattice.ny(); r++)
+        for (int c = 0; c < lattice.nx(); c++) {
+            const double d = truthRaster.cellsize_m;
+            const long tc = std::lround((lattice.cellCenterX_m(c) - truthRaster.xllcenter_m) / d);
+            const long tr = std::lround((lattice.cellCenterY_m(r) - truthRaster.yllcenter_m) / d);
+            if (tc >= 0 && tr >= 0 && tc < truthRaster.cols() && tr < truthRaster.rows())
+                truthPoints.height_m(r, c) = truthRaster.heights_m(int(tr), int(tc));
+        }
+    std::vector<MethodEstimate> methods = heightMethods;
+    methods.push_back(truthPoints);
+    for (const MethodEstimate& m : methods) {
         trav::TraversabilityLayers t;
         trav::computeLayers(trav::cellHeightSamples(lattice, rowMajor(m.height_m)), thresholded, t);
         scores[m.name + "_thresholded"] = trav::scoreProbabilities(t.untraversable, truth);
@@ -346,8 +400,8 @@ std::string EvaluationRun::finish(const OutputFolder& out, double multibinInsert
     for (const auto& m : methods) saveRaster("eval_" + m.name + ".asc", m.height_m);
     out.write("profile.csv", profileCsv(m_truth, methods));
     return multibin::eval::reportTable(scores, order, areas) +
-           evaluateTraversability(out, m_evaluated, m_lattice, m_options.groundTruthPath,
-                                  {filled, heightGrid, truthCells});
+           evaluateTraversability(out, m_evaluated, m_lattice, m_options.area_m,
+                                  m_options.groundTruthPath, {filled, heightGrid, truthCells});
 }
 
 std::string EvaluationRun::profileCsv(const CellArray& truth,

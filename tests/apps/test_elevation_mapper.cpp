@@ -13,6 +13,7 @@
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -367,4 +368,58 @@ TEST(ElevationMapperCli, ProgressOnATerminalForEveryStage) {
     const RunResult plain = runMapper(d, args + " --no-plots");
     EXPECT_EQ(plain.exitCode, 0);
     EXPECT_EQ(plain.err, "");
+}
+
+namespace {
+/** The number after `"field": ` in the entry of `method` of a traversability.json. */
+double jsonField(const std::string& json, const std::string& method, const std::string& field) {
+    const size_t m = json.find("\"" + method + "\": {");
+    if (m == std::string::npos) return NAN;
+    const size_t f = json.find("\"" + field + "\": ", m);
+    return f == std::string::npos ? NAN : std::stod(json.substr(f + field.size() + 4));
+}
+}  // namespace
+
+// The traversability scores (doc/traversability.md): a truth raster at 5 mm with a 0.085 m step
+// along x = 1.3 m, scored over --eval-area 0.995..1.605 x -0.005..0.605 m at 20 mm cells with
+// a disc of 0.05 m, the step as the only limit (0.08 m) and a calibration that would hide the
+// step (biases -0.01 m, -90 deg, -0.1 m; the step's slope and roughness terms negative). By hand:
+// the cells scored are those whose disc lies in the area, centres 1.05..1.55 by 0.05..0.55 m, 26 x
+// 26 = 676; the truth calls the 4 columns of centres 1.27..1.33 untraversable (their discs reach
+// across 1.3; those at 1.25 and 1.35 stop 2.5 mm short of the other side's samples), and so do the
+// truth's own cell means thresholded at the limits themselves (the calibration is the map layer's,
+// not theirs): F1 1.
+TEST(ElevationMapperTraversability, BaselinesAreThresholdedAtTheLimitsOnDiscsInsideTheArea) {
+    const fs::path d = scratchDir("traversability_scores");
+    writePatchRawlog(d / "patch.rawlog", 60);
+    writeIni(d / "maps.ini");
+    {
+        std::ofstream f(d / "maps.ini", std::ios::app);
+        f << "[MappingApplication_multiBinElevationMap_00_traversabilityOpts]\n"
+             "max_slope_deg = 89\nmax_roughness_m = 1\n"  // the step alone decides
+             "step_bias_m = -0.01\nslope_bias_deg = -90\nroughness_bias_m = -0.1\n"
+             "step_slope_gain = -0.01\nstep_roughness_gain = -10\n";
+    }
+    multibin::EsriAsciiGrid gt;
+    gt.cellsize_m = 0.005;
+    gt.xllcenter_m = 0.9025;  // samples between, never on, the cells' edges
+    gt.yllcenter_m = -0.0975;
+    gt.heights_m.resize(160, 160);
+    for (int r = 0; r < 160; r++)
+        for (int c = 0; c < 160; c++)
+            gt.heights_m(r, c) = gt.xllcenter_m + c * gt.cellsize_m > 1.3 ? -0.215f : -0.3f;
+    gt.save((d / "gt.asc").string());
+    const RunResult r = runMapper(d, "--config " + (d / "maps.ini").string() + " --rawlog " +
+                                         (d / "patch.rawlog").string() + " --ground-truth " +
+                                         (d / "gt.asc").string() +
+                                         " --eval-area 0.995,1.605,-0.005,0.605 --no-plots "
+                                         "--outputs map --out " +
+                                         (d / "out").string());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const std::string json = readAll(d / "out" / "traversability.json");
+    for (const char* m : {"multibin", "truth_cell_means_thresholded"})
+        EXPECT_EQ(jsonField(json, m, "truth_cells"), 676) << m << "\n" << json;
+    EXPECT_EQ(jsonField(json, "truth_cell_means_thresholded", "tp"), 4 * 26) << json;
+    EXPECT_EQ(jsonField(json, "truth_cell_means_thresholded", "f1"), 1.0) << json;
+    EXPECT_EQ(jsonField(json, "truth_at_cell_centres_thresholded", "f1"), 1.0) << json;
 }

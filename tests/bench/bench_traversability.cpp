@@ -6,7 +6,9 @@
 #include <mrpt/maps/CSimpleMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
+#include <ctime>
 #include <string>
+#include <vector>
 
 namespace {
 /** The shipped mock-up's keyframes (rawlogs/mockup.simplemap); false if missing. */
@@ -64,6 +66,54 @@ BENCHMARK(BM_MockupWithTraversability)
     ->Args({0, 0})
     ->Args({0, 1})
     ->Unit(benchmark::kMillisecond);
+
+// Issue 34's bound, one laser scan at a time: the mock-up mapped up to its last 20 laser scans
+// with the layers up to date, then each of those scans inserted and the layers brought up to date
+// after it, the two timed apart (CPU time of the thread) in the same run. Counters: the insertion
+// and the update per scan [ms] and their ratio (issue 34's bound: update / insertion <= 0.2).
+static void BM_LaserScanUpdateOverInsertion(benchmark::State& state) {
+    mrpt::maps::CSimpleMap simplemap;
+    if (!loadMockup(simplemap)) {
+        state.SkipWithError("rawlogs/mockup.simplemap not found");
+        return;
+    }
+    // The thread's CPU time: the machine's other load does not enter the ratio.
+    const auto cpu_ms = [] {
+        timespec t;
+        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+        return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+    };
+    constexpr size_t kTimedScans = 20;
+    double insert_ms = 0, update_ms = 0;
+    size_t timed = 0;
+    for (auto _ : state) {
+        state.PauseTiming();
+        // The observations live in `simplemap`.
+        std::vector<std::pair<const mrpt::obs::CObservation*, mrpt::poses::CPose3DPDFGaussian>> all;
+        mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
+            simplemap,
+            [&](const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3DPDFGaussian& pdf) {
+                if (isLaser(obs)) all.emplace_back(&obs, pdf);
+            });
+        const size_t first = all.size() > kTimedScans ? all.size() - kTimedScans : 0;
+        mrpt::maps::CMultiBinElevationMap map = mockupMap();
+        for (size_t i = 0; i < first; i++) map.insertObservation(*all[i].first, all[i].second);
+        map.updateTraversability();
+        state.ResumeTiming();
+        for (size_t i = first; i < all.size(); i++) {
+            const double t0 = cpu_ms();
+            map.insertObservation(*all[i].first, all[i].second);
+            const double t1 = cpu_ms();
+            map.updateTraversability();
+            const double t2 = cpu_ms();
+            insert_ms += t1 - t0, update_ms += t2 - t1, timed++;
+        }
+    }
+    state.counters["insert_ms_per_scan"] = insert_ms / double(timed);
+    state.counters["update_ms_per_scan"] = update_ms / double(timed);
+    state.counters["update_over_insert"] = update_ms / insert_ms;
+}
+BENCHMARK(BM_LaserScanUpdateOverInsertion)->Iterations(3)->Unit(benchmark::kMillisecond);
 
 // The layers of the whole mock-up map computed once from nothing (what a batch run's export
 // costs).

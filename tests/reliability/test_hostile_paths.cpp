@@ -101,6 +101,7 @@ std::vector<std::string> outputNames() {
             "elevation_sigma_supersampled.asc",
             "report.json",
             "traversability.json",
+            "traversability_cells.csv",
             "profile.csv",
             "eval_truth.asc",
             "eval_raw_all.asc",

@@ -281,6 +281,39 @@ TEST(TraversabilityLayers, ZeroDrawsThresholdTheFeatures) {
     EXPECT_EQ(t.slopeSigma_deg[t.lattice.index(5, 5)], 0.0f);
 }
 
+// The step's calibration reads the map's roughness and slope too: on a 20 deg plane with 1 cm
+// waves, the calibrated step is bias + gain step + step_roughness_gain roughness + step_slope_gain
+// slope of the uncalibrated features, and decides the class (here the roughness term alone takes
+// it across 0.08 m).
+TEST(TraversabilityLayers, TheStepCalibrationReadsRoughnessAndSlope) {
+    TraversabilityOptions o;
+    o.monte_carlo_draws = 0;
+    const auto surface = [](double x, double y) {
+        return std::tan(20 * kDeg) * x + 0.01 * std::sin(2 * kPi * x / 0.03) * std::cos(y / 0.02);
+    };
+    const SurfaceSamples samples = samplesOf(surface, 11, 11, 0.02, 0.002);
+    TraversabilityLayers raw, cal;
+    computeLayers(samples, o, raw);
+    o.step = {0.02, 0.1, 0};
+    o.step_roughness_gain = 10;
+    o.step_slope_gain = 0.0005;
+    computeLayers(samples, o, cal);
+    const size_t k = raw.lattice.index(5, 5);
+    const double expected =
+        0.02 + 0.1 * raw.step_m[k] + 10 * raw.roughness_m[k] + 0.0005 * raw.slope_deg[k];
+    EXPECT_NEAR(cal.step_m[k], expected, 1e-6);
+    EXPECT_EQ(cal.slope_deg[k], raw.slope_deg[k]);
+    EXPECT_EQ(cal.roughness_m[k], raw.roughness_m[k]);
+    // The roughness term takes the step across the limit, and the class with it.
+    ASSERT_GT(expected, o.max_step_m);
+    EXPECT_EQ(cal.untraversable[k], 1.f);
+    o.step_roughness_gain = 0;
+    computeLayers(samples, o, cal);
+    EXPECT_NEAR(cal.step_m[k], expected - 10 * raw.roughness_m[k], 1e-6);
+    ASSERT_LT(cal.step_m[k], o.max_step_m);
+    EXPECT_EQ(cal.untraversable[k], 0.f);
+}
+
 TEST(TraversabilityLayers, DilateMaskGrowsASquare) {
     std::vector<uint8_t> m(7 * 5, 0);
     m[2 * 7 + 3] = 1;

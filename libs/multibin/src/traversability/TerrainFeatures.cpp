@@ -276,20 +276,26 @@ struct Moments {
     }
 };
 
+/** The truth's features as the calibration predicts them from the map's (without model error). */
+DiscFeatures calibrated(const DiscFeatures& f, const TraversabilityOptions& o) {
+    return {o.step.apply(f.step_m) + o.step_roughness_gain * f.roughness_m +
+                o.step_slope_gain * f.slope_deg,
+            o.slope.apply(f.slope_deg), o.roughness.apply(f.roughness_m)};
+}
+
 void computeCell(const std::vector<Known>& known, const std::vector<float>& z, int groups,
                  const TraversabilityOptions& o, TraversabilityLayers& out, size_t k) {
     Realisation mean;
     for (const Known& p : known) mean.add(p, p.h_m);
     DiscFeatures f;
     if (!mean.disc.features(f)) return;  // stays unknown: no plane
-    const DiscFeatures calibrated{o.step.apply(f.step_m), o.slope.apply(f.slope_deg),
-                                  o.roughness.apply(f.roughness_m)};
-    out.step_m[k] = float(calibrated.step_m);
-    out.slope_deg[k] = float(calibrated.slope_deg);
-    out.roughness_m[k] = float(calibrated.roughness_m);
+    const DiscFeatures fc = calibrated(f, o);
+    out.step_m[k] = float(fc.step_m);
+    out.slope_deg[k] = float(fc.slope_deg);
+    out.roughness_m[k] = float(fc.roughness_m);
     const int draws = o.monte_carlo_draws;
     if (draws == 0) {
-        out.untraversable[k] = mean.untraversable(calibrated, o) ? 1.f : 0.f;
+        out.untraversable[k] = mean.untraversable(fc, o) ? 1.f : 0.f;
         out.foothold[k] = mean.goodFoothold(o) ? 1.f : 0.f;
         out.stepSigma_m[k] = out.slopeSigma_deg[k] = out.roughnessSigma_m[k] = 0.f;
         return;
@@ -320,12 +326,14 @@ void computeCell(const std::vector<Known>& known, const std::vector<float>& z, i
     const float* model = z.data() + size_t(draws) * stride;
     int bad = 0;
     for (size_t n = 0; n < drawn.size(); n++) {
-        const DiscFeatures& d = drawn[n];
         const float* zm = model + 3 * n;
-        const DiscFeatures c{
-            o.step.apply(d.step_m + shift.step_m) + o.step.model_sigma * zm[0],
-            o.slope.apply(d.slope_deg + shift.slope_deg) + o.slope.model_sigma * zm[1],
-            o.roughness.apply(d.roughness_m + shift.roughness_m) + o.roughness.model_sigma * zm[2]};
+        DiscFeatures c =
+            calibrated({drawn[n].step_m + shift.step_m, drawn[n].slope_deg + shift.slope_deg,
+                        drawn[n].roughness_m + shift.roughness_m},
+                       o);
+        c.step_m += o.step.model_sigma * zm[0];
+        c.slope_deg += o.slope.model_sigma * zm[1];
+        c.roughness_m += o.roughness.model_sigma * zm[2];
         bad += mean.untraversable(c, o);
     }
     out.untraversable[k] = float(bad) / float(valid);

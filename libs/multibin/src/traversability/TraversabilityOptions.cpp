@@ -34,8 +34,17 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("roughness_bias_m", o.roughness.bias, finite("m"));
     visit("roughness_gain", o.roughness.gain, positive());
     visit("roughness_model_sigma_m", o.roughness.model_sigma, atLeast(0, "m"));
+    visit("step_roughness_gain", o.step_roughness_gain, finite());
+    visit("step_slope_gain", o.step_slope_gain, finite("m"));
 }
 }  // namespace
+
+TraversabilityOptions TraversabilityOptions::uncalibrated() const {
+    TraversabilityOptions o = *this;
+    o.step = o.slope = o.roughness = {};
+    o.step_roughness_gain = o.step_slope_gain = 0;
+    return o;
+}
 
 double TraversabilityOptions::reach_m() const {
     return std::max(radius_m, foot_radius_m + foothold_clearance_m);

@@ -61,6 +61,16 @@ struct TraversabilityOptions {
     FeatureCalibration step;       //!< [step_bias_m, step_gain, step_model_sigma_m]
     FeatureCalibration slope;      //!< [slope_bias_deg, slope_gain, slope_model_sigma_deg]
     FeatureCalibration roughness;  //!< [roughness_bias_m, roughness_gain, roughness_model_sigma_m]
+    /** [step_roughness_gain] the truth's step also grows with the map's roughness by this much
+     * (relief finer than the lattice, gaps between stones, shows in the roughness before the
+     * step) [m/m]; 0 by default. */
+    double step_roughness_gain = 0;
+    /** [step_slope_gain] and with the map's slope by this much (a tilted disc's range, which
+     * outliers do not make) [m/deg]; 0 by default. */
+    double step_slope_gain = 0;
+
+    /** These options with the identity calibration (the map's features are the truth's). */
+    TraversabilityOptions uncalibrated() const;
 
     /** The radius of the largest disc any layer reads [m]. */
     double reach_m() const;
