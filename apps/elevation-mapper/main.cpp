@@ -302,7 +302,8 @@ int run(const Arguments& args, std::string& stage) {
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
     stage = "mapping " + inputName;
-    MrptWarnings mrptWarnings;  // MRPT's own lines while reading: once each, after the bar
+    const auto map0 = Clock::now();  // reading = the mapping loop's time outside the insertion
+    MrptWarnings mrptWarnings;       // MRPT's own lines while reading: once each, after the bar
     ProgressBar bar("mapping");
     if (!args.rawlog.empty()) {
         RawlogSource::forEachInRawlog(
@@ -333,6 +334,7 @@ int run(const Arguments& args, std::string& stage) {
             });
     }
     bar.finish("done");
+    const double read_s = std::chrono::duration<double>(Clock::now() - map0).count() - insert_s;
     for (const std::string& w : mrptWarnings.summary())
         std::cerr << "elevation-mapper: warning: " << w << "\n";
     std::cout << tally.report();
@@ -359,9 +361,15 @@ int run(const Arguments& args, std::string& stage) {
     const auto fill0 = Clock::now();
     ProgressBar::runWithProgress("filling", [&] { elevation->dem_update_map(); });  // once
     const double fill_s = std::chrono::duration<double>(Clock::now() - fill0).count();
+    const auto outputs0 = Clock::now();  // the layers and the files (the evaluation apart)
+    double evaluation_s = 0;
     std::string table;
     // Scoring (the MRF solve draws its own line) and the layers of a large window take seconds.
-    if (evaluation) table = evaluation->finish(folder, insert_s, fill_s);
+    if (evaluation) {
+        const auto e0 = Clock::now();
+        table = evaluation->finish(folder, insert_s, fill_s);
+        evaluation_s = std::chrono::duration<double>(Clock::now() - e0).count();
+    }
     MapLayers layers;
     ProgressBar::runWithProgress("layers", [&] { layers = MapLayers::of(*elevation); });
     // Everything that can fail on the request is computed before the first output is written.
@@ -377,6 +385,8 @@ int run(const Arguments& args, std::string& stage) {
         written.insert(written.end(), std::begin(SupersampledLayers::kFiles),
                        std::end(SupersampledLayers::kFiles));
     }
+    const double outputs_s =
+        std::chrono::duration<double>(Clock::now() - outputs0).count() - evaluation_s;
 
     const auto& fs_ = elevation->lastFill().stats;
     std::cout << elevation->asString() << "\n"
@@ -389,7 +399,10 @@ int run(const Arguments& args, std::string& stage) {
               << "cells filled: " << fs_.median << " by weighted median, " << fs_.gaussian
               << " by Gaussian surface (" << fs_.supportAreas << " support areas); " << fs_.unfilled
               << " left unknown\n"
-              << "insertion time: " << insert_s << " s; fill time: " << fill_s << " s\n"
+              << "reading time: " << read_s << " s; insertion time: " << insert_s
+              << " s; fill time: " << fill_s << " s; outputs time: " << outputs_s << " s"
+              << (evaluation ? "; evaluation time: " + std::to_string(evaluation_s) + " s" : "")
+              << "\n"
               << "rasters: " << layers.cells.nx << " x " << layers.cells.ny
               << " cells (the known cells plus " << MapLayers::kMargin_cells << ")\n"
               << "wrote " << fs::absolute(folder.dir()).string() << "/{";

@@ -10,6 +10,7 @@
 #include "MapLock.h"
 #include "TraversabilityCache.h"
 #include "multibin/fill/HeightRaster.h"
+#include "multibin/fill/SparseFill.h"
 #include "multibin/geometry/Lattice.h"
 #include "multibin/map/BinGrid.h"
 #include "multibin/sensors/SensorDispatch.h"
@@ -33,7 +34,11 @@ struct CMultiBinElevationMap::Impl {
     mrpt::Clock::time_point lastRobotPoseTime;
     /** Previous laser scans (eq 14), stereo covariance table, sensor statistics. */
     multibin::sensors::SensorModelState sensorState;
-    /** The last gap filling, over fillWindow of grid (absolute cell indices). */
+    /** The last gap filling's filled cells, over fillWindow of grid (absolute cell indices): what
+     * the queries and rasters read. */
+    multibin::fill::FilledCells filled;
+    /** The same as one raster over fillWindow (lastFill(), the traversability layers); empty
+     * beyond kMaxWholeWindowCells. */
     multibin::fill::FillResult fill;
     multibin::CellWindow fillWindow;
     bool fillStale = true;
