@@ -215,11 +215,11 @@ FilledCells fillSparse(const SparseHeights& in, const FillOptions& o) {
     out.lattice = in.lattice;
     const CellWindow& w = in.lattice.window;
     size_t measured = 0;
-    constexpr size_t kSide = TiledCells<MeasuredCell>::kSide;
+    constexpr int kSide = TiledCells<MeasuredCell>::kSide;
     in.cells.forEachTile([&](int tx, int ty, const TiledCells<MeasuredCell>::Tile& t) {
         for (size_t k = 0; k < t.size(); k++)
-            measured += in.isMeasured(tx * TiledCells<MeasuredCell>::kSide + int(k % kSide),
-                                      ty * TiledCells<MeasuredCell>::kSide + int(k / kSide));
+            measured += measuredCell(t[k]) &&
+                        w.contains(tx * kSide + int(k) % kSide, ty * kSide + int(k) / kSide);
     });
     size_t filled[5] = {};  // per HeightSource
     if (o.enabled)
