@@ -196,9 +196,24 @@ HeightRaster SparseHeights::toRaster(const CellWindow& w) const {
 }
 
 FillResult FilledCells::toResult(const SparseHeights& in) const {
-    std::vector<char> measured;
-    FillResult out = detail::initResult(in.toRaster(lattice.window), measured);
+    // In one pass over the window (no HeightRaster of it): measured cells from in's tiles, then
+    // the filled ones, as detail::initResult and fillGaps() set them.
+    FillResult out;
+    out.lattice = lattice;
+    out.height_m.assign(lattice.cellCount(), detail::kNaN);
+    out.sigma_m.assign(lattice.cellCount(), detail::kNaN);
+    out.source.assign(lattice.cellCount(), HeightSource::Unknown);
     const CellWindow& w = lattice.window;
+    constexpr int kSide = TiledCells<MeasuredCell>::kSide;
+    in.cells.forEachTile([&](int tx, int ty, const TiledCells<MeasuredCell>::Tile& t) {
+        for (size_t k = 0; k < t.size(); k++) {
+            const int ix = tx * kSide + int(k) % kSide, iy = ty * kSide + int(k) / kSide;
+            if (!measuredCell(t[k]) || !w.contains(ix, iy)) continue;
+            const size_t q = out.index(ix - w.ix0, iy - w.iy0);
+            out.height_m[q] = t[k].height_m, out.sigma_m[q] = t[k].sigma_m;
+            out.source[q] = HeightSource::Measured;
+        }
+    });
     forEachFilled([&](int ix, int iy, const FilledCell& c) {
         const size_t k = out.index(ix - w.ix0, iy - w.iy0);
         out.height_m[k] = c.height_m, out.sigma_m[k] = c.sigma_m, out.source[k] = c.source;
