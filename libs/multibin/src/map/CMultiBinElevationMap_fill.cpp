@@ -53,8 +53,9 @@ multibin::fill::SparseHeights CMultiBinElevationMap::fillInput() const {
                 double h, s;
                 // Without the pose part the cells share (CellSurface::poseVariance_m2): it moves
                 // a gap's neighbours together, so it does not weigh one against another.
-                if (w.contains(ix, iy) && surfaceQuery(false, o.x() + grid.cellCenter_m(ix),
-                                                       o.y() + grid.cellCenter_m(iy), h, s, false))
+                if (w.contains(ix, iy) && m_impl->holdsBins(ix, iy, isDualGrid()) &&
+                    surfaceQuery(false, o.x() + grid.cellCenter_m(ix),
+                                 o.y() + grid.cellCenter_m(iy), h, s, false))
                     in.setMeasured(ix, iy, float(h), float(s));
             }
     return in;

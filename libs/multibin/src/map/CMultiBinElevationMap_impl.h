@@ -49,6 +49,17 @@ struct CMultiBinElevationMap::Impl {
     std::shared_ptr<multibin::TileStoreFile> tileFile;
     size_t peakResidentBytes = 0;
     bool budgetWarned = false;
+    /** Whether cell (ix, iy) of `grid` holds a bin, or with the dual grid the local grid's cell at
+     * its centre does: a cell without is unknown, skipped without a surface query. */
+    bool holdsBins(int ix, int iy, bool dual) const {
+        bool any = false;
+        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
+        if (!any && dual)
+            local.forEachBin(local.cellIndex(grid.cellCenter_m(ix)),
+                             local.cellIndex(grid.cellCenter_m(iy)),
+                             [&](const multibin::Bin&) { any = true; });
+        return any;
+    }
     /** The traversability layers (CMultiBinElevationMap_traversability.cpp). */
     multibin::TraversabilityCache traversability;
 };

@@ -392,13 +392,8 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     const multibin::CellWindow& fw = m_impl->fillWindow;
     const bool withFill = insertionOptions.dem_return_filled;
     const auto mayBeKnown = [&](int ix, int iy) {
-        bool any = false;
-        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
-        if (!any && isDualGrid())
-            m_impl->local.forEachBin(m_impl->local.cellIndex(grid.cellCenter_m(ix)),
-                                     m_impl->local.cellIndex(grid.cellCenter_m(iy)),
-                                     [&](const multibin::Bin&) { any = true; });
-        return any || (withFill && fw.contains(ix, iy) && f.find(ix, iy));
+        return m_impl->holdsBins(ix, iy, isDualGrid()) ||
+               (withFill && fw.contains(ix, iy) && f.find(ix, iy));
     };
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
