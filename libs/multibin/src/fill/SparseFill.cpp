@@ -23,7 +23,8 @@ bool measuredCell(const MeasuredCell& c) {
            c.sigma_m > 0;
 }
 
-/** Reads cells of a TiledCells, keeping the last tile found: a flood stays in one tile mostly. */
+/** Reads cells of a TiledCells, keeping the last tile found: a flood stays in one tile mostly.
+ * The pointer kept stays valid: only this cursor adds tiles, and only when it moves to one. */
 template <typename Cells, typename TilePtr>
 class Cursor {
 public:
@@ -36,7 +37,7 @@ public:
             if constexpr (std::is_const_v<Cells>)
                 m_tile = m_c.findTile(tx, ty);
             else
-                m_tile = &m_c.tile(tx, ty);
+                m_tile = m_c.tile(tx, ty);
         }
         return m_tile;
     }
@@ -59,14 +60,14 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
                                FillResult::Stats& s) {
     const CellWindow& w = in.lattice.window;
     TiledCells<int> label(kUnvisited);
-    Cursor<const TiledCells<MeasuredCell>, const TiledCells<MeasuredCell>::Tile*> data(in.cells);
-    Cursor<TiledCells<int>, TiledCells<int>::Tile*> labels(label);
+    Cursor<const TiledCells<MeasuredCell>, const MeasuredCell*> data(in.cells);
+    Cursor<TiledCells<int>, int*> labels(label);
     auto measured = [&](int ix, int iy) {
         const auto* t = data.tileOf(ix, iy);
-        return t && measuredCell((*t)[TiledCells<int>::inTile(ix, iy)]);
+        return t && measuredCell(t[TiledCells<int>::inTile(ix, iy)]);
     };
     auto labelOf = [&](int ix, int iy) -> int& {
-        return (*labels.tileOf(ix, iy))[TiledCells<int>::inTile(ix, iy)];
+        return labels.tileOf(ix, iy)[TiledCells<int>::inTile(ix, iy)];
     };
     std::vector<GapCells> gaps;
     GapCells members;
@@ -100,8 +101,8 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
         gaps.push_back(members);
     };
     // Every gap touches a measured cell (the window is connected): seed from their neighbours.
-    in.cells.forEachTile([&](int tx, int ty, const TiledCells<MeasuredCell>::Tile& t) {
-        for (size_t k = 0; k < t.size(); k++) {
+    in.cells.forEachTile([&](int tx, int ty, const MeasuredCell* t) {
+        for (size_t k = 0; k < TiledCells<MeasuredCell>::kTileCells; k++) {
             if (!measuredCell(t[k])) continue;
             const int x = tx * TiledCells<int>::kSide + int(k % TiledCells<int>::kSide);
             const int y = ty * TiledCells<int>::kSide + int(k / TiledCells<int>::kSide);
@@ -185,7 +186,7 @@ HeightRaster SparseHeights::toRaster(const CellWindow& w) const {
             const int ya = std::max(ty << k, w.iy0), yb = std::min((ty + 1) << k, w.iy0 + w.ny);
             for (int iy = ya; iy < yb; iy++)
                 for (int ix = xa; ix < xb; ix++) {
-                    const MeasuredCell& c = (*t)[TiledCells<MeasuredCell>::inTile(ix, iy)];
+                    const MeasuredCell& c = t[TiledCells<MeasuredCell>::inTile(ix, iy)];
                     if (!lattice.window.contains(ix, iy)) continue;
                     const size_t q = r.index(ix - w.ix0, iy - w.iy0);
                     r.height_m[q] = c.height_m, r.sigma_m[q] = c.sigma_m;
@@ -205,8 +206,8 @@ FillResult FilledCells::toResult(const SparseHeights& in) const {
     out.source.assign(lattice.cellCount(), HeightSource::Unknown);
     const CellWindow& w = lattice.window;
     constexpr int kSide = TiledCells<MeasuredCell>::kSide;
-    in.cells.forEachTile([&](int tx, int ty, const TiledCells<MeasuredCell>::Tile& t) {
-        for (size_t k = 0; k < t.size(); k++) {
+    in.cells.forEachTile([&](int tx, int ty, const MeasuredCell* t) {
+        for (size_t k = 0; k < TiledCells<MeasuredCell>::kTileCells; k++) {
             const int ix = tx * kSide + int(k) % kSide, iy = ty * kSide + int(k) / kSide;
             if (!measuredCell(t[k]) || !w.contains(ix, iy)) continue;
             const size_t q = out.index(ix - w.ix0, iy - w.iy0);
@@ -231,8 +232,8 @@ FilledCells fillSparse(const SparseHeights& in, const FillOptions& o) {
     const CellWindow& w = in.lattice.window;
     size_t measured = 0;
     constexpr int kSide = TiledCells<MeasuredCell>::kSide;
-    in.cells.forEachTile([&](int tx, int ty, const TiledCells<MeasuredCell>::Tile& t) {
-        for (size_t k = 0; k < t.size(); k++)
+    in.cells.forEachTile([&](int tx, int ty, const MeasuredCell* t) {
+        for (size_t k = 0; k < TiledCells<MeasuredCell>::kTileCells; k++)
             measured += measuredCell(t[k]) &&
                         w.contains(tx * kSide + int(k) % kSide, ty * kSide + int(k) / kSide);
     });

@@ -56,8 +56,8 @@ struct FilledCells {
     /** Calls f(ix, iy, const FilledCell&) for every filled cell, tile by tile. */
     template <typename F>
     void forEachFilled(F&& f) const {
-        cells.forEachTile([&](int tx, int ty, const TiledCells<FilledCell>::Tile& t) {
-            for (size_t k = 0; k < t.size(); k++)
+        cells.forEachTile([&](int tx, int ty, const FilledCell* t) {
+            for (size_t k = 0; k < TiledCells<FilledCell>::kTileCells; k++)
                 if (t[k].source != HeightSource::Unknown)
                     f(tx * TiledCells<FilledCell>::kSide + int(k % TiledCells<FilledCell>::kSide),
                       ty * TiledCells<FilledCell>::kSide + int(k / TiledCells<FilledCell>::kSide),
