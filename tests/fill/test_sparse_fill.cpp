@@ -19,6 +19,8 @@
 #include "SurfaceTexture.h"
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/SparseFill.h"
+#include "multibin/map/BinGrid.h"
+#include "multibin/map/CellSurface.h"
 
 using multibin::CellWindow;
 using multibin::HeightSource;
@@ -60,13 +62,15 @@ size_t expectSameFill(const SparseHeights& in, const FillOptions& o, const std::
     return filled;
 }
 
-/** A shipped scenario's map (its ini, its simplemap). */
-void mapScenario(const std::string& scenario, mrpt::maps::CMultiBinElevationMap& map) {
+/** A shipped scenario's map (its ini, its simplemap), with the dual grid if asked. */
+void mapScenario(const std::string& scenario, mrpt::maps::CMultiBinElevationMap& map,
+                 bool dualGrid = false) {
     const std::string dir = MULTIBIN_SOURCE_DIR;
     mrpt::config::CConfigFile ini(dir + "/ini/" + scenario + ".ini");
     const std::string prefix = "MappingApplication_multiBinElevationMap_00_";
     mrpt::maps::CMultiBinElevationMap::TCreationOptions creation;
     creation.loadFromConfigFile(ini, prefix + "creationOpts");
+    creation.dual_grid = dualGrid;
     map.setCreationOptions(creation);
     map.insertionOptions.loadFromConfigFile(ini, prefix + "insertOpts");
     mrpt::maps::CSimpleMap sm;
@@ -129,6 +133,35 @@ TEST(SparseFill, SameAsTheWholeWindowOnTheShippedMockupAndWalkMaps) {
         const FillResult dense =
             multibin::fill::fillGaps(in.toRaster(in.lattice.window), map.insertionOptions.fill);
         ASSERT_EQ(map.lastFill().source, dense.source) << scenario;
+    }
+}
+
+TEST(SparseFill, FillInputHoldsEveryMeasuredCellOfTheWindowWithOneGridOrTwo) {
+    // Every cell of the window queried as the whole-window fill did (the cell surface without
+    // the shared pose part): the tiled input holds exactly the measured ones, the same bits.
+    for (const bool dual : {false, true}) {
+        mrpt::maps::CMultiBinElevationMap map;
+        mapScenario("mockup", map, dual);
+        const SparseHeights in = map.fillInput();
+        const multibin::BinGrid& g = map.grid();
+        const CellWindow& w = g.window();
+        ASSERT_EQ(in.lattice.window, w);
+        size_t measured = 0, differ = 0;
+        for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
+            for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
+                multibin::CellSurface c;
+                const bool known = multibin::surfaceAt(
+                    g, dual ? &map.localGrid() : nullptr, g.cellCenter_m(ix), g.cellCenter_m(iy),
+                    map.binUpdateParams(), map.insertionOptions.relief_sigma, c);
+                measured += known;
+                const auto& m = in.cells.get(ix, iy);
+                differ += known != in.isMeasured(ix, iy) ||
+                          (known && (!sameBits(m.height_m, float(c.height_m)) ||
+                                     !sameBits(m.sigma_m, float(std::sqrt(c.variance_m2)))));
+            }
+        EXPECT_GT(measured, 1000u) << dual;  // the dual grid's global cells are 5 cm
+        EXPECT_EQ(differ, 0u) << "dual grid " << dual;
+        expectSameFill(in, map.insertionOptions.fill, dual ? "mockup, dual grid" : "mockup");
     }
 }
 
