@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -218,6 +219,28 @@ void checkRegularFile(const std::string& what, const std::string& path) {
 }
 
 /** Maps and writes; `stage` says what is being done, for errors that do not say it. */
+/** Wall and process CPU time spent in one stage of the run [s]: on a shared machine the CPU
+ * time is what the stage costs, the wall time what one waited for it. */
+struct StageTime {
+    double wall_s = 0, cpu_s = 0;
+    struct Start {
+        std::chrono::steady_clock::time_point wall = std::chrono::steady_clock::now();
+        std::clock_t cpu = std::clock();
+    };
+    /** Adds the time since `t0`. */
+    void addSince(const Start& t0) {
+        wall_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0.wall).count();
+        cpu_s += double(std::clock() - t0.cpu) / CLOCKS_PER_SEC;
+    }
+    /** Takes another stage's time out of this one (it ran inside this one's interval). */
+    void subtract(const StageTime& inner) { wall_s -= inner.wall_s, cpu_s -= inner.cpu_s; }
+    std::string text() const {
+        std::ostringstream os;
+        os << wall_s << " s (CPU " << cpu_s << " s)";
+        return os.str();
+    }
+};
+
 int run(const Arguments& args, std::string& stage) {
     for (const auto& [what, path] : {std::pair{"config", args.config},
                                      {"rawlog", args.rawlog},
@@ -283,8 +306,7 @@ int run(const Arguments& args, std::string& stage) {
         evaluation = std::make_unique<EvaluationRun>(eo, *elevation);
     }
 
-    using Clock = std::chrono::steady_clock;
-    double insert_s = 0;  // the multi-bin map's own insertion time
+    StageTime insertion;  // the multi-bin map's own insertion
     ObservationTally tally;
     RunFacts facts;
     PoseCounts poseCounts;  // a rawlog's: how its observations got their pose
@@ -293,16 +315,17 @@ int run(const Arguments& args, std::string& stage) {
                            const mrpt::poses::CPose3DPDFGaussian& pose, bool poseHasCov) {
         tally.before(*elevation);
         reach.add(pose.mean);
-        const auto t0 = Clock::now();
+        const StageTime::Start t0;
         const bool inserted = poseHasCov ? elevation->insertObservation(obs, pose)
                                          : elevation->insertObservation(obs, pose.mean);
-        insert_s += std::chrono::duration<double>(Clock::now() - t0).count();
+        insertion.addSince(t0);
         tally.after(obs, inserted, *elevation);
         facts.observationsWithPoseCovariance += inserted && poseHasCov;
         if (evaluation) evaluation->observe(obs, pose, poseHasCov);
     };
     stage = "mapping " + inputName;
-    MrptWarnings mrptWarnings;  // MRPT's own lines while reading: once each, after the bar
+    const StageTime::Start map0;  // reading: the mapping loop's time outside the insertion
+    MrptWarnings mrptWarnings;    // MRPT's own lines while reading: once each, after the bar
     ProgressBar bar("mapping");
     if (!args.rawlog.empty()) {
         RawlogSource::forEachInRawlog(
@@ -333,6 +356,9 @@ int run(const Arguments& args, std::string& stage) {
             });
     }
     bar.finish("done");
+    StageTime reading;
+    reading.addSince(map0);
+    reading.subtract(insertion);
     for (const std::string& w : mrptWarnings.summary())
         std::cerr << "elevation-mapper: warning: " << w << "\n";
     std::cout << tally.report();
@@ -356,12 +382,19 @@ int run(const Arguments& args, std::string& stage) {
 
     stage = "filling the map of " + inputName;
     elevation->flushLocalToGlobal();  // dual grid: the global grid holds the whole run
-    const auto fill0 = Clock::now();
+    StageTime filling;
+    const StageTime::Start fill0;
     ProgressBar::runWithProgress("filling", [&] { elevation->dem_update_map(); });  // once
-    const double fill_s = std::chrono::duration<double>(Clock::now() - fill0).count();
+    filling.addSince(fill0);
+    const StageTime::Start outputs0;  // the layers and the files (the evaluation apart)
+    StageTime outputs, scoring;
     std::string table;
     // Scoring (the MRF solve draws its own line) and the layers of a large window take seconds.
-    if (evaluation) table = evaluation->finish(folder, insert_s, fill_s);
+    if (evaluation) {
+        const StageTime::Start e0;
+        table = evaluation->finish(folder, insertion.wall_s, filling.wall_s);
+        scoring.addSince(e0);
+    }
     MapLayers layers;
     ProgressBar::runWithProgress("layers", [&] { layers = MapLayers::of(*elevation); });
     // Everything that can fail on the request is computed before the first output is written.
@@ -377,6 +410,8 @@ int run(const Arguments& args, std::string& stage) {
         written.insert(written.end(), std::begin(SupersampledLayers::kFiles),
                        std::end(SupersampledLayers::kFiles));
     }
+    outputs.addSince(outputs0);
+    outputs.subtract(scoring);
 
     const auto& fs_ = elevation->lastFill().stats;
     std::cout << elevation->asString() << "\n"
@@ -389,7 +424,9 @@ int run(const Arguments& args, std::string& stage) {
               << "cells filled: " << fs_.median << " by weighted median, " << fs_.gaussian
               << " by Gaussian surface (" << fs_.supportAreas << " support areas); " << fs_.unfilled
               << " left unknown\n"
-              << "insertion time: " << insert_s << " s; fill time: " << fill_s << " s\n"
+              << "reading time: " << reading.text() << "; insertion time: " << insertion.text()
+              << "; fill time: " << filling.text() << "; outputs time: " << outputs.text()
+              << (evaluation ? "; evaluation time: " + scoring.text() : "") << "\n"
               << "rasters: " << layers.cells.nx << " x " << layers.cells.ny
               << " cells (the known cells plus " << MapLayers::kMargin_cells << ")\n"
               << "wrote " << fs::absolute(folder.dir()).string() << "/{";

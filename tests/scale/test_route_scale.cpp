@@ -1,14 +1,15 @@
 /* Part of the multibin elevation-mapping library's tests.
  * Routes of 50, 200 and 1000 m (RouteScene.h, 5 cm cells, defaults otherwise): every point the
- * sensor model keeps is fused, none "outside map"; the map's memory grows with the ground seen,
- * not with the route's bounding box. Timing and peak process memory: route-scale
- * (doc/route-scale.md). */
+ * sensor model keeps is fused, none "outside map"; the map's memory and the gap filling's work
+ * grow with the ground seen, not with the route's bounding box. Timing and peak process memory:
+ * route-scale (doc/route-scale.md). */
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include "multibin/map/BinGrid.h"
 
 #include "RouteScene.h"
 #include "multibin/fill/GapFilling.h"
+#include "multibin/fill/SparseFill.h"
 #include "multibin/traversability/TerrainFeatures.h"
 
 namespace {
@@ -16,6 +17,7 @@ struct RouteResult {
     size_t points = 0, fused = 0, outsideMap = 0, tooUncertain = 0, tiles = 0, bytes = 0;
     size_t windowCells = 0;
     bool filled = false;              //!< dem_update_map() filled some cell
+    size_t fillVisited = 0;           //!< cells the fill's gap search and per-gap rasters read
     std::string traversabilityError;  //!< what traversabilityLayers() threw, if it did
 };
 
@@ -42,7 +44,9 @@ RouteResult mapRoute(double length_m) {
     r.windowCells = map.grid().window().cellCount();
     map.insertionOptions.fill.enabled = true;
     map.dem_update_map();
-    r.filled = !map.lastFill().source.empty();
+    const multibin::fill::FillResult::Stats& fs = map.lastFilledCells().stats;
+    r.filled = fs.median + fs.gaussian > 0;
+    r.fillVisited = fs.cellsVisited;
     try {
         map.traversabilityLayers();
     } catch (const std::exception& e) {
@@ -69,11 +73,15 @@ TEST(RouteScale, EveryPointIsFusedAndMemoryFollowsTheGroundSeen) {
     EXPECT_LT(tiles, 5.5);
     EXPECT_LT(bytes, 6.0);
     EXPECT_LT(double(r1000.bytes), 1.5e9);
-    // Filling and the traversability layers are one raster over the window: done up to 8192 x
-    // 8192 cells, beyond it (the 1000 m route) filling is skipped and the layers refuse, by name.
+    // Filling is tiled: done on every route, its work 5 times the 200 m route's, as the ground
+    // seen. The traversability layers are one raster over the window: done up to 8192 x 8192
+    // cells, beyond it (the 1000 m route) they refuse, by name.
     EXPECT_TRUE(r200.filled);
+    EXPECT_TRUE(r1000.filled);
+    const double visited = double(r1000.fillVisited) / double(r200.fillVisited);
+    EXPECT_GT(visited, 4.0) << r200.fillVisited << " " << r1000.fillVisited;
+    EXPECT_LT(visited, 6.0) << r200.fillVisited << " " << r1000.fillVisited;
     EXPECT_TRUE(r200.traversabilityError.empty()) << r200.traversabilityError;
-    EXPECT_FALSE(r1000.filled);
     EXPECT_NE(r1000.traversabilityError.find("14"), std::string::npos) << r1000.traversabilityError;
     // The 50 m route: a quarter of the 200 m one, give or take the ends.
     EXPECT_LT(double(r200.tiles) / double(r50.tiles), 4.6);

@@ -8,6 +8,7 @@
 #include "multibin/fill/ModelSelection.h"
 #include "multibin/fill/ShadowOccluders.h"
 #include "multibin/fill/detail/MedianFiller.h"
+#include "multibin/fill/detail/OneGap.h"
 #include "multibin/fill/detail/ResultSetup.h"
 
 namespace multibin::fill {
@@ -57,11 +58,39 @@ bool fillShadow(const HeightRaster& masked, const FillOptions& o, const std::vec
 
 }  // namespace
 
+namespace detail {
+
+void fillGap(const HeightRaster& r, const FillOptions& o, const Gap& gap,
+             const std::vector<char>& measured, MedianFiller& median, FillResult& out) {
+    if (gap.cells.empty()) return;  // too large: stays Unknown
+    if (gap.medianReach) {
+        // The median of a small gap uses measured cells only.
+        for (int k : gap.cells) median.fillCell(k % r.nx(), k / r.nx(), out, measured);
+        return;
+    }
+    if (o.gaussianEnabled && o.shadowOccluders) {
+        // A shadow behind a step: the step's top is not data of the hidden surface.
+        const ShadowOccluders occ = findShadowOccluders(r, gap.cells, o);
+        if (!occ.cells.empty() && fillShadow(withoutOccluders(r, occ), o, gap.cells, out)) {
+            out.stats.shadowGaps++;
+            out.stats.shadowCells += int(gap.cells.size());
+            return;
+        }
+    }
+    if (o.gaussianEnabled && fillWithGaussianSurface(r, o, gap.cells, out)) return;
+    // Fallback: rim-inwards median; its intermediate cells must not leak into other gaps.
+    std::vector<char> local = measured;
+    median.fillRepeated(gap.cells, out, local);
+}
+
+}  // namespace detail
+
 FillResult fillGaps(const HeightRaster& r, const FillOptions& o) {
     r.validate();
     o.validate();
     std::vector<char> measured;
     FillResult out = detail::initResult(r, measured);
+    out.stats.cellsVisited = r.size();
     std::vector<int> sizes;
     const std::vector<int> label = labelGaps(r, sizes);
     out.stats.gapComponents = int(sizes.size());
@@ -69,29 +98,9 @@ FillResult fillGaps(const HeightRaster& r, const FillOptions& o) {
         detail::countSources(out);
         return out;
     }
-    const std::vector<Gap> gaps = collectGaps(r, label, sizes, o);
     detail::MedianFiller median(r, o);
-    const std::vector<char>& usable = measured;  // the median of a small gap uses measured cells
-    for (const Gap& gap : gaps) {
-        if (gap.cells.empty()) continue;  // too large: stays Unknown
-        if (gap.medianReach) {
-            for (int k : gap.cells) median.fillCell(k % r.nx(), k / r.nx(), out, usable);
-            continue;
-        }
-        if (o.gaussianEnabled && o.shadowOccluders) {
-            // A shadow behind a step: the step's top is not data of the hidden surface.
-            const ShadowOccluders occ = findShadowOccluders(r, gap.cells, o);
-            if (!occ.cells.empty() && fillShadow(withoutOccluders(r, occ), o, gap.cells, out)) {
-                out.stats.shadowGaps++;
-                out.stats.shadowCells += int(gap.cells.size());
-                continue;
-            }
-        }
-        if (o.gaussianEnabled && fillWithGaussianSurface(r, o, gap.cells, out)) continue;
-        // Fallback: rim-inwards median; its intermediate cells must not leak into other gaps.
-        std::vector<char> local = measured;
-        median.fillRepeated(gap.cells, out, local);
-    }
+    for (const Gap& gap : collectGaps(r, label, sizes, o))
+        detail::fillGap(r, o, gap, measured, median, out);
     detail::countSources(out);
     return out;
 }

@@ -36,33 +36,31 @@ std::vector<int> labelGaps(const HeightRaster& r, std::vector<int>& sizes) {
     return label;
 }
 
+bool medianReaches(const HeightRaster& r, const std::vector<int>& cells, const FillOptions& o) {
+    const int half = o.medianWindow_cells / 2;
+    for (int k : cells) {
+        // Measured cells in the window around the cell, clipped to the raster.
+        const int ix = k % r.nx(), iy = k / r.nx();
+        const int xa = std::max(ix - half, 0), xb = std::min(ix + half + 1, r.nx());
+        const int ya = std::max(iy - half, 0), yb = std::min(iy + half + 1, r.ny());
+        int known = 0;
+        for (int y = ya; y < yb; y++)
+            for (int x = xa; x < xb; x++) known += int(r.isMeasured(r.index(x, y)));
+        if (known < o.medianMinKnown) return false;
+    }
+    return true;
+}
+
 std::vector<Gap> collectGaps(const HeightRaster& r, const std::vector<int>& label,
                              const std::vector<int>& sizes, const FillOptions& o) {
-    // Measured cells per window, from a summed-area table: O(1) per cell.
-    const int nx = r.nx(), ny = r.ny();
-    const int half = o.medianWindow_cells / 2;
-    std::vector<int> sat(size_t(nx + 1) * size_t(ny + 1), 0);
-    auto S = [&](int x, int y) -> int& { return sat[size_t(y) * size_t(nx + 1) + size_t(x)]; };
-    for (int iy = 0; iy < ny; iy++)
-        for (int ix = 0; ix < nx; ix++)
-            S(ix + 1, iy + 1) =
-                int(r.isMeasured(r.index(ix, iy))) + S(ix, iy + 1) + S(ix + 1, iy) - S(ix, iy);
-    auto knownInWindow = [&](int ix, int iy) {
-        const int xa = std::max(ix - half, 0), xb = std::min(ix + half + 1, nx);
-        const int ya = std::max(iy - half, 0), yb = std::min(iy + half + 1, ny);
-        return S(xb, yb) - S(xa, yb) - S(xb, ya) + S(xa, ya);
-    };
-
     std::vector<Gap> gaps(sizes.size());
     for (size_t id = 0; id < sizes.size(); id++)
         if (sizes[id] <= o.maxGapCells) gaps[id].cells.reserve(size_t(sizes[id]));
     for (size_t k = 0; k < r.size(); k++) {
         const int id = label[k];
-        if (id < 0 || sizes[size_t(id)] > o.maxGapCells) continue;
-        gaps[size_t(id)].cells.push_back(int(k));
-        if (knownInWindow(int(k) % nx, int(k) / nx) < o.medianMinKnown)
-            gaps[size_t(id)].medianReach = false;
+        if (id >= 0 && sizes[size_t(id)] <= o.maxGapCells) gaps[size_t(id)].cells.push_back(int(k));
     }
+    for (Gap& g : gaps) g.medianReach = medianReaches(r, g.cells, o);
     return gaps;
 }
 

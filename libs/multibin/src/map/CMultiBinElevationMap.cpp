@@ -451,6 +451,7 @@ void CMultiBinElevationMap::internal_clear() {
     m_impl->lastRobotPose.reset();
     m_impl->sensorState.reset();
     m_impl->fill = {};
+    m_impl->filled = {};
     m_impl->fillWindow = {};
     m_impl->fillStale = true;
 }

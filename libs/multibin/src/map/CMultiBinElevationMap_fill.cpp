@@ -2,15 +2,18 @@
  * CMultiBinElevationMap: gap filling and the DEM queries that return filled heights.
  *
  * Filling is lazy: insertions only mark the last fill stale, and dem_update_map() (MRPT's hook
- * for "make every observation count") refills the whole window once. A map read from a file
+ * for "make every observation count") refills the window once, tile by tile (fill::fillSparse:
+ * the cost follows the cells near data, not the window). A map read from a file
  * fills itself on its first query (fillIfLoaded()), so it answers as the map that wrote it. Filled
  * cells keep certainty 0; a cell measured after the fill answers with its measurement. */
 #include "CMultiBinElevationMap_impl.h"
 
 #include <cmath>
-#include <iostream>
+#include <set>
+#include <utility>
 
-#include "multibin/fill/GapFilling.h"
+#include "multibin/fill/SparseFill.h"
+#include "multibin/map/BinStore.h"
 
 using namespace mrpt::maps;
 
@@ -20,33 +23,62 @@ void CMultiBinElevationMap::dem_update_map() {
     if (m_impl->fillStale) fillNow();
 }
 
+multibin::fill::SparseHeights CMultiBinElevationMap::fillInput() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    const multibin::BinGrid& grid = m_impl->grid;
+    multibin::fill::SparseHeights in;
+    in.lattice = grid.lattice();
+    // A cell is measured only where a bin of either grid is: the global grid's tiles, and with
+    // the dual grid the global tiles under the local grid's tiles.
+    constexpr int kTile = multibin::BinStore::kTileCells;
+    std::set<std::pair<int, int>> tiles;  // (ty, tx): row by row
+    grid.store().forEachTile([&](int tx, int ty) { tiles.emplace(ty, tx); });
+    if (isDualGrid())
+        m_impl->local.store().forEachTile([&](int tx, int ty) {
+            const multibin::BinGrid& l = m_impl->local;
+            const int gx0 = grid.cellIndex(l.cellCenter_m(tx * kTile)),
+                      gx1 = grid.cellIndex(l.cellCenter_m(tx * kTile + kTile - 1));
+            const int gy0 = grid.cellIndex(l.cellCenter_m(ty * kTile)),
+                      gy1 = grid.cellIndex(l.cellCenter_m(ty * kTile + kTile - 1));
+            for (int y = multibin::BinStore::tileOf(gy0); y <= multibin::BinStore::tileOf(gy1); y++)
+                for (int x = multibin::BinStore::tileOf(gx0); x <= multibin::BinStore::tileOf(gx1);
+                     x++)
+                    tiles.emplace(y, x);
+        });
+    const Eigen::Vector2d& o = m_impl->origin_m;  // surfaceQuery() takes pose-frame coordinates
+    const multibin::CellWindow& w = in.lattice.window;
+    for (const auto& [ty, tx] : tiles)
+        for (int iy = ty * kTile; iy < (ty + 1) * kTile; iy++)
+            for (int ix = tx * kTile; ix < (tx + 1) * kTile; ix++) {
+                double h, s;
+                // Without the pose part the cells share (CellSurface::poseVariance_m2): it moves
+                // a gap's neighbours together, so it does not weigh one against another.
+                if (w.contains(ix, iy) && m_impl->holdsBins(ix, iy, isDualGrid()) &&
+                    surfaceQuery(false, o.x() + grid.cellCenter_m(ix),
+                                 o.y() + grid.cellCenter_m(iy), h, s, false))
+                    in.setMeasured(ix, iy, float(h), float(s));
+            }
+    return in;
+}
+
 void CMultiBinElevationMap::fillNow() const {
-    const multibin::CellWindow w = m_impl->grid.window();
-    if (w.cellCount() > kMaxWholeWindowCells) {
-        // One raster of the whole window: beyond this, GBs for a route's mostly empty box.
-        std::cerr << "CMultiBinElevationMap: gap filling skipped: the window of " << w.nx << " x "
-                  << w.ny << " cells is beyond the " << kMaxWholeWindowCells
-                  << " cells filled as one raster (long routes); set fill_enabled = false to "
-                     "skip it without this message\n";
+    // Tiled: the cost follows the cells near data, not the window (a long route's box).
+    const multibin::fill::SparseHeights in = fillInput();
+    m_impl->filled = multibin::fill::fillSparse(in, insertionOptions.fill);
+    m_impl->fillWindow = in.lattice.window;
+    // One raster for lastFill() and the traversability layers, where the window allows it.
+    if (in.lattice.cellCount() <= kMaxWholeWindowCells) {
+        m_impl->fill = m_impl->filled.toResult(in);
+    } else {
         m_impl->fill = {};
-        m_impl->fillWindow = {};
-        m_impl->fillStale = false;
-        return;
+        m_impl->fill.stats = m_impl->filled.stats;
     }
-    multibin::fill::HeightRaster raster(multibin::Lattice{m_impl->grid.cellSize_m(), w});
-    const Eigen::Vector2d& o = m_impl->origin_m;  // getHeight() takes pose-frame coordinates
-    for (int r = 0; r < w.ny; r++)
-        for (int c = 0; c < w.nx; c++) {
-            double h, s;
-            // Without the pose part the cells share (CellSurface::poseVariance_m2): it moves a
-            // gap's neighbours together, so it does not weigh one against another.
-            if (surfaceQuery(false, o.x() + m_impl->grid.cellCenter_m(w.ix0 + c),
-                             o.y() + m_impl->grid.cellCenter_m(w.iy0 + r), h, s, false))
-                raster.setMeasured(c, r, float(h), float(s));
-        }
-    m_impl->fill = multibin::fill::fillGaps(raster, insertionOptions.fill);
-    m_impl->fillWindow = w;
     m_impl->fillStale = false;
+}
+
+const multibin::fill::FilledCells& CMultiBinElevationMap::lastFilledCells() const {
+    fillIfLoaded();
+    return m_impl->filled;
 }
 
 void CMultiBinElevationMap::fillIfLoaded() const {
@@ -94,19 +126,17 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::elevationQuery(
 CMultiBinElevationMap::HeightSource CMultiBinElevationMap::filledQuery(double x_m, double y_m,
                                                                        double& height_m,
                                                                        double& sigma_m) const {
-    if (m_impl->fill.source.empty()) return HeightSource::Unknown;
     const int ix = m_impl->grid.cellIndex(x_m - m_impl->origin_m.x()),
               iy = m_impl->grid.cellIndex(y_m - m_impl->origin_m.y());
     if (!m_impl->fillWindow.contains(ix, iy)) return HeightSource::Unknown;
-    const size_t k = m_impl->fill.index(ix - m_impl->fillWindow.ix0, iy - m_impl->fillWindow.iy0);
-    if (!m_impl->fill.isFilled(k)) return HeightSource::Unknown;
-    height_m = m_impl->fill.height_m[k];
-    sigma_m = m_impl->fill.sigma_m[k];
+    const multibin::fill::FilledCell* f = m_impl->filled.find(ix, iy);
+    if (!f) return HeightSource::Unknown;
+    height_m = f->height_m;
+    sigma_m = f->sigma_m;
     // FilledHarmonic is a surface fill too (eq 16 plus harmonic rim residuals): one value of
     // the source layer for both surface paths.
-    return m_impl->fill.source[k] == multibin::HeightSource::FilledMedian
-               ? HeightSource::FilledMedian
-               : HeightSource::FilledSurface;
+    return f->source == multibin::HeightSource::FilledMedian ? HeightSource::FilledMedian
+                                                             : HeightSource::FilledSurface;
 }
 
 bool CMultiBinElevationMap::dem_get_z_by_cell(const size_t cx, const size_t cy,

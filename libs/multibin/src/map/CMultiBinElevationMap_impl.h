@@ -10,6 +10,7 @@
 #include "MapLock.h"
 #include "TraversabilityCache.h"
 #include "multibin/fill/HeightRaster.h"
+#include "multibin/fill/SparseFill.h"
 #include "multibin/geometry/Lattice.h"
 #include "multibin/map/BinGrid.h"
 #include "multibin/sensors/SensorDispatch.h"
@@ -33,7 +34,11 @@ struct CMultiBinElevationMap::Impl {
     mrpt::Clock::time_point lastRobotPoseTime;
     /** Previous laser scans (eq 14), stereo covariance table, sensor statistics. */
     multibin::sensors::SensorModelState sensorState;
-    /** The last gap filling, over fillWindow of grid (absolute cell indices). */
+    /** The last gap filling's filled cells, over fillWindow of grid (absolute cell indices): what
+     * the queries and rasters read. */
+    multibin::fill::FilledCells filled;
+    /** The same as one raster over fillWindow (lastFill(), the traversability layers); empty
+     * beyond kMaxWholeWindowCells. */
     multibin::fill::FillResult fill;
     multibin::CellWindow fillWindow;
     bool fillStale = true;
@@ -44,6 +49,17 @@ struct CMultiBinElevationMap::Impl {
     std::shared_ptr<multibin::TileStoreFile> tileFile;
     size_t peakResidentBytes = 0;
     bool budgetWarned = false;
+    /** Whether cell (ix, iy) of `grid` holds a bin, or with the dual grid the local grid's cell at
+     * its centre does: a cell without is unknown, skipped without a surface query. */
+    bool holdsBins(int ix, int iy, bool dual) const {
+        bool any = false;
+        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
+        if (!any && dual)
+            local.forEachBin(local.cellIndex(grid.cellCenter_m(ix)),
+                             local.cellIndex(grid.cellCenter_m(iy)),
+                             [&](const multibin::Bin&) { any = true; });
+        return any;
+    }
     /** The traversability layers (CMultiBinElevationMap_traversability.cpp). */
     multibin::TraversabilityCache traversability;
 };

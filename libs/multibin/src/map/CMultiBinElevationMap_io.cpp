@@ -388,18 +388,12 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     std::vector<multibin::EsriAsciiGrid> out(layers.size(), g);
     // A cell without a bin in either grid and without a filled value is unknown: most cells of
     // a sparse route's tiles, skipped without a query.
-    const multibin::fill::FillResult& f = m_impl->fill;
+    const multibin::fill::FilledCells& f = m_impl->filled;
     const multibin::CellWindow& fw = m_impl->fillWindow;
-    const bool withFill = insertionOptions.dem_return_filled && f.source.size() == fw.cellCount();
+    const bool withFill = insertionOptions.dem_return_filled;
     const auto mayBeKnown = [&](int ix, int iy) {
-        bool any = false;
-        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { any = true; });
-        if (!any && isDualGrid())
-            m_impl->local.forEachBin(m_impl->local.cellIndex(grid.cellCenter_m(ix)),
-                                     m_impl->local.cellIndex(grid.cellCenter_m(iy)),
-                                     [&](const multibin::Bin&) { any = true; });
-        return any ||
-               (withFill && fw.contains(ix, iy) && f.isFilled(f.index(ix - fw.ix0, iy - fw.iy0)));
+        return m_impl->holdsBins(ix, iy, isDualGrid()) ||
+               (withFill && fw.contains(ix, iy) && f.find(ix, iy));
     };
     for (int r = 0; r < w.ny; r++)
         for (int c = 0; c < w.nx; c++) {
@@ -461,12 +455,9 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
                 m_impl->grid.cellIndex(l.cellCenter_m(iy)));
         });
     }
-    const multibin::fill::FillResult& f = m_impl->fill;
-    const multibin::CellWindow& fw = m_impl->fillWindow;
-    if (insertionOptions.dem_return_filled && f.source.size() == fw.cellCount())
-        for (int r = 0; r < fw.ny; r++)
-            for (int c = 0; c < fw.nx; c++)
-                if (f.isFilled(f.index(c, r))) add(fw.ix0 + c, fw.iy0 + r);
+    if (insertionOptions.dem_return_filled)  // the filled cells, tile by tile
+        m_impl->filled.forEachFilled(
+            [&](int ix, int iy, const multibin::fill::FilledCell&) { add(ix, iy); });
     std::vector<multibin::CellWindow> tiles;
     tiles.reserve(corners.size());
     for (const auto& [iy0, ix0] : corners)

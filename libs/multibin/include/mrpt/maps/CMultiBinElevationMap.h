@@ -26,7 +26,8 @@
 
 // The library's internals stay out of this header: these are only named here. Include
 // multibin/map/BinGrid.h to read grid(), multibin/io/EsriAsciiGrid.h to use toRaster(),
-// multibin/fill/HeightRaster.h for lastFill(), multibin/map/MapStatistics.h for statistics().
+// multibin/fill/HeightRaster.h for lastFill(), multibin/fill/SparseFill.h for fillInput() and
+// lastFilledCells(), multibin/map/MapStatistics.h for statistics().
 namespace multibin {
 class BinGrid;
 struct CellWindow;
@@ -36,7 +37,9 @@ struct PoseVariances;
 struct EsriAsciiGrid;
 namespace fill {
 struct FillResult;
-}
+struct FilledCells;
+struct SparseHeights;
+}  // namespace fill
 namespace sensors {
 struct SensorModelStats;
 }
@@ -309,8 +312,14 @@ public:
                                bool includeFilled = true) const;
     /** True when observations arrived after the last gap filling (dem_update_map() refills). */
     bool fillIsStale() const;
-    /** The last gap filling's result over the grid window it was run on. */
+    /** The last gap filling's result over the grid window it was run on, as one raster: empty
+     * (stats only) beyond kMaxWholeWindowCells; lastFilledCells() holds it at any size. */
     const multibin::fill::FillResult& lastFill() const;
+    /** The last gap filling's filled cells, tile by tile (absolute cell indices of grid()). */
+    const multibin::fill::FilledCells& lastFilledCells() const;
+    /** The input of gap filling: each measured cell's surface (without the pose part the cells
+     * share), tile by tile, over grid()'s window. dem_update_map() fills its gaps. */
+    multibin::fill::SparseHeights fillInput() const;
 
     /** height() where measured: height [m] and sigma [m] at (x, y) from the map's surface (the
      * cell surface: its winning bin merged with the adjacent bins that agree with it,
@@ -514,9 +523,9 @@ private:
     void growToCover(const multibin::PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
                      const multibin::BinUpdateParams& params);
 
-    /** Largest window gap filling and the traversability layers compute over as one raster
-     * [cells] (8192 x 8192): beyond it (a long route's box), filling is skipped with a message
-     * and the layers refuse, instead of allocating GBs. */
+    /** Largest window the traversability layers and lastFill() compute over as one raster
+     * [cells] (8192 x 8192): beyond it (a long route's box), the layers refuse and lastFill()
+     * holds statistics only, instead of allocating GBs (gap filling itself is tiled). */
     static constexpr size_t kMaxWholeWindowCells = size_t(1) << 26;
     /** Side of the square the global grid covers around the robot [cells]: global_size_m. */
     int globalSideCells() const;

@@ -18,6 +18,11 @@ struct Gap {
     bool medianReach = true;  //!< every cell's median window holds >= medianMinKnown measured cells
 };
 
+/** Whether every one of `cells` (raster indices) has >= options.medianMinKnown measured cells in
+ * its medianWindow_cells window, clipped to the raster: the weighted median fills the gap. */
+bool medianReaches(const HeightRaster& raster, const std::vector<int>& cells,
+                   const FillOptions& options);
+
 /** The gaps of labelGaps() in label order, each with its cells (none for a gap larger than
  * options.maxGapCells, which stays Unknown) and whether the median reaches all of them. */
 std::vector<Gap> collectGaps(const HeightRaster& raster, const std::vector<int>& label,

@@ -72,6 +72,9 @@ struct FillResult {
         /** gaps filled as shadows behind a step, from their hidden side (ShadowOccluders.h), and
          * their cells (FilledHarmonic) */
         int shadowGaps = 0, shadowCells = 0;
+        /** cells the run read or labelled: the whole raster for fillGaps(); for fillSparse()
+         * the cells its gap search flooded plus the per-gap rasters (its cost follows the data) */
+        size_t cellsVisited = 0;
     } stats;
 
     int nx() const { return lattice.nx(); }
