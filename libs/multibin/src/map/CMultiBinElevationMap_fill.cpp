@@ -24,6 +24,7 @@ void CMultiBinElevationMap::dem_update_map() {
 }
 
 multibin::fill::SparseHeights CMultiBinElevationMap::fillInput() const {
+    prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::BinGrid& grid = m_impl->grid;
     multibin::fill::SparseHeights in;
@@ -77,7 +78,7 @@ void CMultiBinElevationMap::fillNow() const {
 }
 
 const multibin::fill::FilledCells& CMultiBinElevationMap::lastFilledCells() const {
-    fillIfLoaded();
+    prepareForReading();
     return m_impl->filled;
 }
 
