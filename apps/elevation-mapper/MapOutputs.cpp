@@ -2,6 +2,7 @@
 #include "MapOutputs.h"
 
 #include <cmath>
+#include <limits>
 
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
@@ -61,16 +62,23 @@ const Layer kLayers[] = {Layer::Height, Layer::Sigma, Layer::Certainty, Layer::S
 const char* const kTraversabilityNames[] = {"untraversable", "step", "slope", "roughness",
                                             "foothold"};
 
-/** The map's traversability layer over the same cells as `like` (a cropped map raster). */
+/** The map's traversability layer over the same cells as `like` (a cropped map raster): NODATA
+ * where `like` reaches beyond the layers' window (its margin around the known cells may). */
 multibin::EsriAsciiGrid traversabilityLike(const CMultiBinElevationMap& map, int layer,
                                            const multibin::EsriAsciiGrid& like) {
     const multibin::EsriAsciiGrid t =
         map.traversabilityRaster(static_cast<CMultiBinElevationMap::TraversabilityLayer>(layer));
-    multibin::RasterBox box;
-    box.col0 = int(std::lround((like.xllcenter_m - t.xllcenter_m) / t.cellsize_m));
-    box.row0 = int(std::lround((like.yllcenter_m - t.yllcenter_m) / t.cellsize_m));
-    box.cols = like.cols(), box.rows = like.rows();
-    return multibin::cropRaster(t, box);
+    const int col0 = int(std::lround((like.xllcenter_m - t.xllcenter_m) / t.cellsize_m));
+    const int row0 = int(std::lround((like.yllcenter_m - t.yllcenter_m) / t.cellsize_m));
+    multibin::EsriAsciiGrid out = like;
+    out.heights_m.setConstant(std::numeric_limits<float>::quiet_NaN());
+    for (int r = 0; r < like.rows(); r++)
+        for (int c = 0; c < like.cols(); c++) {
+            const int tr = r + row0, tc = c + col0;
+            if (tr >= 0 && tc >= 0 && tr < t.rows() && tc < t.cols())
+                out.heights_m(r, c) = t.heights_m(tr, tc);
+        }
+    return out;
 }
 
 /** The serialized form of an object, gzip-compressed in memory (what CFileGZOutputStream writes

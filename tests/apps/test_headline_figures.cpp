@@ -47,8 +47,21 @@ nlohmann::json runScenario(const std::string& s) {
     const auto r = mapper_run::runMapper(
         dir, "--config " + src + "/ini/" + s + ".ini --rawlog " + src + "/rawlogs/" + s +
                  ".rawlog --ground-truth " + src + "/rawlogs/" + s +
-                 "_gt.asc --no-plots --outputs map --out " + (dir / "out").string());
+                 "_gt.asc --no-plots --outputs map,asc --out " + (dir / "out").string());
     EXPECT_EQ(r.exitCode, 0) << r.err;
+    // Every layer over the same cells as the heights (the traversability layers' window may be
+    // smaller than the heights' margin around the known cells: NODATA there, not an error).
+    const auto header = [&](const std::string& name) {
+        const std::string text = mapper_run::readAll(dir / "out" / name);
+        size_t end = 0;
+        for (int line = 0; line < 6 && end != std::string::npos; line++)
+            end = text.find('\n', end + 1);
+        return text.substr(0, end);
+    };
+    const std::string heights = header("elevation_height.asc");
+    EXPECT_FALSE(heights.empty());
+    for (const char* layer : {"untraversable", "step", "slope", "roughness", "foothold"})
+        EXPECT_EQ(header("elevation_" + std::string(layer) + ".asc"), heights) << layer;
     return nlohmann::json::parse(mapper_run::readAll(dir / "out" / "report.json"));
 }
 
