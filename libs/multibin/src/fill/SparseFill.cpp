@@ -182,8 +182,10 @@ HeightRaster SparseHeights::toRaster(const CellWindow& w) const {
         for (int tx = w.ix0 >> k; tx <= (w.ix0 + w.nx - 1) >> k; tx++) {
             const auto* t = cells.findTile(tx, ty);
             if (!t) continue;
-            const int xa = std::max(tx << k, w.ix0), xb = std::min((tx + 1) << k, w.ix0 + w.nx);
-            const int ya = std::max(ty << k, w.iy0), yb = std::min((ty + 1) << k, w.iy0 + w.ny);
+            // Multiplied, not shifted: tile indices are negative left of the origin.
+            const int side = 1 << k;
+            const int xa = std::max(tx * side, w.ix0), xb = std::min((tx + 1) * side, w.ix0 + w.nx);
+            const int ya = std::max(ty * side, w.iy0), yb = std::min((ty + 1) * side, w.iy0 + w.ny);
             for (int iy = ya; iy < yb; iy++)
                 for (int ix = xa; ix < xb; ix++) {
                     const MeasuredCell& c = t[TiledCells<MeasuredCell>::inTile(ix, iy)];
