@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <iostream>
-#include <limits>
 
 using namespace mrpt::maps;
 
@@ -29,7 +28,7 @@ void CMultiBinElevationMap::prepareForReading() const {
     }
     if (spilled) {
         const multibin::MapLock::Exclusive lock(m_impl->lock);
-        m_impl->grid.reloadTilesNear(0, 0, std::numeric_limits<double>::infinity());
+        m_impl->grid.reloadAllTiles();
     }
     fillIfLoaded();
 }

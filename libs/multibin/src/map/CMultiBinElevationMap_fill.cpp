@@ -19,7 +19,7 @@ using namespace mrpt::maps;
 
 void CMultiBinElevationMap::dem_update_map() {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
-    m_impl->grid.reloadTilesNear(0, 0, std::numeric_limits<double>::infinity());
+    m_impl->grid.reloadAllTiles();
     if (m_impl->fillStale) fillNow();
 }
 

@@ -96,6 +96,10 @@ public:
     /** Reads back every tile on disk within `reach_m` of (x_m, y_m) (all with an infinite
      * reach); returns the tiles read. */
     size_t reloadTilesNear(double x_m, double y_m, double reach_m);
+    /** Reads back every tile on disk (before a read of the whole grid). */
+    size_t reloadAllTiles() {
+        return reloadTilesNear(0, 0, std::numeric_limits<double>::infinity());
+    }
     bool hasSpilledTiles() const { return m_store.spilledTileCount() > 0; }
     size_t spilledTileCount() const { return m_store.spilledTileCount(); }
 
