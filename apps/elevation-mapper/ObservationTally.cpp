@@ -1,5 +1,6 @@
 /* Part of the multibin elevation-mapping library: the elevation-mapper program. */
 #include "ObservationTally.h"
+#include "multibin/map/MapStatistics.h"
 
 #include <mrpt/obs/CObservationRobotPose.h>
 
@@ -8,21 +9,21 @@
 using mrpt::maps::CMultiBinElevationMap;
 
 void ObservationTally::before(const CMultiBinElevationMap& map) {
-    m_accepted0 = map.insertStats().accepted;
-    m_rejected0 = map.insertStats().rejected();
-    m_byLabel0 = map.skippedByLabelCount();
+    m_accepted0 = map.statistics().insert.accepted;
+    m_rejected0 = map.statistics().insert.rejected();
+    m_byLabel0 = map.statistics().skippedByLabel;
 }
 
 void ObservationTally::after(const mrpt::obs::CObservation& obs, bool inserted,
                              const CMultiBinElevationMap& map) {
     Counts& c = m_byClass[obs.GetRuntimeClass()->className];
-    const size_t fused = map.insertStats().accepted - m_accepted0;
-    const size_t rejected = map.insertStats().rejected() - m_rejected0;
+    const size_t fused = map.statistics().insert.accepted - m_accepted0;
+    const size_t rejected = map.statistics().insert.rejected() - m_rejected0;
     c.pointsFused += fused;
     c.pointsRejected += rejected;
     if (dynamic_cast<const mrpt::obs::CObservationRobotPose*>(&obs))
         c.poses++;  // a pose PDF for the observations that follow, not data
-    else if (map.skippedByLabelCount() > m_byLabel0)
+    else if (map.statistics().skippedByLabel > m_byLabel0)
         c.byLabel++;
     else if (inserted || fused > 0)
         c.used++;

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorStats.h"
 
 namespace {
@@ -14,8 +15,8 @@ struct Gate {
 };
 
 std::vector<Gate> gatesOf(const mrpt::maps::CMultiBinElevationMap& map) {
-    const multibin::InsertStats& s = map.insertStats();
-    const multibin::sensors::SensorModelStats& m = map.sensorModelStats();
+    const multibin::InsertStats& s = map.statistics().insert;
+    const multibin::sensors::SensorModelStats& m = map.statistics().sensorModels;
     // Readings without an echo (no return, not decoded) are not a gate: no option brings them.
     const size_t range =
         m.laser.outOfRange + m.stereo.outOfRange + m.depth.outOfRange + m.lidar.outOfRange;
@@ -42,7 +43,7 @@ std::vector<Gate> gatesOf(const mrpt::maps::CMultiBinElevationMap& map) {
 
 std::string dominantRejection(const mrpt::maps::CMultiBinElevationMap& map) {
     const std::vector<Gate> gates = gatesOf(map);
-    size_t total = map.insertStats().accepted;
+    size_t total = map.statistics().insert.accepted;
     const Gate* top = nullptr;
     for (const Gate& g : gates) {
         total += g.count;
@@ -61,7 +62,7 @@ std::string dominantRejection(const mrpt::maps::CMultiBinElevationMap& map) {
 std::vector<std::string> runWarnings(const mrpt::maps::CMultiBinElevationMap& map,
                                      const RunFacts& facts) {
     std::vector<std::string> out;
-    const multibin::InsertStats& s = map.insertStats();
+    const multibin::InsertStats& s = map.statistics().insert;
     const size_t handed = s.accepted + s.tooUncertain + s.outsideMap + s.outsideBinRange +
                           s.continuityRejected + s.badCovariance;
     // Under 1 % of the points looked down: the map holds what stands at the sensors' height.
@@ -71,8 +72,8 @@ std::vector<std::string> runWarnings(const mrpt::maps::CMultiBinElevationMap& ma
             std::to_string(handed) +
             " points lie more than 5 degrees below a sensor's horizontal (a horizontal laser "
             "maps walls, not terrain: pitch it down, or add a sensor that sees the ground)");
-    if (map.poseFallbackCount() > 0 && facts.observationsWithPoseCovariance == 0)
-        out.push_back("every observation (" + std::to_string(map.poseFallbackCount()) +
+    if (map.statistics().poseFallbacks > 0 && facts.observationsWithPoseCovariance == 0)
+        out.push_back("every observation (" + std::to_string(map.statistics().poseFallbacks) +
                       ") was mapped with the default pose covariance (default_pose_sigmas): the "
                       "input gives none (no CObservationRobotPose, no simplemap covariance), so "
                       "the map's sigmas rest on that guess");

@@ -38,10 +38,11 @@
 #include "ProgressBar.h"
 #include "RawlogSource.h"
 #include "RunWarnings.h"
-#include "multibin/fill/HeightRaster.h"
+#include "multibin/fill/SparseFill.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
 #include "multibin/io/OutputFile.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
@@ -362,7 +363,7 @@ int run(const Arguments& args, std::string& stage) {
     for (const std::string& w : mrptWarnings.summary())
         std::cerr << "elevation-mapper: warning: " << w << "\n";
     std::cout << tally.report();
-    const multibin::InsertStats& fused = elevation->insertStats();
+    const multibin::InsertStats& fused = elevation->statistics().insert;
     const std::string beyond =
         reach.beyondSupportedRange(elevation->mapOrigin().x, elevation->mapOrigin().y);
     if (fused.accepted == 0 && !beyond.empty())
@@ -413,11 +414,11 @@ int run(const Arguments& args, std::string& stage) {
     outputs.addSince(outputs0);
     outputs.subtract(scoring);
 
-    const auto& fs_ = elevation->lastFill().stats;
+    const auto& fs_ = elevation->lastFilledCells().stats;
     std::cout << elevation->asString() << "\n"
-              << insertSummary(elevation->insertStats()) << "\n"
-              << "observations with the default pose covariance: " << elevation->poseFallbackCount()
-              << "\n"
+              << insertSummary(elevation->statistics().insert) << "\n"
+              << "observations with the default pose covariance: "
+              << elevation->statistics().poseFallbacks << "\n"
               << "rawlog poses: " << poseCounts.robotPose << " robot pose, "
               << poseCounts.odometrySinceRobotPose << " robot pose + odometry since, "
               << poseCounts.defaultCovariance << " default covariance\n"

@@ -7,10 +7,11 @@
 #include <mrpt/maps/CHeightGridMap2D.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
-#include <multibin/map/BinGrid.h>
+#include <multibin/grid/BinGrid.h>
 
 #include <cmath>
 #include <memory>
+#include "multibin/map/MapInternals.h"
 
 namespace terrain_sim {
 namespace {
@@ -122,7 +123,7 @@ struct Rms {
 RandomSceneScores::CellKind cellKind(const CMultiBinElevationMap& map, double x, double y,
                                      double truth_m) {
     constexpr double kAtGround_m = 0.03;
-    const multibin::BinGrid& grid = map.grid();
+    const multibin::BinGrid& grid = multibin::MapInternals::grid(map);
     const auto origin = map.mapOrigin();
     const int ix = grid.cellIndex(x - origin.x), iy = grid.cellIndex(y - origin.y);
     if (!grid.window().contains(ix, iy)) return RandomSceneScores::NoBin;

@@ -23,6 +23,7 @@
 
 #include "mapper_run.h"
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace fs = std::filesystem;
 
@@ -228,7 +229,7 @@ TEST(ElevationMapperOutputs, OutputsChoosesWhatIsWritten) {
     mrpt::io::CFileGZInputStream in((d / "def" / "elevation_map.bin").string());
     mrpt::maps::CMultiBinElevationMap map;
     mrpt::serialization::archiveFrom(in) >> map;
-    EXPECT_EQ(map.insertStats().accepted, 0u);  // statistics are not serialized
+    EXPECT_EQ(map.statistics().insert.accepted, 0u);  // statistics are not serialized
     double h = 0, s = 0;
     EXPECT_TRUE(map.getHeight(1.05, 0.05, h, s));
     EXPECT_NEAR(h, -0.3, 0.01);

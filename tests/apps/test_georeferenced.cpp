@@ -27,9 +27,11 @@
 
 #include "RawlogSource.h"
 #include "mapper_run.h"
+#include "multibin/grid/BinGrid.h"
 #include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/io/RasterExport.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace fs = std::filesystem;
 using Map = mrpt::maps::CMultiBinElevationMap;
@@ -177,7 +179,7 @@ TEST(Georeferenced, TheMockupMovedToUtmCoordinatesIsTheSameMapCellForCell) {
         const auto moved = mapMockup(movedLog.string());
         EXPECT_NEAR(moved->mapOrigin().x, s.dx, 1e-9);  // the whole km nearest the first pose
         EXPECT_NEAR(moved->mapOrigin().y, s.dy, 1e-9);
-        EXPECT_EQ(moved->insertStats().accepted, original->insertStats().accepted);
+        EXPECT_EQ(moved->statistics().insert.accepted, original->statistics().insert.accepted);
         const size_t measured = expectSameMap(*original, *moved, s.dx, s.dy);
         EXPECT_GT(measured, 20000u);  // the mock-up's measured cells, not an empty map
     }
@@ -192,7 +194,8 @@ TEST(Georeferenced, TheDualGridMovedToUtmCoordinatesIsTheSameMap) {
     const auto moved = mapMockup(movedLog.string(), true);
     EXPECT_GT(expectSameMap(*original, *moved, kUtm.dx, kUtm.dy), 1000u);
     // The local grid followed the robot in the same cells.
-    EXPECT_EQ(moved->localGrid().window(), original->localGrid().window());
+    EXPECT_EQ(multibin::MapInternals::localGrid(*moved).window(),
+              multibin::MapInternals::localGrid(*original).window());
 }
 
 namespace {
@@ -311,13 +314,14 @@ TEST(Georeferenced, AnExplicitOriginIsAnOptionAndAnExtentIsInThePoseFrame) {
     EXPECT_EQ(byExtent.mapOrigin().y, 5400000.0);
     EXPECT_NEAR(byExtent.getXMin(), 450010, 1e-6);
     EXPECT_NEAR(byExtent.getYMax(), 5400022, 1e-6);
-    EXPECT_EQ(byExtent.grid().window().nx, 200);
+    EXPECT_EQ(multibin::MapInternals::grid(byExtent).window().nx, 200);
 
     c.origin_auto = false;
     c.origin_x_m = 450012, c.origin_y_m = 5400021;
     Map fixed(c);
     EXPECT_EQ(fixed.mapOrigin().x, 450012.0);
-    EXPECT_EQ(fixed.grid().window().ix0, -100);  // cells relative to the origin
+    EXPECT_EQ(multibin::MapInternals::grid(fixed).window().ix0,
+              -100);  // cells relative to the origin
     ASSERT_TRUE(fixed.insertIndividualPoint(450013.01, 5400020.51, 0.2));
     double h, s;
     ASSERT_TRUE(fixed.getHeight(450013.01, 5400020.51, h, s));

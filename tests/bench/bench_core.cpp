@@ -15,9 +15,9 @@
 #include <thread>
 
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/CellSurface.h"
-#include "multibin/map/VisibilityConstraint.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/CellSurface.h"
+#include "multibin/grid/VisibilityConstraint.h"
 
 using namespace multibin;
 

@@ -38,8 +38,8 @@
 #include <vector>
 
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/BinUpdate.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/BinUpdate.h"
 
 using namespace multibin;
 

@@ -20,6 +20,7 @@
 #include <cmath>
 #include <limits>
 
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/LidarModel.h"
 #include "multibin/sensors/RayModel.h"
 
@@ -95,13 +96,13 @@ void BM_MapInsertVlp16Revolution(benchmark::State& state) {
     auto map = lidarMap();
     map->insertionOptions.visibility.enabled = state.range(0) != 0;
     map->insertObservation(cloud, pose);  // grows the map: not timed
-    const size_t before = map->insertStats().accepted;
-    const VisibilityStats visBefore = map->visibilityStats();
+    const size_t before = map->statistics().insert.accepted;
+    const VisibilityStats visBefore = map->statistics().visibility;
     for (auto _ : state) benchmark::DoNotOptimize(map->insertObservation(cloud, pose));
     const double n = double(state.iterations());
-    const VisibilityStats& vis = map->visibilityStats();
+    const VisibilityStats& vis = map->statistics().visibility;
     state.counters["returns"] = double(cloud.pointcloud->size());
-    state.counters["fused_per_scan"] = double(map->insertStats().accepted - before) / n;
+    state.counters["fused_per_scan"] = double(map->statistics().insert.accepted - before) / n;
     state.counters["rays"] = double(vis.raysCast - visBefore.raysCast) / n;
     state.counters["cells_tested"] = double(vis.cellsVisited - visBefore.cellsVisited) / n;
     state.counters["bins_removed"] = double(vis.binsRemoved - visBefore.binsRemoved) / n;
@@ -188,7 +189,8 @@ void BM_MrptRgbdFrame(benchmark::State& state) {
     pose.mean = mrpt::poses::CPose3D(0, 0, 1.5, 0, M_PI / 2, 0);
     map.insertObservation(*frame, pose);  // grows the map: not timed
     for (auto _ : state) benchmark::DoNotOptimize(map.insertObservation(*frame, pose));
-    state.counters["fused"] = double(map.insertStats().accepted) / double(state.iterations() + 1);
+    state.counters["fused"] =
+        double(map.statistics().insert.accepted) / double(state.iterations() + 1);
 }
 BENCHMARK(BM_MrptRgbdFrame)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 }  // namespace

@@ -20,7 +20,9 @@
 #include <vector>
 
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/StereoDisparity.h"
 
 using namespace multibin;
@@ -106,11 +108,11 @@ mrpt::obs::CObservationStereoImages stereoFrameOverFloor() {
 template <typename Insert>
 void runMap(benchmark::State& state, mrpt::maps::CMultiBinElevationMap& map, Insert&& insert) {
     insert();  // warm-up: grows the grid to cover the data
-    const size_t before = map.insertStats().accepted;
+    const size_t before = map.statistics().insert.accepted;
     for (auto _ : state) insert();
     state.counters["points_per_update"] =
-        double(map.insertStats().accepted - before) / double(state.iterations());
-    state.counters["bins"] = double(map.grid().binCount());
+        double(map.statistics().insert.accepted - before) / double(state.iterations());
+    state.counters["bins"] = double(multibin::MapInternals::grid(map).binCount());
 }
 
 void setVisibility(mrpt::maps::CMultiBinElevationMap& map, benchmark::State& state) {
@@ -185,9 +187,9 @@ static void BM_LaserScansMockup(benchmark::State& state) {
     size_t accepted = 0, cellsVisited = 0, rays = 0;
     for (auto _ : state) {
         const auto map = mapObservations(creation, insertion, scans);
-        accepted = map.insertStats().accepted;
-        cellsVisited = map.visibilityStats().cellsVisited;
-        rays = map.visibilityStats().raysCast;
+        accepted = map.statistics().insert.accepted;
+        cellsVisited = map.statistics().visibility.cellsVisited;
+        rays = map.statistics().visibility.raysCast;
     }
     state.counters["scans"] = double(scans.size());
     state.counters["points_per_scan"] = double(accepted) / double(scans.size());
@@ -217,7 +219,7 @@ static void BM_MockupAllObservations(benchmark::State& state) {
     insertion.loadFromConfigFile(ini, section + "insertOpts");
     size_t accepted = 0;
     for (auto _ : state)
-        accepted = mapObservations(creation, insertion, observations).insertStats().accepted;
+        accepted = mapObservations(creation, insertion, observations).statistics().insert.accepted;
     state.counters["observations"] = double(observations.size());
     state.counters["points"] = double(accepted);
 }

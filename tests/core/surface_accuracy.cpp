@@ -14,8 +14,9 @@
 #include <stdexcept>
 
 #include "SurfaceAccuracy.h"
+#include "multibin/grid/BinGrid.h"
 #include "multibin/io/EsriAsciiGrid.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 
@@ -109,7 +110,8 @@ int main(int argc, char** argv) try {
             far++;
             tooHigh += e.error_m[3] > 0;
             bool seen = false;
-            for (const multibin::BinGrid* g : {&map->grid(), &map->localGrid()})
+            for (const multibin::BinGrid* g :
+                 {&multibin::MapInternals::grid(*map), &multibin::MapInternals::localGrid(*map)})
                 g->forEachBin(g->cellIndex(e.x_m), g->cellIndex(e.y_m),
                               [&](const multibin::Bin& b) {
                                   seen |= std::abs(b.height_m - e.truth_m) < 0.02;

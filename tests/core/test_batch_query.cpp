@@ -18,8 +18,9 @@
 #include <vector>
 
 #include "mockup_map.h"
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/CellSurface.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/CellSurface.h"
+#include "multibin/map/MapInternals.h"
 
 namespace {
 using Map = mrpt::maps::CMultiBinElevationMap;
@@ -125,12 +126,13 @@ TEST(BatchQuery, ACacheNarrowerThanItsQueriesAnswersAsHeightAt) {
     queryPoints(map.getXMin(), map.getXMax(), map.getYMin(), map.getYMax(),
                 map.creationOptions.resolution_m, map.mapOrigin().x, 20000, x, y);
     const multibin::BinUpdateParams params = map.binUpdateParams();
-    multibin::HeightAtCache cache(map.grid(), nullptr, params, 0.0);
+    multibin::HeightAtCache cache(multibin::MapInternals::grid(map), nullptr, params, 0.0);
     size_t known = 0, mismatches = 0;
     for (size_t i = 0; i < x.size(); i++) {
         const double xi = x[i] - map.mapOrigin().x, yi = y[i] - map.mapOrigin().y;
         multibin::CellSurface a, b;
-        const bool haveA = multibin::heightAt(map.grid(), nullptr, xi, yi, params, true, a);
+        const bool haveA =
+            multibin::heightAt(multibin::MapInternals::grid(map), nullptr, xi, yi, params, true, a);
         const bool haveB = cache.heightAt(xi, yi, true, b);
         known += haveA;
         mismatches += haveA != haveB ||

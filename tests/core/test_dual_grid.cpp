@@ -7,7 +7,8 @@
 #include <map>
 #include <random>
 
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 
 using namespace multibin;
 using mrpt::maps::CMultiBinElevationMap;
@@ -107,15 +108,15 @@ TEST(DualGrid, RoutesBySensorAndFusesWithoutCountingTwice) {
     const auto laser = cloudAt(0.0, 0.0, -1.0, 4, "LASER");
     laser->sensorPose = mrpt::poses::CPose3D(0.5123, 0.3071, 1.0, 0, 0, 0);
     ASSERT_TRUE(map.insertObservation(*laser, exactPose(0, 0)));
-    EXPECT_FALSE(map.localGrid().empty());
-    EXPECT_TRUE(map.grid().empty());
+    EXPECT_FALSE(multibin::MapInternals::localGrid(map).empty());
+    EXPECT_TRUE(multibin::MapInternals::grid(map).empty());
     double h, sLocal;
     ASSERT_TRUE(map.cellHeight(0.5123, 0.3071, h, sLocal));
     EXPECT_NEAR(sLocal, 0.01 / 2, 1e-4);  // 4 independent points
 
     // Scroll the spot out of the local grid (written back to the global grid) and back in.
     map.recenter(4.0, 0.0);
-    EXPECT_FALSE(map.grid().empty());
+    EXPECT_FALSE(multibin::MapInternals::grid(map).empty());
 
     double hBack, sBack;
     ASSERT_TRUE(map.cellHeight(0.5123, 0.3071, hBack, sBack));
@@ -144,15 +145,20 @@ TEST(DualGrid, GridsFollowTheRobot) {
         map.insertObservation(*laser, exactPose(x, 0.0123));
     // The local grid is 2 m around the robot, centred on its last position, x = 19.5123; the
     // global one covers 10 m around every position along the route.
-    EXPECT_NEAR(0.5 * (map.localGrid().window().ix0 * 0.015 +
-                       (map.localGrid().window().ix0 + map.localGrid().window().nx) * 0.015),
+    EXPECT_NEAR(0.5 * (multibin::MapInternals::localGrid(map).window().ix0 * 0.015 +
+                       (multibin::MapInternals::localGrid(map).window().ix0 +
+                        multibin::MapInternals::localGrid(map).window().nx) *
+                           0.015),
                 19.5123, 0.02);
     double h, s;
-    EXPECT_TRUE(map.cellHeight(16.0123, 0.0123, h, s));   // written back, in the global grid
-    EXPECT_TRUE(map.cellHeight(0.5123, 0.0123, h, s));  // the start: the global grid keeps it
-    EXPECT_FALSE(map.cellHeight(0.5123, 3.0, h, s));   // never seen
-    EXPECT_LE(map.grid().window().ix0 * 0.05, -5.0 + 0.1);
-    EXPECT_GE((map.grid().window().ix0 + map.grid().window().nx) * 0.05, 19.5 + 5.0 - 0.1);
-    EXPECT_TRUE(map.cellHeight(19.5123, 0.0123, h, s));   // in the local grid
-    EXPECT_LE(map.localGrid().binCount(), 3u);
+    EXPECT_TRUE(map.cellHeight(16.0123, 0.0123, h, s));  // written back, in the global grid
+    EXPECT_TRUE(map.cellHeight(0.5123, 0.0123, h, s));   // the start: the global grid keeps it
+    EXPECT_FALSE(map.cellHeight(0.5123, 3.0, h, s));     // never seen
+    EXPECT_LE(multibin::MapInternals::grid(map).window().ix0 * 0.05, -5.0 + 0.1);
+    EXPECT_GE((multibin::MapInternals::grid(map).window().ix0 +
+               multibin::MapInternals::grid(map).window().nx) *
+                  0.05,
+              19.5 + 5.0 - 0.1);
+    EXPECT_TRUE(map.cellHeight(19.5123, 0.0123, h, s));  // in the local grid
+    EXPECT_LE(multibin::MapInternals::localGrid(map).binCount(), 3u);
 }

@@ -6,6 +6,7 @@
 #include <mrpt/serialization/CArchive.h>
 
 #include <cmath>
+#include "multibin/map/MapInternals.h"
 
 namespace {
 using Map = mrpt::maps::CMultiBinElevationMap;
@@ -64,7 +65,7 @@ TEST(LoadedMap, AnswersFilledCellsWithoutDemUpdateMap) {
     EXPECT_DOUBLE_EQ(z, h0);
     ASSERT_TRUE(loaded.dem_get_z_by_cell(10, 10, zc));
     EXPECT_DOUBLE_EQ(zc, h0);
-    EXPECT_FALSE(loaded.fillIsStale());
+    EXPECT_FALSE(multibin::MapInternals::fillIsStale(loaded));
 }
 
 // A loaded map that then receives data is an ordinary map again: its fill follows
@@ -76,7 +77,7 @@ TEST(LoadedMap, AfterAnInsertionTheFillIsExplicitAgain) {
     ASSERT_TRUE(loaded.insertIndividualPoint(0.025, 0.025, 0.0025, p));
     double h, s;
     EXPECT_EQ(loaded.getElevation(0.525, 0.525, h, s), Map::HeightSource::Unknown);
-    EXPECT_TRUE(loaded.fillIsStale());
+    EXPECT_TRUE(multibin::MapInternals::fillIsStale(loaded));
     loaded.dem_update_map();
     EXPECT_NE(loaded.getElevation(0.525, 0.525, h, s), Map::HeightSource::Unknown);
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapInternals.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 using Source = CMultiBinElevationMap::HeightSource;
@@ -31,9 +32,9 @@ TEST(MapFill, FillingIsLazyAndFilledCellsAreMarked) {
     const double hx = 0.51, hy = 0.51;  // the hole's centre cell
     double z, s;
     EXPECT_FALSE(map.dem_get_z(hx, hy, z)) << "nothing is filled before dem_update_map()";
-    EXPECT_TRUE(map.fillIsStale());
+    EXPECT_TRUE(multibin::MapInternals::fillIsStale(map));
     map.dem_update_map();
-    EXPECT_FALSE(map.fillIsStale());
+    EXPECT_FALSE(multibin::MapInternals::fillIsStale(map));
     ASSERT_TRUE(map.dem_get_z(hx, hy, z));
     EXPECT_NEAR(z, 0.1, 1e-4);
     EXPECT_EQ(map.getElevation(hx, hy, z, s), Source::FilledMedian);
@@ -58,7 +59,7 @@ TEST(MapFill, FillingIsLazyAndFilledCellsAreMarked) {
     CMultiBinElevationMap::TPointInsertParams ip;
     ip.pt_z_std = 0.003;
     map.insertIndividualPoint(hx, hy, 0.3, ip);
-    EXPECT_TRUE(map.fillIsStale());
+    EXPECT_TRUE(multibin::MapInternals::fillIsStale(map));
     EXPECT_EQ(map.getElevation(hx, hy, z, s), Source::Measured);
     EXPECT_NEAR(z, 0.3, 1e-6);
 }

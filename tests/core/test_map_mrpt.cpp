@@ -19,7 +19,8 @@
 #include <random>
 
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 #include "multibin/map/MapStatistics.h"
 #include "test_scenes.h"
 
@@ -154,13 +155,13 @@ TEST(CMultiBinElevationMap, PitchedLaserOverFloorGivesFlatMapWithHonestSigma) {
     CPose3DPDFGaussian pose =
         poseWithCov(CPose3D(0, 0, 0, 0, 0, 0), {1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4});
     ASSERT_TRUE(map.insertObservation(*scan, pose));
-    EXPECT_GT(map.insertStats().accepted, 300u);
+    EXPECT_GT(map.statistics().insert.accepted, 300u);
     double h, s;
     ASSERT_TRUE(map.getHeight(0.26, 0.0, h, s));  // straight ahead, 0.26 m at 45 deg
     EXPECT_NEAR(h, 0.0, 0.001);
     EXPECT_GE(s, map.insertionOptions.height_sigma_floor_m - 1e-9);
     EXPECT_FALSE(map.getHeight(-0.5, 0.0, h, s));  // behind the robot: never seen
-    EXPECT_EQ(map.poseFallbackCount(), 0u);
+    EXPECT_EQ(map.statistics().poseFallbacks, 0u);
 }
 
 TEST(CMultiBinElevationMap, ExactAndPartlyExactPosesAreFusedIndefiniteOnesRejected) {
@@ -174,7 +175,7 @@ TEST(CMultiBinElevationMap, ExactAndPartlyExactPosesAreFusedIndefiniteOnesReject
         CPose3DPDFGaussian pose;
         pose.cov = cov;
         map.insertObservation(*scan, pose);
-        stats = map.insertStats();
+        stats = map.statistics().insert;
         double h = NAN, s;
         map.getHeight(0.26, 0.0, h, s);
         return h;
@@ -214,7 +215,7 @@ TEST(CMultiBinElevationMap, UsesLatestRobotPoseCovarianceWhileFresh) {
     scan->timestamp = mrpt::Clock::fromDouble(100.1);
     map.insertObservation(*robotPose);
     ASSERT_TRUE(map.insertObservation(*scan, CPose3D()));
-    EXPECT_EQ(map.poseFallbackCount(), 0u);
+    EXPECT_EQ(map.statistics().poseFallbacks, 0u);
     double h, sFresh;
     ASSERT_TRUE(map.cellHeight(0.26, 0.0, h, sFresh));
     // sigma_z of the robot pose is 20 mm; one scan's points are fused as independent, so the
@@ -226,7 +227,7 @@ TEST(CMultiBinElevationMap, UsesLatestRobotPoseCovarianceWhileFresh) {
     scan->timestamp = mrpt::Clock::fromDouble(101.0);  // 0.9 s > robot_pose_max_dt
     map2.insertObservation(*robotPose);
     ASSERT_TRUE(map2.insertObservation(*scan, CPose3D()));
-    EXPECT_EQ(map2.poseFallbackCount(), 1u);
+    EXPECT_EQ(map2.statistics().poseFallbacks, 1u);
     double sStale;
     ASSERT_TRUE(map2.cellHeight(0.26, 0.0, h, sStale));
     // sigma_z: about 10.4 mm with the default covariance against 20 mm with the robot pose's.
@@ -241,7 +242,7 @@ TEST(CMultiBinElevationMap, SerializationRoundTripIsBitExactThroughClassRegistry
     for (int k = 0; k < 5; k++)
         map.insertObservation(*scan, poseWithCov(CPose3D(0.05 * k, 0, 0.01 * k, 0.1 * k, 0, 0),
                                                  {1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3}));
-    ASSERT_GT(map.grid().binCount(), 100u);
+    ASSERT_GT(multibin::MapInternals::grid(map).binCount(), 100u);
     const std::vector<uint8_t> bytes = serialize(map);
 
     mrpt::io::CMemoryStream buf;
@@ -251,13 +252,14 @@ TEST(CMultiBinElevationMap, SerializationRoundTripIsBitExactThroughClassRegistry
     const auto copy = std::dynamic_pointer_cast<CMultiBinElevationMap>(obj);
     ASSERT_TRUE(copy);
     EXPECT_EQ(serialize(*copy), bytes);
-    EXPECT_EQ(copy->grid().binCount(), map.grid().binCount());
+    EXPECT_EQ(multibin::MapInternals::grid(*copy).binCount(),
+              multibin::MapInternals::grid(map).binCount());
     EXPECT_EQ(copy->insertionOptions.sensor_labels, map.insertionOptions.sensor_labels);
-    const auto& w = map.grid().window();
+    const auto& w = multibin::MapInternals::grid(map).window();
     for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
         for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
-            const auto* a = map.grid().winningBin(ix, iy);
-            const auto* b = copy->grid().winningBin(ix, iy);
+            const auto* a = multibin::MapInternals::grid(map).winningBin(ix, iy);
+            const auto* b = multibin::MapInternals::grid(*copy).winningBin(ix, iy);
             ASSERT_EQ(a == nullptr, b == nullptr);
             if (a) {
                 EXPECT_EQ(a->height_m, b->height_m);
@@ -413,9 +415,9 @@ TEST(CMultiBinElevationMap, PointCloudObservationAndGrowth) {
     EXPECT_NEAR(map.getXMax() - map.getXMin(), 5.0, 0.1);
     // 15 m away: with the default pose covariance too uncertain (3 sigma_z ~ 0.2 m > 0.1 m),
     // which is what it is counted as, wherever it lies; it does not grow the window.
-    EXPECT_EQ(map.insertStats().tooUncertain, 1u);
-    EXPECT_EQ(map.insertStats().outsideMap, 0u);
-    EXPECT_EQ(map.insertStats().outOfRange, 1u);  // 50 m away: beyond max_range
+    EXPECT_EQ(map.statistics().insert.tooUncertain, 1u);
+    EXPECT_EQ(map.statistics().insert.outsideMap, 0u);
+    EXPECT_EQ(map.statistics().insert.outOfRange, 1u);  // 50 m away: beyond max_range
 }
 
 // statistics(): one snapshot of every count, each part from its own counter (distinct counts, so
@@ -457,12 +459,12 @@ TEST(CMultiBinElevationMap, StatisticsSnapshotHoldsEveryCountOnce) {
     EXPECT_EQ(s.sensorModels.depth.points, 2u * (21 * 21 + 2));  // a cloud: the depth model
     EXPECT_GT(s.visibility.raysCast, 0u);
     // The deprecated accessors: the snapshot's parts.
-    EXPECT_EQ(map.insertStats().accepted, s.insert.accepted);
-    EXPECT_EQ(map.visibilityStats().raysCast, s.visibility.raysCast);
-    EXPECT_EQ(map.sensorModelStats().depth.kept, s.sensorModels.depth.kept);
-    EXPECT_EQ(map.poseFallbackCount(), 2u);
-    EXPECT_EQ(map.skippedByLabelCount(), 1u);
-    EXPECT_EQ(map.nonFinitePoseCount(), 3u);
+    EXPECT_EQ(map.statistics().insert.accepted, s.insert.accepted);
+    EXPECT_EQ(map.statistics().visibility.raysCast, s.visibility.raysCast);
+    EXPECT_EQ(map.statistics().sensorModels.depth.kept, s.sensorModels.depth.kept);
+    EXPECT_EQ(map.statistics().poseFallbacks, 2u);
+    EXPECT_EQ(map.statistics().skippedByLabel, 1u);
+    EXPECT_EQ(map.statistics().nonFinitePoses, 3u);
 
     map.clear();
     const multibin::MapStatistics z = map.statistics();
@@ -498,10 +500,10 @@ TEST(CMultiBinElevationMap, GrowsForOnePointJustOutsideAmongManyInside) {
         const size_t at = size_t(k) * 50 + 7;
         const double robotX_m = xMax - 1.0;  // the edge 1 m ahead, well within the reach
         points[at].x() = float(xMax + 0.001 - robotX_m);  // just beyond the east edge
-        const size_t outsideBefore = map.insertStats().outsideMap;
+        const size_t outsideBefore = map.statistics().insert.outsideMap;
         ASSERT_TRUE(map.insertObservation(*cloud(points), CPose3D(robotX_m, 0, 0, 0, 0, 0)));
         EXPECT_GT(map.getXMax(), xMax) << "insertion " << k;
-        EXPECT_EQ(map.insertStats().outsideMap, outsideBefore) << "insertion " << k;
+        EXPECT_EQ(map.statistics().insert.outsideMap, outsideBefore) << "insertion " << k;
     }
     const double xMax = map.getXMax();
     std::vector<Eigen::Vector3f> far(300, Eigen::Vector3f(0.f, 0.f, -1.f));

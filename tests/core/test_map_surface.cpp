@@ -3,11 +3,10 @@
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
 #include <cmath>
-#include "multibin/io/EsriAsciiGrid.h"
-#include "multibin/map/BinGrid.h"
 
+#include "multibin/grid/BinGrid.h"
 #include "multibin/io/EsriAsciiGrid.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 #include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
@@ -91,6 +90,7 @@ TEST(CellSurface, EveryLayerDescribesTheSameSurface) {
     EXPECT_FLOAT_EQ(map.toRaster(Layer::Height).heights_m(5, 5), float(h));
     EXPECT_FLOAT_EQ(map.toRaster(Layer::Sigma).heights_m(5, 5), float(s));
     EXPECT_FLOAT_EQ(map.toRaster(Layer::Certainty).heights_m(5, 5), 6.f);
-    ASSERT_NE(map.grid().winningBin(5, 5), nullptr);
-    EXPECT_FLOAT_EQ(map.grid().winningBin(5, 5)->certainty, 3.f) << "the case the test is about";
+    ASSERT_NE(multibin::MapInternals::grid(map).winningBin(5, 5), nullptr);
+    EXPECT_FLOAT_EQ(multibin::MapInternals::grid(map).winningBin(5, 5)->certainty, 3.f)
+        << "the case the test is about";
 }

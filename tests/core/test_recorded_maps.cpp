@@ -24,7 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 
 namespace {
 
@@ -95,7 +96,7 @@ void expectRecordedMap(const Recorded& r) {
     map->insertSimpleMapWithPosePdfs(simplemap);
     ASSERT_FALSE(map->isDualGrid()) << "the shipped scenarios map into one grid";
     size_t bins = 0;
-    const uint64_t digest = binDigest(map->grid(), bins);
+    const uint64_t digest = binDigest(multibin::MapInternals::grid(*map), bins);
     EXPECT_EQ(bins, r.bins) << s;
     EXPECT_EQ(digest, r.digest) << s << ": the map moved; digest now 0x" << std::hex << digest;
 }

@@ -9,7 +9,7 @@
 #include <random>
 
 #include "SurfaceAccuracy.h"
-#include "multibin/map/BinUpdate.h"
+#include "multibin/grid/BinUpdate.h"
 #include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;

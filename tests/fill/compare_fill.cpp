@@ -32,6 +32,7 @@
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/Kriging.h"
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapInternals.h"
 
 using namespace multibin;
 using namespace multibin::fill;
@@ -411,7 +412,7 @@ int mapper(const std::string& mapPath, const std::string& truthPath) {
     }
     map.insertionOptions.fill = g_base;
     map.dem_update_map();
-    const FillResult& fill = map.lastFill();
+    const FillResult& fill = multibin::MapInternals::lastFill(map);
     std::map<HeightSource, std::vector<Err>> bySource;
     // FILL_DUMP=FILE: every filled cell as "column row height sigma truth source" [m], to look at.
     std::FILE* dump =

@@ -21,6 +21,7 @@
 #include "multibin/eval/Evaluation.h"
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapInternals.h"
 
 namespace {
 
@@ -44,7 +45,7 @@ std::map<multibin::HeightSource, Coverage> filledOnlyCoverage(const std::string&
     mrpt::serialization::archiveFrom(f) >> sm;
     map.insertSimpleMapWithPosePdfs(sm);
     map.dem_update_map();
-    const multibin::fill::FillResult& fill = map.lastFill();
+    const multibin::fill::FillResult& fill = multibin::MapInternals::lastFill(map);
 
     std::map<multibin::HeightSource, Coverage> out;
     multibin::filltest::forEachFilledCellWithTruth(

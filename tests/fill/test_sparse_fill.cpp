@@ -19,8 +19,9 @@
 #include "SurfaceTexture.h"
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/SparseFill.h"
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/CellSurface.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/CellSurface.h"
+#include "multibin/map/MapInternals.h"
 
 using multibin::CellWindow;
 using multibin::HeightSource;
@@ -132,7 +133,7 @@ TEST(SparseFill, SameAsTheWholeWindowOnTheShippedMockupAndWalkMaps) {
         map.dem_update_map();
         const FillResult dense =
             multibin::fill::fillGaps(in.toRaster(in.lattice.window), map.insertionOptions.fill);
-        ASSERT_EQ(map.lastFill().source, dense.source) << scenario;
+        ASSERT_EQ(multibin::MapInternals::lastFill(map).source, dense.source) << scenario;
     }
 }
 
@@ -143,7 +144,7 @@ TEST(SparseFill, FillInputHoldsEveryMeasuredCellOfTheWindowWithOneGridOrTwo) {
         mrpt::maps::CMultiBinElevationMap map;
         mapScenario("mockup", map, dual);
         const SparseHeights in = map.fillInput();
-        const multibin::BinGrid& g = map.grid();
+        const multibin::BinGrid& g = multibin::MapInternals::grid(map);
         const CellWindow& w = g.window();
         ASSERT_EQ(in.lattice.window, w);
         size_t measured = 0, differ = 0;
@@ -151,8 +152,9 @@ TEST(SparseFill, FillInputHoldsEveryMeasuredCellOfTheWindowWithOneGridOrTwo) {
             for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++) {
                 multibin::CellSurface c;
                 const bool known = multibin::surfaceAt(
-                    g, dual ? &map.localGrid() : nullptr, g.cellCenter_m(ix), g.cellCenter_m(iy),
-                    map.binUpdateParams(), map.insertionOptions.relief_sigma, c);
+                    g, dual ? &multibin::MapInternals::localGrid(map) : nullptr, g.cellCenter_m(ix),
+                    g.cellCenter_m(iy), map.binUpdateParams(), map.insertionOptions.relief_sigma,
+                    c);
                 measured += known;
                 const auto& m = in.cells.get(ix, iy);
                 differ += known != in.isMeasured(ix, iy) ||

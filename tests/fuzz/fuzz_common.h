@@ -15,7 +15,8 @@
 #include <cstring>
 #include <string>
 #include <vector>
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 
 namespace fuzz {
 
@@ -70,7 +71,8 @@ inline std::vector<uint8_t> serialize(const mrpt::maps::CMultiBinElevationMap& m
  * bin's sigma (what getHeight() reports) finite and >= 0. */
 inline void checkInvariants(const mrpt::maps::CMultiBinElevationMap& map) {
     // Over the stored bins, tile by tile: a window grown by a far pose is mostly empty.
-    for (const multibin::BinGrid* g : {&map.grid(), &map.localGrid()})
+    for (const multibin::BinGrid* g :
+         {&multibin::MapInternals::grid(map), &multibin::MapInternals::localGrid(map)})
         g->store().forEachStoredBin([&](int ix, int iy, const multibin::Bin& b) {
             if (!g->window().contains(ix, iy)) fail("bin outside the window");
             if (!std::isfinite(b.height_m)) fail("bin height not finite");

@@ -19,7 +19,8 @@
 
 #include "../core/test_files.h"
 #include "../core/test_scenes.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 #include "multibin/sensors/StereoDisparity.h"
 
 #if defined(__has_feature)
@@ -76,7 +77,8 @@ using BinRecord = std::tuple<int, int, int, int, float, float, float, uint32_t>;
 inline std::vector<BinRecord> content(const Map& map) {
     std::vector<BinRecord> out;
     int gi = 0;
-    for (const multibin::BinGrid* g : {&map.grid(), &map.localGrid()}) {
+    for (const multibin::BinGrid* g :
+         {&multibin::MapInternals::grid(map), &multibin::MapInternals::localGrid(map)}) {
         // Tile by tile: a window grown by a far pose is mostly empty.
         g->store().forEachStoredBin([&](int ix, int iy, const multibin::Bin& b) {
             out.emplace_back(gi, ix, iy, b.index, b.height_m, b.variance_m2, b.certainty,

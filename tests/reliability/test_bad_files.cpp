@@ -14,7 +14,7 @@
 #include <iterator>
 #include <sstream>
 
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
 #include "reliability_helpers.h"
 
 namespace fs = std::filesystem;
@@ -201,7 +201,7 @@ TEST(BadInputFiles, SerializedMapWithCorruptGridIsRejected) {
     auto bytes = serialize(mapWithData(c));
     // The grid follows the options text; its window is the first 16 bytes after it. Find the
     // window by its known values.
-    const multibin::CellWindow w = mapWithData(c).grid().window();
+    const multibin::CellWindow w = multibin::MapInternals::grid(mapWithData(c)).window();
     std::vector<uint8_t> pattern(16);
     const int32_t win[4] = {w.ix0, w.iy0, w.nx, w.ny};
     std::memcpy(pattern.data(), win, 16);

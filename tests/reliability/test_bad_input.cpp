@@ -15,7 +15,9 @@
 #include <string>
 #include <tuple>
 
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorDispatch.h"
 #include "multibin/sensors/StereoDisparity.h"
 #include "reliability_helpers.h"
@@ -63,13 +65,13 @@ struct Counted {
 Counted insertIntoMapWithData(const mrpt::obs::CObservation& obs) {
     Map map = mapWithData();
     const auto before = serialize(map);
-    const auto core0 = map.insertStats();
-    const auto sensors0 = map.sensorModelStats();
+    const auto core0 = map.statistics().insert;
+    const auto sensors0 = map.statistics().sensorModels;
     EXPECT_FALSE(map.insertObservation(obs, posePdf()));
     EXPECT_EQ(serialize(map), before) << "a rejected observation changed the map";
-    const auto& c = map.insertStats();
-    const auto& l = map.sensorModelStats().laser;
-    const auto& d = map.sensorModelStats().depth;
+    const auto& c = map.statistics().insert;
+    const auto& l = map.statistics().sensorModels.laser;
+    const auto& d = map.statistics().sensorModels.depth;
     Counted out;
     out.core.accepted = c.accepted - core0.accepted;
     out.core.outOfRange = c.outOfRange - core0.outOfRange;
@@ -139,7 +141,7 @@ TEST(BadInputRanges, BadBeamsAmongGoodOnesLeaveTheGoodOnes) {
     const size_t noReturnBefore = [] {
         Map m;
         m.insertObservation(*floorScan(), posePdf());
-        return m.sensorModelStats().laser.noReturn;
+        return m.statistics().sensorModels.laser.noReturn;
     }();
     size_t nonFinite = 0, negative = 0;
     for (size_t i = 0, k = 0; i < scan->getScanSize(); i += 3, k++) {
@@ -154,8 +156,8 @@ TEST(BadInputRanges, BadBeamsAmongGoodOnesLeaveTheGoodOnes) {
     }
     Map map;
     EXPECT_TRUE(map.insertObservation(*scan, posePdf()));
-    EXPECT_EQ(map.sensorModelStats().laser.notFinite, nonFinite);
-    EXPECT_EQ(map.sensorModelStats().laser.noReturn, noReturnBefore + negative);
+    EXPECT_EQ(map.statistics().sensorModels.laser.notFinite, nonFinite);
+    EXPECT_EQ(map.statistics().sensorModels.laser.noReturn, noReturnBefore + negative);
     double h;
     ASSERT_TRUE(floorHeightAt(map, 0, 0, h));
     EXPECT_NEAR(h, 0.0, 0.01);  // the floor, from the good beams
@@ -209,10 +211,10 @@ TEST(BadInputScans, AnApertureThatIsNaNZeroOrOverATurnIsAnErrorAndCounted) {
         scan->aperture = float(aperture);
         Map map = mapWithData();
         const auto before = serialize(map);
-        const size_t refused0 = map.sensorModelStats().laser.badAperture;
+        const size_t refused0 = map.statistics().sensorModels.laser.badAperture;
         expectErrorMentioning([&] { map.insertObservation(*scan, posePdf()); },
                               {"LASER", "aperture"});
-        EXPECT_EQ(map.sensorModelStats().laser.badAperture - refused0, 50u);
+        EXPECT_EQ(map.statistics().sensorModels.laser.badAperture - refused0, 50u);
         EXPECT_EQ(serialize(map), before);
     }
     // A full turn is a valid aperture.
@@ -220,7 +222,7 @@ TEST(BadInputScans, AnApertureThatIsNaNZeroOrOverATurnIsAnErrorAndCounted) {
     scan->aperture = float(2 * M_PI);
     Map map = mapWithData();
     EXPECT_NO_THROW(map.insertObservation(*scan, posePdf()));
-    EXPECT_EQ(map.sensorModelStats().laser.badAperture, 0u);
+    EXPECT_EQ(map.statistics().sensorModels.laser.badAperture, 0u);
 }
 
 // Found by this test (was an out-of-bounds read of points3D_y/z); fixed in DepthModel.cpp.
@@ -268,7 +270,7 @@ TEST(BadInputPose, NaNInThePoseMeanIsAnErrorNamingTheObservation) {
     expectErrorMentioning([&] { map.insertObservation(*floorScan(), pdf); }, {"LASER", "NaN"});
     expectErrorMentioning([&] { map.insertObservation(*floorScan(), pdf.mean); }, {"LASER", "NaN"});
     EXPECT_EQ(serialize(map), before);
-    EXPECT_EQ(map.nonFinitePoseCount(), 2u);  // refused and counted
+    EXPECT_EQ(map.statistics().nonFinitePoses, 2u);  // refused and counted
 }
 
 TEST(BadInputPose, NaNInThePoseCovarianceRejectsEveryPoint) {
@@ -276,10 +278,10 @@ TEST(BadInputPose, NaNInThePoseCovarianceRejectsEveryPoint) {
     pdf.cov(2, 2) = std::numeric_limits<double>::quiet_NaN();
     Map map = mapWithData();
     const auto before = serialize(map);
-    const size_t notFinite0 = map.insertStats().notFinite;
+    const size_t notFinite0 = map.statistics().insert.notFinite;
     // Every point's covariance is NaN: each is counted as non-finite, none reaches a bin.
     EXPECT_FALSE(map.insertObservation(*floorScan(), pdf));
-    EXPECT_EQ(map.insertStats().notFinite - notFinite0, kFloorReturns);
+    EXPECT_EQ(map.statistics().insert.notFinite - notFinite0, kFloorReturns);
     EXPECT_EQ(serialize(map), before);
 }
 
@@ -289,7 +291,7 @@ TEST(BadInputPose, NonPositiveDefinitePoseCovarianceRejectsEveryPoint) {
     Map map = mapWithData();
     const auto before = serialize(map);
     EXPECT_FALSE(map.insertObservation(*floorScan(), pdf));
-    EXPECT_EQ(map.insertStats().badCovariance, kFloorReturns);
+    EXPECT_EQ(map.statistics().insert.badCovariance, kFloorReturns);
     EXPECT_EQ(serialize(map), before);
 }
 
@@ -301,7 +303,7 @@ TEST(BadInputPose, NonSymmetricPoseCovarianceIsRejected) {
     Map map = mapWithData();
     const auto before = serialize(map);
     EXPECT_FALSE(map.insertObservation(*floorScan(), pdf));
-    EXPECT_EQ(map.insertStats().badCovariance, kFloorReturns);
+    EXPECT_EQ(map.statistics().insert.badCovariance, kFloorReturns);
     EXPECT_EQ(serialize(map), before);
 }
 
@@ -348,19 +350,19 @@ TEST(BadInputExtent, AGrowingMapHoldsEveryPointAndAFixedWindowCountsTheRest) {
         c.resolution_m = resolution_m;
         Map map(c);
         map.insertObservation(*floorScan(), posePdf());
-        const multibin::InsertStats& s = map.insertStats();
+        const multibin::InsertStats& s = map.statistics().insert;
         EXPECT_GT(s.accepted, 0u);
         EXPECT_EQ(s.outsideMap, 0u);
-        EXPECT_EQ(s.accepted, map.sensorModelStats().laser.kept);
+        EXPECT_EQ(s.accepted, map.statistics().sensorModels.laser.kept);
     }
     Map::TCreationOptions far = fixedTwoMetreMap();
     far.resolution_m = 30;
     far.min_x = 5e7, far.max_x = 5e7 + 1;  // within the +-1e8 m of map coordinates
     Map map(far);
     map.insertObservation(*floorScan(), posePdf());
-    EXPECT_EQ(map.insertStats().accepted, 0u);
-    EXPECT_EQ(map.insertStats().outsideMap, map.sensorModelStats().laser.kept);
-    EXPECT_GT(map.insertStats().outsideMap, 0u);
+    EXPECT_EQ(map.statistics().insert.accepted, 0u);
+    EXPECT_EQ(map.statistics().insert.outsideMap, map.statistics().sensorModels.laser.kept);
+    EXPECT_GT(map.statistics().insert.outsideMap, 0u);
 }
 
 // A stray return 1000 km ahead: beyond max_range_m it is counted out of range and the window
@@ -368,29 +370,32 @@ TEST(BadInputExtent, AGrowingMapHoldsEveryPointAndAFixedWindowCountsTheRest) {
 // directory's entries, not by the 1000 km (a dense grid of that window: 5e10 cells).
 TEST(BadInputExtent, AStrayFarPointCostsATileNotItsDistance) {
     Map map = mapWithData();
-    const multibin::CellWindow w = map.grid().window();
-    const size_t bytes0 = map.grid().memoryBytes();
+    const multibin::CellWindow w = multibin::MapInternals::grid(map).window();
+    const size_t bytes0 = multibin::MapInternals::grid(map).memoryBytes();
     auto obs = mrpt::obs::CObservationPointCloud::Create();
     obs->sensorLabel = "CLOUD";
     auto pts = mrpt::maps::CSimplePointsMap::Create();
     pts->insertPoint(1e6f, 0, -0.3f);
     obs->pointcloud = pts;
-    const size_t outOfRange0 = map.insertStats().outOfRange;
+    const size_t outOfRange0 = map.statistics().insert.outOfRange;
     map.insertObservation(*obs, posePdf());
-    EXPECT_TRUE(map.grid().window() == w);
-    EXPECT_EQ(map.insertStats().outOfRange - outOfRange0, 1u);
+    EXPECT_TRUE(multibin::MapInternals::grid(map).window() == w);
+    EXPECT_EQ(map.statistics().insert.outOfRange - outOfRange0, 1u);
     map.insertionOptions.max_range_m = 1e7;                  // the point passes the sensor model
     map.insertionOptions.max_elevation_uncertainty_m = 1e5;  // and eq 13: sigma_z is ~1 km
     map.insertionOptions.default_pose_sigmas = {0, 0, 0, 0, 0, 0};
-    const size_t accepted0 = map.insertStats().accepted;
+    const size_t accepted0 = map.statistics().insert.accepted;
     map.insertObservation(*obs, mrpt::poses::CPose3D());
-    EXPECT_EQ(map.insertStats().accepted - accepted0, 1u)
-        << "too uncertain " << map.insertStats().tooUncertain << ", outside map "
-        << map.insertStats().outsideMap << ", not finite " << map.insertStats().notFinite
-        << ", bad covariance " << map.insertStats().badCovariance << ", out of range "
-        << map.insertStats().outOfRange;
-    EXPECT_GT(map.grid().window().ix0 + map.grid().window().nx, w.ix0 + w.nx + 1000000);
-    EXPECT_LT(map.grid().memoryBytes() - bytes0, size_t(1) << 20);
+    EXPECT_EQ(map.statistics().insert.accepted - accepted0, 1u)
+        << "too uncertain " << map.statistics().insert.tooUncertain << ", outside map "
+        << map.statistics().insert.outsideMap << ", not finite "
+        << map.statistics().insert.notFinite << ", bad covariance "
+        << map.statistics().insert.badCovariance << ", out of range "
+        << map.statistics().insert.outOfRange;
+    EXPECT_GT(multibin::MapInternals::grid(map).window().ix0 +
+                  multibin::MapInternals::grid(map).window().nx,
+              w.ix0 + w.nx + 1000000);
+    EXPECT_LT(multibin::MapInternals::grid(map).memoryBytes() - bytes0, size_t(1) << 20);
 }
 
 TEST(BadInputExtent, ARobotPoseFarAwayKeepsTheDataAlreadyMapped) {
@@ -399,10 +404,10 @@ TEST(BadInputExtent, ARobotPoseFarAwayKeepsTheDataAlreadyMapped) {
     // must stay.
     Map map = mapWithData();
     const auto before = serialize(map);
-    const size_t outside0 = map.insertStats().outsideMap;
+    const size_t outside0 = map.statistics().insert.outsideMap;
     EXPECT_FALSE(map.insertObservation(*floorScan(), posePdf(1e12, -1e12)));
     EXPECT_EQ(serialize(map), before);  // window included: the grid did not jump there
-    EXPECT_EQ(map.insertStats().outsideMap - outside0, kFloorReturns);
+    EXPECT_EQ(map.statistics().insert.outsideMap - outside0, kFloorReturns);
     double h;
     EXPECT_TRUE(floorHeightAt(map, 0, 0, h));
 }
@@ -507,8 +512,8 @@ TEST(BadInputStereo, NonFiniteOrAbsurdIntrinsicsAreAnErrorAndCounted) {
         Map map = mapWithData();
         const auto before = serialize(map);
         expectErrorMentioning([&] { map.insertObservation(*obs, posePdf()); }, {what});
-        EXPECT_EQ(map.sensorModelStats().stereo.badCalibration, 1u);
-        EXPECT_EQ(map.sensorModelStats().stereo.pixels, 0u) << "no pixel is visited";
+        EXPECT_EQ(map.statistics().sensorModels.stereo.badCalibration, 1u);
+        EXPECT_EQ(map.statistics().sensorModels.stereo.pixels, 0u) << "no pixel is visited";
         EXPECT_EQ(serialize(map), before);
     }
     auto obs = stereoPair(32, 24);
@@ -522,12 +527,13 @@ TEST(BadInputStereo, MatchingSizesAreInserted) {
     // The control case: the same pair with matching sizes does reach the map.
     Map map;
     EXPECT_TRUE(map.insertObservation(*stereoPair(32, 24), posePdf()));
-    const auto& st = map.sensorModelStats().stereo;
-    EXPECT_GT(map.insertStats().accepted, 0u)
+    const auto& st = map.statistics().sensorModels.stereo;
+    EXPECT_GT(map.statistics().insert.accepted, 0u)
         << "pixels " << st.pixels << " noDisparity " << st.noDisparity << " halo " << st.halo
         << " near " << st.nearCluster << " tooNear " << st.tooNear << " outOfRange "
         << st.outOfRange << " kept " << st.kept << "; core rejected "
-        << map.insertStats().rejected() << " too uncertain " << map.insertStats().tooUncertain;
+        << map.statistics().insert.rejected() << " too uncertain "
+        << map.statistics().insert.tooUncertain;
 }
 
 // ---------------------------------------------------------------------------------------------

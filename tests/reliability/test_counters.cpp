@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <limits>
 
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/BinUpdate.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/BinUpdate.h"
 #include "multibin/sensors/SensorStats.h"
 #include "multibin/util/Counters.h"
 

@@ -21,6 +21,7 @@
 #include <limits>
 
 #include "multibin/io/ErrorMessage.h"
+#include "multibin/map/MapStatistics.h"
 #include "reliability_helpers.h"
 
 namespace fs = std::filesystem;
@@ -177,7 +178,7 @@ TEST(OptionsMisuse, ARobotPoseFromTheFarPastIsNotFresh) {
     scan->timestamp = mrpt::Clock::time_point(
         mrpt::Clock::duration(std::numeric_limits<mrpt::Clock::rep>::max() - 5));
     map.insertObservation(*scan);
-    EXPECT_EQ(map.poseFallbackCount(), 1u) << "a pose 2^64 ticks old was taken as fresh";
+    EXPECT_EQ(map.statistics().poseFallbacks, 1u) << "a pose 2^64 ticks old was taken as fresh";
 }
 
 // multiBinElevationMap_count = -1 or 100000 took 9-23 GB inside MRPT's initializers.

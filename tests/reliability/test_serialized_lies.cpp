@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "multibin/map/MapInternals.h"
 #include "reliability_helpers.h"
 
 using namespace reliability;
@@ -124,7 +125,7 @@ void expectRefused(const LyingMap& m, const std::string& what) {
 TEST(SerializedLies, AnHonestPayloadWrittenTheSameWayLoads) {
     Map map;
     deserializeInto(map, serialized(LyingMap{}));
-    EXPECT_EQ(map.grid().binCount(), 2u);
+    EXPECT_EQ(multibin::MapInternals::grid(map).binCount(), 2u);
 }
 
 // A window index near 2^31: ix0 + nx overflowed int, and the map spanned x 4.29e7 to -4.29e7.
@@ -193,7 +194,7 @@ TEST(SerializedLies, TheShippedScenariosMapsLoad) {
         auto arch = mrpt::serialization::archiveFrom(in);
         Map map;
         EXPECT_NO_THROW(arch >> map);
-        EXPECT_GT(map.grid().binCount(), 1000u);
+        EXPECT_GT(multibin::MapInternals::grid(map).binCount(), 1000u);
     }
 }
 #endif

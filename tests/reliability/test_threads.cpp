@@ -117,9 +117,9 @@ TEST(Threads, TwoMapsOnTheSecondCoreEqualOneCore) {
     done = true;
     reader.join();
     EXPECT_EQ(bad, 0);
-    ASSERT_GT(reference.insertStats().accepted, size_t(kScans) * kBeams / 2);
+    ASSERT_GT(reference.statistics().insert.accepted, size_t(kScans) * kBeams / 2);
     for (const Map* m : {&a, &b}) {
-        EXPECT_EQ(m->insertStats().accepted, reference.insertStats().accepted);
+        EXPECT_EQ(m->statistics().insert.accepted, reference.statistics().insert.accepted);
         for (const auto layer : {Map::RasterLayer::Height, Map::RasterLayer::Sigma}) {
             const auto x = reference.toRaster(layer), y = m->toRaster(layer);
             ASSERT_EQ(x.rows(), y.rows());

@@ -13,7 +13,7 @@
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/serialization/CArchive.h>
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
 
 #include <chrono>
 #include <cstdio>
@@ -23,6 +23,8 @@
 #include <string>
 
 #include "RouteScene.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace {
 /** The process's peak resident memory [MB] (VmHWM). */
@@ -60,14 +62,14 @@ int main(int argc, char** argv) {
         });
         const double mappingPeak_mb = peakResidentMB();
         const mrpt::maps::CMultiBinElevationMap::TileStoreStats tiles = map.tileStoreStats();
-        const multibin::InsertStats& s = map.insertStats();
+        const multibin::InsertStats& s = map.statistics().insert;
         const std::string file = "route-scale-" + std::string(argv[1]) + "m.mbmap.gz";
         {
             mrpt::io::CFileGZOutputStream out(file);
             mrpt::serialization::archiveFrom(out) << map;
         }
         std::ifstream written(file, std::ios::binary | std::ios::ate);
-        const multibin::CellWindow& w = map.grid().window();
+        const multibin::CellWindow& w = multibin::MapInternals::grid(map).window();
         std::printf(
             "route %.0f m: %zu clouds, %zu points; fused %zu, outside map %zu, too uncertain %zu, "
             "out of range %zu\n",
@@ -78,9 +80,13 @@ int main(int argc, char** argv) {
         std::printf(
             "window %d x %d cells (%.0f M), %zu tiles (%.1f M cells), %zu bins; map %.1f MB, "
             "process peak %.1f MB; file %.1f MB (%s)\n",
-            w.nx, w.ny, double(w.cellCount()) / 1e6, map.grid().store().tileCount(),
-            double(map.grid().store().tileCount() * multibin::BinStore::kTileSlots) / 1e6,
-            map.grid().binCount(), double(map.grid().memoryBytes()) / 1e6, peakResidentMB(),
+            w.nx, w.ny, double(w.cellCount()) / 1e6,
+            multibin::MapInternals::grid(map).store().tileCount(),
+            double(multibin::MapInternals::grid(map).store().tileCount() *
+                   multibin::BinStore::kTileSlots) /
+                1e6,
+            multibin::MapInternals::grid(map).binCount(),
+            double(multibin::MapInternals::grid(map).memoryBytes()) / 1e6, peakResidentMB(),
             double(written.tellg()) / 1e6, file.c_str());
         std::printf(
             "while mapping: process peak %.1f MB, grid peak %.1f MB; tiles written to disk %zu, "

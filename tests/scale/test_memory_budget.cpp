@@ -12,7 +12,8 @@
 #include <vector>
 
 #include "RouteScene.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
 
 namespace {
 using Map = mrpt::maps::CMultiBinElevationMap;
@@ -54,12 +55,13 @@ void mapClouds(Map& map, const std::vector<Cloud>& clouds) {
 using BinRecord = std::tuple<int, int, std::vector<unsigned char>>;
 std::vector<BinRecord> allBins(const Map& map) {
     std::vector<BinRecord> bins;
-    map.grid().store().forEachStoredBin([&](int ix, int iy, const multibin::Bin& b) {
-        const multibin::BinEstimate& e = b;
-        std::vector<unsigned char> bytes(sizeof e);
-        std::memcpy(bytes.data(), &e, sizeof e);
-        bins.emplace_back(ix, iy, bytes);
-    });
+    multibin::MapInternals::grid(map).store().forEachStoredBin(
+        [&](int ix, int iy, const multibin::Bin& b) {
+            const multibin::BinEstimate& e = b;
+            std::vector<unsigned char> bytes(sizeof e);
+            std::memcpy(bytes.data(), &e, sizeof e);
+            bins.emplace_back(ix, iy, bytes);
+        });
     // Tiles come back in another order than they were allocated: sort by cell, keeping each
     // cell's chain order (stable).
     std::stable_sort(bins.begin(), bins.end(), [](const BinRecord& a, const BinRecord& b) {
@@ -73,7 +75,7 @@ TEST(MemoryBudget, ARouteOverItsBudgetHoldsTheSameBinsAsWithoutOne) {
     const std::vector<Cloud> clouds = outAndBack();
     Map unbounded(creation(0));
     mapClouds(unbounded, clouds);
-    const size_t needed = unbounded.grid().residentBytes();
+    const size_t needed = multibin::MapInternals::grid(unbounded).residentBytes();
 
     const double budget_mb = 1.5;
     ASSERT_GT(double(needed), 3 * budget_mb * 1e6) << "the route must need well over the budget";
@@ -96,7 +98,8 @@ TEST(MemoryBudget, ARouteOverItsBudgetHoldsTheSameBinsAsWithoutOne) {
     std::filesystem::remove_all(dir);
 
     // Reading brings every tile back: the same bins, bit for bit, cell by cell.
-    EXPECT_EQ(budgeted.grid().binCount(), unbounded.grid().binCount());
+    EXPECT_EQ(multibin::MapInternals::grid(budgeted).binCount(),
+              multibin::MapInternals::grid(unbounded).binCount());
     EXPECT_EQ(budgeted.tileStoreStats().tilesOnDisk, 0u);
     EXPECT_TRUE(allBins(budgeted) == allBins(unbounded));
     // And the same heights where the route was.

@@ -5,11 +5,13 @@
  * route-scale (doc/route-scale.md). */
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
 
 #include "RouteScene.h"
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/SparseFill.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/traversability/TerrainFeatures.h"
 
 namespace {
@@ -36,12 +38,12 @@ RouteResult mapRoute(double length_m) {
         map.insertObservation(cloud, pose);
         r.points += points;
     });
-    r.fused = map.insertStats().accepted;
-    r.outsideMap = map.insertStats().outsideMap;
-    r.tooUncertain = map.insertStats().tooUncertain;
-    r.tiles = map.grid().store().tileCount();
-    r.bytes = map.grid().memoryBytes();
-    r.windowCells = map.grid().window().cellCount();
+    r.fused = map.statistics().insert.accepted;
+    r.outsideMap = map.statistics().insert.outsideMap;
+    r.tooUncertain = map.statistics().insert.tooUncertain;
+    r.tiles = multibin::MapInternals::grid(map).store().tileCount();
+    r.bytes = multibin::MapInternals::grid(map).memoryBytes();
+    r.windowCells = multibin::MapInternals::grid(map).window().cellCount();
     map.insertionOptions.fill.enabled = true;
     map.dem_update_map();
     const multibin::fill::FillResult::Stats& fs = map.lastFilledCells().stats;

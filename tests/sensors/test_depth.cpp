@@ -12,7 +12,9 @@
 
 #include "mc_check.h"
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/RayModel.h"
 #include "multibin/sensors/SensorDispatch.h"
@@ -140,10 +142,10 @@ TEST(DepthModel, RealMrptDepthFrameInsertsWithoutNaN) {
         EXPECT_TRUE(map.insertObservation(*depth, mrpt::poses::CPose3DPDFGaussian()));
     }
     ASSERT_EQ(frames, 1u);
-    EXPECT_GT(map.sensorModelStats().depth.kept, 1000u);
-    EXPECT_GT(map.insertStats().accepted, 1000u);
+    EXPECT_GT(map.statistics().sensorModels.depth.kept, 1000u);
+    EXPECT_GT(map.statistics().insert.accepted, 1000u);
     // No NaN anywhere: every bin of every cell has a finite height, variance and certainty.
-    const auto& g = map.grid();
+    const auto& g = multibin::MapInternals::grid(map);
     size_t bins = 0;
     for (int iy = g.window().iy0; iy < g.window().iy0 + g.window().ny; iy++)
         for (int ix = g.window().ix0; ix < g.window().ix0 + g.window().nx; ix++)
@@ -187,8 +189,8 @@ TEST(DepthModel, FrameSharedErrorFusesToSigmaSquaredOverNPlusShared) {
             map.insertionOptions.sensors.depth.frameSigmaRelative = 0;
         }
         ASSERT_TRUE(map.insertObservation(scan, pose));
-        EXPECT_EQ(map.insertStats().accepted, 16u);
-        EXPECT_EQ(map.insertStats().tooUncertain, 1u);
+        EXPECT_EQ(map.statistics().insert.accepted, 16u);
+        EXPECT_EQ(map.statistics().insert.tooUncertain, 1u);
         ASSERT_TRUE(map.cellHeight(0.01, 0.01, h[on], sigma[on]));
     }
     const double sa = shared.axialSigma_m(1.0), s = shared.frameSigma_m(1.0);

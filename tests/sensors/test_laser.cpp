@@ -12,6 +12,7 @@
 
 #include "mc_check.h"
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/LaserModel.h"
 
 using namespace multibin;
@@ -251,7 +252,7 @@ TEST(LaserModel, ContinuityGateRejectsJumpAndKeepsSmallChangeInTheMap) {
         rise[3] = 0.03;
         rise[7] = 0.004;
         map.insertObservation(downwardScan(0.3, rise, 0.1), pose);
-        return map.insertStats();
+        return map.statistics().insert;
     };
     const InsertStats on = run(true);
     EXPECT_EQ(on.continuityRejected, 1u);

@@ -21,6 +21,7 @@
 
 #include "mrpt_datasets.h"
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin::sensors;
@@ -82,11 +83,11 @@ TEST(MrptDatasets, Vlp16ScanFloorIsMrptsPlaneAndEveryReturnIsAccountedFor) {
 
     // Accounting: 75 packets x 12 blocks x 32 channels, each counted once by the model, and each
     // kept point fused or rejected by the map for a named reason.
-    const LidarStats& ls = map.sensorModelStats().lidar;
+    const LidarStats& ls = map.statistics().sensorModels.lidar;
     EXPECT_EQ(ls.returns, 75u * 12u * 32u);
     EXPECT_EQ(ls.returns, ls.noReturn + ls.notDecoded + ls.notFinite + ls.outOfRange + ls.kept);
     EXPECT_EQ(ls.kept, 11305u);  // what MRPT's CSimplePointsMap takes
-    const multibin::InsertStats& is = map.insertStats();
+    const multibin::InsertStats& is = map.statistics().insert;
     EXPECT_EQ(is.outOfRange, ls.noReturn + ls.notDecoded + ls.outOfRange);
     EXPECT_EQ(is.notFinite, ls.notFinite);
     EXPECT_EQ(is.accepted + is.rejected() - is.outOfRange - is.notFinite, ls.kept);
@@ -154,7 +155,7 @@ TEST(MrptDatasets, RotatingScansMapWhenTheyHaveGeometryAndAreRefusedByNameOtherw
     for (int i = 0; i < rot->columnCount; i++) echoes += rot->rangeImage(0, i) != 0;
     map.insertionOptions.max_range_m = 80.0;
     map.insertObservation(*rot, originPose());
-    const LidarStats& ls = map.sensorModelStats().lidar;
+    const LidarStats& ls = map.statistics().sensorModels.lidar;
     EXPECT_EQ(ls.returns, size_t(rot->columnCount));
     EXPECT_EQ(ls.noReturn + ls.notFinite, size_t(rot->columnCount) - echoes);
     EXPECT_EQ(ls.kept + ls.outOfRange, echoes);
@@ -240,12 +241,12 @@ TEST(MrptDatasets, IcpSlamSimplemapWithExactPosesIsMapped) {
     exact.insertSimpleMapWithPosePdfs(simplemap);
     reference.insertSimpleMapWithPosePdfs(nearExact);
 
-    const multibin::InsertStats& s = exact.insertStats();
+    const multibin::InsertStats& s = exact.statistics().insert;
     EXPECT_EQ(s.badCovariance, 0u);
     EXPECT_EQ(s.notFinite, 0u);
     EXPECT_GT(s.accepted, 1000u);
-    EXPECT_GE(double(s.accepted), 0.99 * double(reference.insertStats().accepted))
-        << "exact " << s.accepted << ", 1 mm " << reference.insertStats().accepted;
+    EXPECT_GE(double(s.accepted), 0.99 * double(reference.statistics().insert.accepted))
+        << "exact " << s.accepted << ", 1 mm " << reference.statistics().insert.accepted;
     EXPECT_GT(expectFiniteCells(exact), 100u);
 }
 

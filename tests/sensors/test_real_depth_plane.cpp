@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "mrpt_datasets.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorStats.h"
 
 namespace {
@@ -101,7 +102,7 @@ TEST(RealDepthPlane, WallAsGroundHasAtMostHalfAPercentOfCellsOff50mm) {
         off += e > 0.05;
         worst_m = std::max(worst_m, e);
     }
-    const multibin::sensors::DepthStats& d = map.sensorModelStats().depth;
+    const multibin::sensors::DepthStats& d = map.statistics().sensorModels.depth;
     std::printf(
         "  %zu points, %zu measured cells, %zu (%.3f %%) more than 50 mm off the plane, "
         "worst %.1f mm; flying pixels removed %zu, border %zu\n",

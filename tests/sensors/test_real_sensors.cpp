@@ -15,6 +15,7 @@
 
 #include "mrpt_datasets.h"
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/RayModel.h"
 #include "multibin/sensors/SensorStats.h"
 
@@ -65,8 +66,8 @@ TEST(RealSensors, Vlp16PresetWithDefaultPoseCovarianceKeepsTheGroundRing) {
 
     Map map = mapFromPreset("lidar-vlp16.ini");
     map.insertObservation(*scan, mrpt::poses::CPose3D());  // no PDF: the default covariance
-    EXPECT_EQ(map.poseFallbackCount(), 1u);
-    const multibin::InsertStats& s = map.insertStats();
+    EXPECT_EQ(map.statistics().poseFallbacks, 1u);
+    const multibin::InsertStats& s = map.statistics().insert;
     std::printf("  fused %zu of 11305 (too uncertain %zu, outside map %zu)\n", s.accepted,
                 s.tooUncertain, s.outsideMap);
     EXPECT_GE(double(s.accepted), 0.9 * 11305);

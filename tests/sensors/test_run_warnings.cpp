@@ -12,6 +12,7 @@
 
 #include "RunWarnings.h"
 #include "mrpt_datasets.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace {
 using Map = mrpt::maps::CMultiBinElevationMap;
@@ -63,7 +64,7 @@ Map vlp16Map(double resolution_m) {
 // option.
 TEST(RunWarnings, TooUncertainPointsAreCountedAsSuchAndTheReportNamesTheOption) {
     const Map small = vlp16Map(0.1), fine = vlp16Map(0.05);
-    const multibin::InsertStats &a = small.insertStats(), &b = fine.insertStats();
+    const multibin::InsertStats &a = small.statistics().insert, &b = fine.statistics().insert;
     EXPECT_EQ(a.accepted, b.accepted);
     EXPECT_EQ(a.tooUncertain, b.tooUncertain);
     EXPECT_EQ(a.outsideMap, 0u);
@@ -85,7 +86,7 @@ TEST(RunWarnings, PointsOutsideAFixedWindowNameTheExtentOptions) {
     Map map(c);
     map.insertionOptions.fill.enabled = false;
     map.insertObservation(scanOf(2.0, 0.5), posePdf());
-    EXPECT_GT(map.insertStats().outsideMap, 100u);
+    EXPECT_GT(map.statistics().insert.outsideMap, 100u);
     const std::string gate = dominantRejection(map);
     EXPECT_NE(gate.find("outside map"), std::string::npos) << gate;
     EXPECT_NE(gate.find("min_x"), std::string::npos) << gate;
@@ -99,7 +100,7 @@ TEST(RunWarnings, AHorizontalLaserWarnsThatNoGroundWasSeen) {
         map.insertionOptions.fill.enabled = false;
         // Pitched, the 3 m beams reach the floor (0.3 m down) at about 0.52 m ahead: 0.6 m beams.
         map.insertObservation(scanOf(pitch_rad > 0 ? 0.6 : 3.0, pitch_rad), posePdf());
-        ASSERT_GT(map.insertStats().accepted, 100u);
+        ASSERT_GT(map.statistics().insert.accepted, 100u);
         const auto warnings = runWarnings(map, {1});
         EXPECT_EQ(mentions(warnings, "no surface below the sensors"), pitch_rad == 0)
             << "pitch " << pitch_rad;
@@ -113,7 +114,7 @@ TEST(RunWarnings, AllDefaultPoseCovariancesWarnOnce) {
     Map map;
     map.insertionOptions.fill.enabled = false;
     map.insertObservation(scanOf(0.6, 30 * M_PI / 180), mrpt::poses::CPose3D());
-    ASSERT_EQ(map.poseFallbackCount(), 1u);
+    ASSERT_EQ(map.statistics().poseFallbacks, 1u);
     EXPECT_TRUE(mentions(runWarnings(map, {0}), "default pose covariance"));
     EXPECT_TRUE(runWarnings(map, {1}).empty());
 }

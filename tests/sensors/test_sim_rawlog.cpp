@@ -14,6 +14,7 @@
 #include <cstdio>
 
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 namespace {
@@ -53,8 +54,8 @@ Outcome run(const std::string& scenario, const std::vector<std::string>& labels,
     const auto gt = multibin::EsriAsciiGrid::load(kPrefix + "_gt.asc");
     Outcome o;
     o.opts = map.insertionOptions;
-    o.stats = map.sensorModelStats();
-    o.core = map.insertStats();
+    o.stats = map.statistics().sensorModels;
+    o.core = map.statistics().insert;
     for (int r = 0; r < gt.rows(); r++)
         for (int k = 0; k < gt.cols(); k++) {
             const double x = gt.xllcenter_m + k * gt.cellsize_m,

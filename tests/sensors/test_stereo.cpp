@@ -14,6 +14,7 @@
 
 #include "mc_check.h"
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorDispatch.h"
 #include "multibin/sensors/StereoDisparity.h"
 #include "multibin/sensors/StereoModel.h"
@@ -336,7 +337,7 @@ TEST(StereoModel, GroundSeenByPitchedCameraIsMappedFlat) {
     mrpt::poses::CPose3DPDFGaussian pose;
     for (int i = 0; i < 6; i++) pose.cov(i, i) = 1e-8;
     ASSERT_TRUE(map.insertObservation(obs, pose));
-    const auto& st = map.sensorModelStats().stereo;
+    const auto& st = map.statistics().sensorModels.stereo;
     EXPECT_EQ(st.halo + st.nearCluster, 0u);  // a smooth plane has no artefacts
     EXPECT_GT(st.kept, 5000u);
     size_t checked = 0;

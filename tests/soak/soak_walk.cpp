@@ -39,7 +39,9 @@
 #include "SurfaceTexture.h"
 #include "Terrain.h"
 #include "Trajectory.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
@@ -66,7 +68,8 @@ struct CellCheck {
 /** Every bin of both grids: finite height, finite variance >= 0, finite certainty >= 0. */
 CellCheck checkCells(const CMultiBinElevationMap& map) {
     CellCheck c;
-    for (const multibin::BinGrid* g : {&map.grid(), &map.localGrid()}) {
+    for (const multibin::BinGrid* g :
+         {&multibin::MapInternals::grid(map), &multibin::MapInternals::localGrid(map)}) {
         const multibin::CellWindow& w = g->window();
         for (int iy = w.iy0; iy < w.iy0 + w.ny; iy++)
             for (int ix = w.ix0; ix < w.ix0 + w.nx; ix++)
@@ -195,14 +198,14 @@ int main(int argc, char** argv) {
             for (const auto& obs : {f.laser, f.stereo}) {
                 if (!obs) continue;
                 obs->timestamp = stamp;
-                const size_t before = map.insertStats().accepted;
+                const size_t before = map.statistics().insert.accepted;
                 const double c0 = threadCpu_s();
                 const auto w0 = std::chrono::steady_clock::now();
                 map.insertObservation(*obs, pdf);
                 m.cpu_s += threadCpu_s() - c0;
                 m.wall_s +=
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
-                m.points += map.insertStats().accepted - before;
+                m.points += map.statistics().insert.accepted - before;
                 m.observations++;
             }
             if (t_s >= nextCheck_s) {
@@ -213,9 +216,11 @@ int main(int argc, char** argv) {
                 nextCheck_s += checkEvery_s;
             }
             m.rss_MB = residentMemory_MB();
-            m.grid_MB = double(map.grid().memoryBytes() + map.localGrid().memoryBytes()) / 1e6;
-            m.localBins = map.localGrid().binCount();
-            m.globalBins = map.grid().binCount();
+            m.grid_MB = double(multibin::MapInternals::grid(map).memoryBytes() +
+                               multibin::MapInternals::localGrid(map).memoryBytes()) /
+                        1e6;
+            m.localBins = multibin::MapInternals::localGrid(map).binCount();
+            m.globalBins = multibin::MapInternals::grid(map).binCount();
         }
         if (done) break;
     }
@@ -261,12 +266,12 @@ int main(int argc, char** argv) {
         tFirst, first.observations / first.cpu_s, tLast, lastMin.observations / lastMin.cpu_s,
         100 * change, steady ? "(within 20 %)" : "(OUTSIDE 20 %)");
     ok &= steady;
-    const auto& s = map.insertStats();
+    const auto& s = map.statistics().insert;
     std::printf(
         "map: %zu points fused, %zu rejected; visibility constraint removed %zu bins, "
         "weakened %zu\n",
-        s.accepted, s.rejected(), map.visibilityStats().binsRemoved,
-        map.visibilityStats().binsWeakened);
+        s.accepted, s.rejected(), map.statistics().visibility.binsRemoved,
+        map.statistics().visibility.binsWeakened);
     std::printf("soak_walk: %s\n", ok ? "PASS" : "FAIL");
     return ok ? 0 : 2;
 }

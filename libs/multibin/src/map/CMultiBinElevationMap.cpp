@@ -15,16 +15,9 @@
 #include <tuple>
 #include <utility>
 
-#include "multibin/io/OptionKeys.h"
-#include "multibin/map/CellSurface.h"
 #include "multibin/map/MapStatistics.h"
 
 using namespace mrpt::maps;
-using multibin::atLeast;
-using multibin::between;
-using multibin::finite;
-using multibin::OptionNames;
-using multibin::positive;
 
 // "multiBinElevationMap" is the name used in CMultiMetricMap ini files
 // (multiBinElevationMap_count).
@@ -50,299 +43,8 @@ void registerMultiBinElevationMap() {
 }
 }  // namespace multibin
 
-namespace {
-// Keys MRPT itself puts in every `_creationOpts` section (TMapGenericParams).
-const std::vector<std::string> kGenericMapKeys = {
-    "enableSaveAs3DObject", "enableObservationLikelihood", "enableObservationInsertion"};
-/** Creation keys of earlier versions, accepted with a message: `max_size_m` capped the growing
- * window before the storage was tiled. */
-constexpr const char* kRetiredCreationKeys[] = {"max_size_m"};
-
-/** "ini file 'F'" or "ini" (a source that is not a file). Messages hold no ']': MRPT's exception
- * wrapper takes the text up to one for a source location. */
-std::string iniName(const mrpt::config::CConfigFileBase& source) {
-    if (const auto* f = dynamic_cast<const mrpt::config::CConfigFile*>(&source))
-        return "ini file '" + f->getAssociatedFile() + "'";
-    return "ini";
-}
-
-constexpr int kMaxMapCount = 64;  //!< maps of this class in one CMultiMetricMap
-
-/** Checks what MRPT's TSetOfMetricMapInitializers does not, before it creates `count` map
- * definitions (count = -1 or 100000 took 9-23 GB): the `multiBinElevationMap_count` key of the
- * parent section, and every section of this map's prefix (`<parent>_multiBinElevationMap_NN_X`:
- * NN below the count, X creationOpts or insertOpts), so a misspelt one is an error, not ignored. */
-void checkMapSections(const mrpt::config::CConfigFileBase& source, const std::string& prefix) {
-    const std::string tag = "_multiBinElevationMap_";
-    const auto at = prefix.rfind(tag);
-    if (at == std::string::npos) return;  // not created through a CMultiMetricMap ini
-    const std::string parent = prefix.substr(0, at);
-    // The parent section too holds each key once (the map count given twice is an error).
-    multibin::StrictConfigSection{source, parent};
-    const std::string countKey = "multiBinElevationMap_count";
-    const std::string countText = source.read_string(parent, countKey, "0");
-    char* end = nullptr;
-    const long count = std::strtol(countText.c_str(), &end, 10);
-    if (countText.empty() || *end != '\0' || count < 0 || count > kMaxMapCount)
-        throw std::invalid_argument(iniName(source) + ", section '" + parent + "', key '" +
-                                    countKey + "': expected a whole number from 0 to " +
-                                    std::to_string(kMaxMapCount) + ", got '" + countText + "'");
-    std::vector<std::string> sections;
-    source.getAllSections(sections);
-    const std::string mapPrefix = parent + tag.substr(0, tag.size() - 1);
-    for (const auto& sec : sections) {
-        if (sec.compare(0, mapPrefix.size(), mapPrefix) != 0) continue;
-        bool known = false;
-        for (long i = 0; i < count && !known; i++) {
-            char nn[8];
-            std::snprintf(nn, sizeof nn, "%02ld", i);
-            for (const char* part : {"_creationOpts", "_insertOpts", "_traversabilityOpts"})
-                known = known || sec == parent + tag + nn + part;
-        }
-        if (!known)
-            throw std::invalid_argument(
-                iniName(source) + ", section '" + sec + "': unknown section (this map reads '" +
-                parent + tag + "NN_creationOpts', '" + parent + tag + "NN_insertOpts' and '" +
-                parent + tag + "NN_traversabilityOpts', NN from 00 to " +
-                std::to_string(count - 1) + ")");
-    }
-}
-
-}  // namespace
-
 // ---------------------------------------------------------------------------------------------
-// Options
-// ---------------------------------------------------------------------------------------------
-namespace {
-/** Largest map origin [m]: beyond any projected coordinate system (UTM northings stay below 1e7
- * m); a double still resolves 15 nm there. */
-constexpr double kMaxOrigin_m = 1e8;
-
-/** Cell sizes: from 0.1 mm (the growth limit, BinStore::kGrowthLimitCells cells, then still
- * reaches 26 km from the map origin) to 1 km. */
-multibin::OptionRule cellSizeRule() { return multibin::between(1e-4, 1e3, "m"); }
-
-/** The creation keys of `o` (a TCreationOptions or a const one), in the order they are written,
- * for the options protocol (multibin/io/OptionKeys.h). */
-template <class Options, class Visit>
-void visitCreationKeys(Options& o, Visit&& visit) {
-    visit({"resolution_m", "resolution"}, o.resolution_m, cellSizeRule());
-    visit({"bin_height_m", "bin_height"}, o.bin_height_m, positive("m"));
-    visit("grow", o.grow);
-    visit({"min_x_m", "min_x"}, o.min_x, finite("m"));
-    visit({"max_x_m", "max_x"}, o.max_x, finite("m"));
-    visit({"min_y_m", "min_y"}, o.min_y, finite("m"));
-    visit({"max_y_m", "max_y"}, o.max_y, finite("m"));
-    visit("dual_grid", o.dual_grid);
-    visit("local_size_m", o.local_size_m, positive("m"));
-    visit({"local_resolution_m", "local_resolution"}, o.local_resolution_m, cellSizeRule());
-    visit("global_size_m", o.global_size_m, positive("m"));
-    visit({"global_resolution_m", "global_resolution"}, o.global_resolution_m, cellSizeRule());
-    visit("origin_auto", o.origin_auto);
-    visit("origin_x_m", o.origin_x_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
-    visit("origin_y_m", o.origin_y_m, between(-kMaxOrigin_m, kMaxOrigin_m, "m"));
-    visit("memory_budget_mb", o.memory_budget_mb, atLeast(0, "MB"));
-    visit("tile_store_dir", o.tile_store_dir);
-}
-
-using HeightQuery = CMultiBinElevationMap::TInsertionOptions::HeightQuery;
-const OptionNames<HeightQuery> kHeightQueries{{"plane", HeightQuery::Plane},
-                                              {"nearest", HeightQuery::Nearest}};
-
-const OptionNames<mrpt::img::TColormap> kColormaps{
-    {"jet", mrpt::img::cmJET}, {"hot", mrpt::img::cmHOT}, {"grayscale", mrpt::img::cmGRAYSCALE}};
-
-/** The insertion keys of `o` (a TInsertionOptions or a const one) with those of its visibility,
- * fill and sensor-model parts, in the order they are written. */
-template <class Options, class Visit>
-void visitInsertionKeys(Options& o, Visit&& visit) {
-    visit("certainty_increment", o.certainty_increment, positive());
-    visit({"max_elevation_uncertainty_m", "max_elevation_uncertainty"},
-          o.max_elevation_uncertainty_m, positive("m"));
-    visit({"height_sigma_floor_m", "height_sigma_floor"}, o.height_sigma_floor_m, atLeast(0, "m"));
-    visit("default_pose_sigmas", o.default_pose_sigmas, atLeast(0));
-    visit({"robot_pose_max_dt_s", "robot_pose_max_dt"}, o.robot_pose_max_dt_s, atLeast(0, "s"));
-    visit({"range_sigma_m", "range_sigma"}, o.range_sigma_m, positive("m"));
-    visit({"min_range_m", "min_range"}, o.min_range_m, atLeast(0, "m"));
-    visit({"max_range_m", "max_range"}, o.max_range_m, positive("m"));
-    visit("sensor_labels", o.sensor_labels);
-    visit("global_sensor_labels", o.global_sensor_labels);
-    visit("colormap", o.colormap, kColormaps);
-    visit("color_by_sigma", o.color_by_sigma);
-    visit("dem_return_filled", o.dem_return_filled);
-    visit("relief_sigma", o.relief_sigma);
-    visit("height_query", o.height_query, kHeightQueries);
-    visit("insertion_threads", o.insertion_threads, between(1, 2));
-}
-
-/** The origin the options fix before any data arrive: the explicit one, or originNear() of a
- * single grid's extent centre; none when it waits for the first insertion. */
-std::optional<mrpt::math::TPoint2D> originBeforeData(
-    const CMultiBinElevationMap::TCreationOptions& c) {
-    if (!c.origin_auto) return mrpt::math::TPoint2D(c.origin_x_m, c.origin_y_m);
-    if (!c.dual_grid && c.max_x > c.min_x && c.max_y > c.min_y)
-        return c.originNear(0.5 * (c.min_x + c.max_x), 0.5 * (c.min_y + c.max_y));
-    return std::nullopt;
-}
-}  // namespace
-
-mrpt::math::TPoint2D CMultiBinElevationMap::TCreationOptions::originNear(double x_m,
-                                                                         double y_m) const {
-    const double cell_m = dual_grid ? global_resolution_m : resolution_m;
-    // Clamped to the origin's range: data beyond it are beyond any map (and stay finite here).
-    const auto snap = [&](double v) {
-        const double km =
-            std::clamp(std::round(v / 1000.0), -kMaxOrigin_m / 1000, kMaxOrigin_m / 1000);
-        return std::round(km * 1000.0 / cell_m) * cell_m;
-    };
-    return {snap(x_m), snap(y_m)};
-}
-
-void CMultiBinElevationMap::TCreationOptions::loadFromConfigFile(
-    const mrpt::config::CConfigFileBase& source, const std::string& section) {
-    std::vector<std::string> allowed = kGenericMapKeys;
-    for (const char* key : kRetiredCreationKeys)
-        if (source.keyExists(section, key)) {
-            std::cerr << "CMultiBinElevationMap: " << iniName(source) << ", section [" << section
-                      << "]: key '" << key
-                      << "' is no longer used and is ignored: the map is stored in tiles and "
-                         "grows with the data, with no size limit. Remove the key.\n";
-            allowed.push_back(key);
-        }
-    multibin::loadStrictly(
-        source, section, *this,
-        [&](multibin::StrictConfigSection& s) {
-            visitCreationKeys(*this, multibin::OptionReader{s});
-        },
-        allowed);
-}
-
-void CMultiBinElevationMap::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
-                                                               const std::string& section) const {
-    visitCreationKeys(*this, multibin::OptionWriter{c, section});
-}
-
-namespace {
-/** Largest cell index an option may produce: int with room for a window of 2^30 cells. */
-constexpr double kMaxCellIndex = 1 << 30;
-}  // namespace
-
-void CMultiBinElevationMap::TCreationOptions::validate() const {
-    const multibin::OptionChecker check("CMultiBinElevationMap creation option");
-    visitCreationKeys(*this, check);
-    const auto bad = [&](const std::string& key, const std::string& what) {
-        check.fail(key, what);
-    };
-    const mrpt::math::TPoint2D origin = originBeforeData(*this).value_or(mrpt::math::TPoint2D());
-    for (const auto& [key, v, o] : {std::tuple{"min_x_m", min_x, origin.x},
-                                    {"max_x_m", max_x, origin.x},
-                                    {"min_y_m", min_y, origin.y},
-                                    {"max_y_m", max_y, origin.y}}) {
-        if (std::abs(v) > kMaxOrigin_m) {
-            std::ostringstream os;
-            os << v << " m is beyond the +-" << kMaxOrigin_m << " m of map coordinates (cell index "
-               << v / resolution_m << " at " << resolution_m << " m cells)";
-            bad(key, os.str());
-        }
-        // Cell indices are int: an extent far from the map origin would overflow them.
-        if (std::abs((v - o) / resolution_m) > kMaxCellIndex) {
-            std::ostringstream os;
-            os << v << " m is cell index " << (v - o) / resolution_m << " from the map origin " << o
-               << " m at " << resolution_m << " m cells, beyond the +-" << kMaxCellIndex
-               << " the grid can index";
-            bad(key, os.str());
-        }
-    }
-    if (max_x < min_x || max_y < min_y)
-        bad("min_x_m/max_x_m/min_y_m/max_y_m", "max must not be below min");
-    if (!grow && (max_x <= min_x || max_y <= min_y))
-        bad("grow", "a fixed extent (grow = false) needs min_x < max_x and min_y < max_y");
-    // The local grid's window is filled densely as the robot sees it (16 bytes per cell: first
-    // bin, cycle stamp, update index, height bound, then the bins): refuse one beyond memory.
-    constexpr double kCellBytes = 16, kMaxCells = 2.0e8;  // 3.2 GB of cell slots
-    auto checkArea = [&](const std::string& key, double side_m, double cell_m) {
-        const double side_cells = side_m / cell_m;
-        if (side_cells * side_cells <= kMaxCells) return;
-        std::ostringstream os;
-        os << "a grid of " << side_cells << " x " << side_cells << " cells (" << cell_m
-           << " m cells) would need " << side_cells * side_cells * kCellBytes / 1e9
-           << " GB for its cells alone; use a coarser resolution or a smaller size";
-        bad(key, os.str());
-    };
-    if (dual_grid) checkArea("local_size_m", local_size_m, local_resolution_m);
-}
-
-void CMultiBinElevationMap::TInsertionOptions::loadFromConfigFile(
-    const mrpt::config::CConfigFileBase& source, const std::string& section) {
-    multibin::loadStrictly(source, section, *this, [&](multibin::StrictConfigSection& s) {
-        visitInsertionKeys(*this, multibin::OptionReader{s});
-        visibility.read(s);
-        fill.read(s);
-        sensors.read(s);
-    });
-}
-
-void CMultiBinElevationMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
-                                                                const std::string& section) const {
-    visitInsertionKeys(*this, multibin::OptionWriter{c, section});
-    visibility.write(c, section);
-    fill.write(c, section);
-    sensors.write(c, section);
-}
-
-void CMultiBinElevationMap::TInsertionOptions::validate() const {
-    const multibin::OptionChecker check("CMultiBinElevationMap insertion option");
-    if (default_pose_sigmas.size() != 6)
-        check.fail("default_pose_sigmas",
-                   "needs 6 values, has " + std::to_string(default_pose_sigmas.size()));
-    visitInsertionKeys(*this, check);
-    visibility.validate();
-    fill.validate();
-    if (!(max_range_m > min_range_m))
-        check.fail("min_range_m/max_range_m", "need 0 <= min_range_m < max_range_m");
-    sensors.validate();
-}
-
-mrpt::math::CMatrixDouble66 CMultiBinElevationMap::TInsertionOptions::defaultPoseCovariance()
-    const {
-    mrpt::math::CMatrixDouble66 C;
-    C.setZero();
-    for (int i = 0; i < 6; i++)
-        C(i, i) = default_pose_sigmas[size_t(i)] * default_pose_sigmas[size_t(i)];
-    return C;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Map definition (CMultiMetricMap ini files)
-// ---------------------------------------------------------------------------------------------
-CMultiBinElevationMap::TMapDefinition::TMapDefinition() = default;
-
-void CMultiBinElevationMap::TMapDefinition::loadFromConfigFile_map_specific(
-    const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix) {
-    checkMapSections(source, sectionNamePrefix);
-    creationOpts.loadFromConfigFile(source, sectionNamePrefix + "_creationOpts");
-    insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
-    if (source.sectionExists(sectionNamePrefix + "_traversabilityOpts"))
-        traversabilityOpts.loadFromConfigFile(source, sectionNamePrefix + "_traversabilityOpts");
-}
-
-void CMultiBinElevationMap::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const {
-    creationOpts.dumpToTextStream(out);
-    insertionOpts.dumpToTextStream(out);
-    out << "traversability: " << traversabilityOpts.text() << "\n";
-}
-
-mrpt::maps::CMetricMap* CMultiBinElevationMap::internal_CreateFromMapDefinition(
-    const mrpt::maps::TMetricMapInitializer& _def) {
-    const auto& def = dynamic_cast<const CMultiBinElevationMap::TMapDefinition&>(_def);
-    auto* obj = new CMultiBinElevationMap(def.creationOpts);
-    obj->insertionOptions = def.insertionOpts;
-    obj->traversabilityOptions = def.traversabilityOpts;
-    return obj;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Construction, queries
+// Construction, statistics, clearing
 // ---------------------------------------------------------------------------------------------
 CMultiBinElevationMap::CMultiBinElevationMap() : m_impl(std::make_unique<Impl>()) {
     setCreationOptions(TCreationOptions());
@@ -392,17 +94,6 @@ multibin::MapStatistics CMultiBinElevationMap::statistics() const {
     return {m_impl->stats,         m_impl->visibilityStats, m_impl->sensorState.stats,
             m_impl->poseFallbacks, m_impl->skippedByLabel,  m_impl->nonFinitePoses};
 }
-multibin::InsertStats CMultiBinElevationMap::insertStats() const { return statistics().insert; }
-multibin::VisibilityStats CMultiBinElevationMap::visibilityStats() const {
-    return statistics().visibility;
-}
-size_t CMultiBinElevationMap::poseFallbackCount() const { return statistics().poseFallbacks; }
-size_t CMultiBinElevationMap::skippedByLabelCount() const { return statistics().skippedByLabel; }
-size_t CMultiBinElevationMap::nonFinitePoseCount() const { return statistics().nonFinitePoses; }
-multibin::sensors::SensorModelStats CMultiBinElevationMap::sensorModelStats() const {
-    return statistics().sensorModels;
-}
-
 void CMultiBinElevationMap::setCreationOptions(const TCreationOptions& creation) {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     creation.validate();
@@ -418,7 +109,7 @@ int CMultiBinElevationMap::globalSideCells() const {
 void CMultiBinElevationMap::internal_clear() {
     const multibin::MapLock::Exclusive lock(m_impl->lock);
     const auto& c = creationOptions;
-    const std::optional<mrpt::math::TPoint2D> origin = originBeforeData(c);
+    const std::optional<mrpt::math::TPoint2D> origin = c.originBeforeData();
     m_impl->originFixed = origin.has_value();
     m_impl->origin_m = origin ? Eigen::Vector2d(origin->x, origin->y) : Eigen::Vector2d(0, 0);
     const Eigen::Vector2d& o = m_impl->origin_m;
@@ -466,41 +157,6 @@ multibin::BinUpdateParams CMultiBinElevationMap::binUpdateParams() const {
     return p;
 }
 
-bool CMultiBinElevationMap::getHeight(double x_m, double y_m, double& height_m,
-                                      double& sigma_m) const {
-    const HeightAnswer a = height(x_m, y_m);
-    if (a.source != HeightSource::Measured) return false;
-    height_m = a.height_m;
-    sigma_m = a.sigma_m;
-    return true;
-}
-
-bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, double& height_m,
-                                         double& sigma_m, bool sharedPosePart) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    const Eigen::Vector2d& o = m_impl->origin_m;
-    const auto estimate = subCell ? multibin::heightAt : multibin::surfaceAt;
-    multibin::CellSurface c;
-    if (!estimate(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m - o.x(), y_m - o.y(),
-                  binUpdateParams(), insertionOptions.relief_sigma, c))
-        return false;
-    height_m = c.height_m;
-    sigma_m = std::sqrt(sharedPosePart ? c.reportedVariance_m2() : c.variance_m2);
-    return true;
-}
-
-bool CMultiBinElevationMap::heightAt(double x_m, double y_m, double& height_m,
-                                     double& sigma_m) const {
-    prepareForReading();
-    return surfaceQuery(true, x_m, y_m, height_m, sigma_m);
-}
-
-bool CMultiBinElevationMap::cellHeight(double x_m, double y_m, double& height_m,
-                                       double& sigma_m) const {
-    prepareForReading();
-    return surfaceQuery(false, x_m, y_m, height_m, sigma_m);
-}
-
 bool CMultiBinElevationMap::isEmpty() const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     return m_impl->grid.empty() && m_impl->local.empty();
@@ -514,25 +170,6 @@ std::string CMultiBinElevationMap::asString() const {
        << getXMax() << "], y in [" << getYMin() << ", " << getYMax() << "] m, "
        << m_impl->grid.binCount() << " bins of " << creationOptions.bin_height_m << " m";
     return os.str();
-}
-
-double CMultiBinElevationMap::getXMin() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
-    return m_impl->origin_m.x() + m_impl->grid.window().ix0 * m_impl->grid.cellSize_m();
-}
-double CMultiBinElevationMap::getXMax() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
-    return m_impl->origin_m.x() +
-           (m_impl->grid.window().ix0 + m_impl->grid.window().nx) * m_impl->grid.cellSize_m();
-}
-double CMultiBinElevationMap::getYMin() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
-    return m_impl->origin_m.y() + m_impl->grid.window().iy0 * m_impl->grid.cellSize_m();
-}
-double CMultiBinElevationMap::getYMax() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
-    return m_impl->origin_m.y() +
-           (m_impl->grid.window().iy0 + m_impl->grid.window().ny) * m_impl->grid.cellSize_m();
 }
 
 mrpt::math::TPoint2D CMultiBinElevationMap::mapOrigin() const {
@@ -586,7 +223,3 @@ bool CMultiBinElevationMap::insertIndividualPoint(const double x, const double y
     growToCover(pts, Eigen::Vector3d(xr, yr, z), binUpdateParams());
     return insertPoints(pts).accepted == 1;
 }
-
-double CMultiBinElevationMap::dem_get_resolution() const { return m_impl->grid.cellSize_m(); }
-size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_impl->grid.window().nx); }
-size_t CMultiBinElevationMap::dem_get_size_y() const { return size_t(m_impl->grid.window().ny); }

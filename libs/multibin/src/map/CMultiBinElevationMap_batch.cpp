@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "CMultiBinElevationMap_impl.h"
-#include "multibin/map/CellSurface.h"
+#include "multibin/grid/CellSurface.h"
 
 using namespace mrpt::maps;
 

@@ -13,7 +13,7 @@
 #include <utility>
 
 #include "multibin/fill/SparseFill.h"
-#include "multibin/map/BinStore.h"
+#include "multibin/grid/BinStore.h"
 
 using namespace mrpt::maps;
 

@@ -12,7 +12,7 @@
 #include "multibin/fill/HeightRaster.h"
 #include "multibin/fill/SparseFill.h"
 #include "multibin/geometry/Lattice.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 namespace mrpt::maps {

@@ -15,7 +15,7 @@
 #include <string>
 
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/VisibilityConstraint.h"
+#include "multibin/grid/VisibilityConstraint.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/SensorDispatch.h"
 #include "multibin/util/VectorClones.h"

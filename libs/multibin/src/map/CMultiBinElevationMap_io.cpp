@@ -15,9 +15,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "multibin/grid/CellSurface.h"
 #include "multibin/io/MapLayerFiles.h"
 #include "multibin/io/OutputFile.h"
-#include "multibin/map/CellSurface.h"
 #include "multibin/map/TerrainView.h"
 
 using namespace mrpt::maps;

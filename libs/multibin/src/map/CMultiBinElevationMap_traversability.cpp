@@ -14,9 +14,9 @@
 #include <cstring>
 
 #include "CMultiBinElevationMap_impl.h"
+#include "multibin/grid/BinUpdate.h"
+#include "multibin/grid/CellSurface.h"
 #include "multibin/io/EsriAsciiGrid.h"
-#include "multibin/map/BinUpdate.h"
-#include "multibin/map/CellSurface.h"
 
 using namespace mrpt::maps;
 using multibin::traversability::SurfaceSamples;

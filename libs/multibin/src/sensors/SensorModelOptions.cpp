@@ -80,21 +80,10 @@ SensorModelKind SensorModelOptions::modelFor(const std::string& label,
 }
 
 double SensorModelOptions::maxElevationUncertaintyFor(SensorModelKind kind, double map_m) const {
-    double own_m = 0;
-    switch (kind) {
-        case SensorModelKind::laser:
-            own_m = laser.maxElevationUncertainty_m;
-            break;
-        case SensorModelKind::lidar:
-            own_m = lidar.maxElevationUncertainty_m;
-            break;
-        case SensorModelKind::stereo:
-            own_m = stereo.maxElevationUncertainty_m;
-            break;
-        case SensorModelKind::depth:
-            own_m = depth.maxElevationUncertainty_m;
-            break;
-    }
+    const double own_m = kind == SensorModelKind::laser    ? laser.maxElevationUncertainty_m
+                         : kind == SensorModelKind::lidar  ? lidar.maxElevationUncertainty_m
+                         : kind == SensorModelKind::stereo ? stereo.maxElevationUncertainty_m
+                                                           : depth.maxElevationUncertainty_m;
     return own_m > 0 ? own_m : map_m;
 }
 

@@ -19,17 +19,21 @@
 #include <vector>
 
 #include "multibin/fill/FillOptions.h"
+#include "multibin/fill/HeightSource.h"
 #include "multibin/geometry/PointsWithCovariance.h"
-#include "multibin/map/MapTypes.h"
+#include "multibin/grid/InsertStats.h"
+#include "multibin/grid/VisibilityParams.h"
 #include "multibin/sensors/SensorModelOptions.h"
 #include "multibin/traversability/TraversabilityOptions.h"
 
 // The library's internals stay out of this header: these are only named here. Include
-// multibin/map/BinGrid.h to read grid(), multibin/io/EsriAsciiGrid.h to use toRaster(),
-// multibin/fill/HeightRaster.h for lastFill(), multibin/fill/SparseFill.h for fillInput() and
-// lastFilledCells(), multibin/map/MapStatistics.h for statistics().
+// multibin/io/EsriAsciiGrid.h to use toRaster(), multibin/fill/SparseFill.h for fillInput() and
+// lastFilledCells(), multibin/map/MapStatistics.h for statistics(); tests and tools reach the
+// grids and the fill's raster through multibin/map/MapInternals.h.
 namespace multibin {
 class BinGrid;
+struct BinUpdateParams;
+struct MapInternals;
 struct CellWindow;
 struct MapStatistics;
 class PosePropagator;
@@ -76,7 +80,7 @@ namespace mrpt::maps {
  *
  * Pose uncertainty: insertObservation(obs, CPose3DPDFGaussian) uses the given PDF; a plain
  * insertObservation(obs, pose) uses the latest CObservationRobotPose's covariance, or else
- * TInsertionOptions::default_pose_sigmas (and counts a warning, see poseFallbackCount()).
+ * TInsertionOptions::default_pose_sigmas (and counts a warning, see statistics().poseFallbacks).
  *
  * Extent: by default one grid that grows to cover the data it receives (every point within
  * TInsertionOptions::max_range_m of its sensor that passes the eq 13 gate), with no size limit:
@@ -103,7 +107,7 @@ namespace mrpt::maps {
  * Threads: one writer and any number of concurrent readers may share a map. Every public entry
  * point takes a reader-writer lock (insertions, recenter(), dem_update_map() and clear() write;
  * queries, rasters, images and the 3D view read). The accessors that return references into the
- * map (grid(), lastFill(), ...) and the public option structs are not covered: use
+ * map (lastFilledCells(), MapInternals) and the public option structs are not covered: use
  * them from the writer thread or while no one writes. See doc/reliability.md.
  *
  * Observation likelihood is not implemented: canComputeObservationLikelihood() returns false.
@@ -153,6 +157,10 @@ public:
         /** The automatic origin for data at (x, y) [m]: the nearest whole kilometre, rounded to
          * whole cells of the (global) grid so the cells stay on multiples of the cell size. */
         mrpt::math::TPoint2D originNear(double x_m, double y_m) const;
+        /** The origin these options fix before any data arrive: the explicit one, or
+         * originNear() of a single grid's extent centre; none when it waits for the first
+         * insertion. */
+        std::optional<mrpt::math::TPoint2D> originBeforeData() const;
 
         void loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                 const std::string& section) override;
@@ -291,7 +299,6 @@ public:
      * most; the answers keep the points' order). */
     void heights(const double* x_m, const double* y_m, size_t n, HeightAnswer* out) const;
 
-    const multibin::BinGrid& grid() const;
     /** The memory budget's work so far (TCreationOptions::memory_budget_mb). */
     struct TileStoreStats {
         size_t tilesWritten = 0;       //!< tiles written to the scratch file
@@ -310,11 +317,6 @@ public:
      * the rasters export. */
     HeightSource cellElevation(double x_m, double y_m, double& height_m, double& sigma_m,
                                bool includeFilled = true) const;
-    /** True when observations arrived after the last gap filling (dem_update_map() refills). */
-    bool fillIsStale() const;
-    /** The last gap filling's result over the grid window it was run on, as one raster: empty
-     * (stats only) beyond kMaxWholeWindowCells; lastFilledCells() holds it at any size. */
-    const multibin::fill::FillResult& lastFill() const;
     /** The last gap filling's filled cells, tile by tile (absolute cell indices of grid()). */
     const multibin::fill::FilledCells& lastFilledCells() const;
     /** The input of gap filling: each measured cell's surface (without the pose part the cells
@@ -323,7 +325,7 @@ public:
 
     /** height() where measured: height [m] and sigma [m] at (x, y) from the map's surface (the
      * cell surface: its winning bin merged with the adjacent bins that agree with it,
-     * multibin/map/CellSurface.h, at the point as `height_query` says); false if unobserved. With
+     * multibin/grid/CellSurface.h, at the point as `height_query` says); false if unobserved. With
      * the dual grid, where both grids know the place and agree within 3 sigma, their independent
      * estimates are fused (no datum is in both grids); otherwise the more certain one is given. */
     bool getHeight(double x_m, double y_m, double& height_m, double& sigma_m) const;
@@ -344,8 +346,6 @@ public:
 
     /** @name Dual grid @{ */
     bool isDualGrid() const { return creationOptions.dual_grid; }
-    /** The precise local grid (empty unless dual grid). grid() is the global one. */
-    const multibin::BinGrid& localGrid() const;
     /** Centres both grids on (x, y) [m]: cells still inside are untouched; local cells that
      * leave are written back into the global grid. Called before each insertion. */
     void recenter(double x_m, double y_m);
@@ -424,14 +424,6 @@ public:
     /** True if observations with this sensor label are inserted (insertionOptions.sensor_labels
      * is empty or lists it). */
     bool acceptsLabel(const std::string& label) const;
-    /** @name Deprecated: one part of statistics() each (a whole snapshot copied per call). @{ */
-    multibin::InsertStats insertStats() const;                     //!< statistics().insert
-    multibin::VisibilityStats visibilityStats() const;             //!< statistics().visibility
-    size_t poseFallbackCount() const;                              //!< statistics().poseFallbacks
-    size_t skippedByLabelCount() const;                            //!< statistics().skippedByLabel
-    size_t nonFinitePoseCount() const;                             //!< statistics().nonFinitePoses
-    multibin::sensors::SensorModelStats sensorModelStats() const;  //!< statistics().sensorModels
-    /** @} */
     /** @} */
 
     /** @name CMetricMap @{ */
@@ -477,6 +469,17 @@ public:
     MAP_DEFINITION_END(CMultiBinElevationMap)
 
 private:
+    friend struct multibin::MapInternals;  // grid(), localGrid(), lastFill(): tests and tools
+
+    /** The grid (the global one with the dual grid), the precise local grid (empty unless dual
+     * grid), the last gap filling's result over the window it ran on as one raster (empty, stats
+     * only, beyond kMaxWholeWindowCells; lastFilledCells() holds it at any size), and whether
+     * observations arrived after it. */
+    const multibin::BinGrid& grid() const;
+    const multibin::BinGrid& localGrid() const;
+    const multibin::fill::FillResult& lastFill() const;
+    bool fillIsStale() const;
+
     void internal_clear() override;
     bool internal_insertObservation(
         const mrpt::obs::CObservation& obs,
@@ -485,6 +488,9 @@ private:
         const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const override;
     bool internal_canComputeObservationLikelihood(
         const mrpt::obs::CObservation& obs) const override;
+
+    /** One edge of the window in the pose frame [m]: 0 x min, 1 x max, 2 y min, 3 y max. */
+    double windowEdge_m(int edge) const;
 
     /** heightAt() (subCell) or cellHeight(): the map's surface at (x, y) in the pose frame;
      * sigma without the pose part the points share if not `sharedPosePart` (the gap filling's

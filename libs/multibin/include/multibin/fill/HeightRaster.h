@@ -3,8 +3,8 @@
 
 #include <vector>
 
+#include "multibin/fill/HeightSource.h"
 #include "multibin/geometry/Lattice.h"
-#include "multibin/map/MapTypes.h"
 
 namespace multibin::fill {
 

@@ -3,7 +3,8 @@
 
 #include <cstddef>
 
-#include "multibin/map/MapTypes.h"
+#include "multibin/grid/InsertStats.h"
+#include "multibin/grid/VisibilityParams.h"
 #include "multibin/sensors/SensorStats.h"
 
 namespace multibin {

@@ -1,12 +1,12 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/map/VisibilityConstraint.h"
+#include "multibin/grid/VisibilityConstraint.h"
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <algorithm>
 #include <vector>
 
+#include "multibin/grid/VisibilityStages.h"
 #include "multibin/io/OptionKeys.h"
-#include "multibin/map/VisibilityStages.h"
 
 namespace multibin {
 

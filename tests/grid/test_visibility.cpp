@@ -7,10 +7,11 @@
 #include <limits>
 #include <random>
 
-#include "multibin/map/CellSurface.h"
-#include "multibin/map/VisibilityConstraint.h"
-#include "multibin/map/VisibilityRule.h"
-#include "test_scenes.h"
+#include "../core/test_scenes.h"
+#include "multibin/grid/CellSurface.h"
+#include "multibin/grid/VisibilityConstraint.h"
+#include "multibin/grid/VisibilityRule.h"
+#include "multibin/map/MapStatistics.h"
 #include "visibility_test_util.h"
 
 using namespace multibin;
@@ -483,7 +484,9 @@ TEST(Visibility, MovedObjectIsForgottenAndItsSurroundingsKept) {
             EXPECT_GT(cells, 50u);
             EXPECT_EQ(within2Sigma, cells) << "footprint cells back on the ground";
             EXPECT_GE(double(aroundOk), 0.95 * double(around)) << "surroundings unharmed";
-            EXPECT_GT(map.visibilityStats().binsRemoved + map.visibilityStats().binsWeakened, 0u);
+            EXPECT_GT(
+                map.statistics().visibility.binsRemoved + map.statistics().visibility.binsWeakened,
+                0u);
         } else {
             // Without the constraint the box lingers: this is what the constraint fixes.
             EXPECT_LT(within2Sigma, cells);

@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/map/VisibilityIndex.h"
+#include "multibin/grid/VisibilityIndex.h"
 
 namespace multibin {
 

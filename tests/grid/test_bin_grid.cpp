@@ -14,7 +14,9 @@
 #include <random>
 
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorDispatch.h"
 
 using namespace multibin;
@@ -593,7 +595,7 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
             ASSERT_TRUE(multibin::sensors::observationToSensorPoints(
                 *obs, pdf, io.sensors, io.min_range_m, io.max_range_m, growingState, again));
             propagator.apply(again.points, mapPoints);
-            const BinGrid& g = growing->grid();
+            const BinGrid& g = multibin::MapInternals::grid(*growing);
             const Eigen::Vector3d& s = propagator.sensorOriginInMap_m();
             const double half = growing->insertionOptions.max_range_m;
             const BinUpdateParams gate{0.05, 1.0f, io.max_elevation_uncertainty_m};
@@ -611,11 +613,14 @@ TEST(MapInsertion, FusedDispatchBuildsTheSameMapAsTwoStepsOnTheMockup) {
     EXPECT_GT(observations, 40u);
     EXPECT_GT(stereo, 3u);
     EXPECT_GT(growthChecked, 50000u);
-    EXPECT_GT(fused->grid().binCount(), 10000u);
-    EXPECT_EQ(fused->insertStats().accepted, twoSteps->insertStats().accepted);
-    EXPECT_EQ(fused->visibilityStats().binsRemoved, twoSteps->visibilityStats().binsRemoved);
-    EXPECT_EQ(fused->visibilityStats().binsWeakened, twoSteps->visibilityStats().binsWeakened);
-    EXPECT_TRUE(binBytes(fused->grid()) == binBytes(twoSteps->grid()));
+    EXPECT_GT(multibin::MapInternals::grid(*fused).binCount(), 10000u);
+    EXPECT_EQ(fused->statistics().insert.accepted, twoSteps->statistics().insert.accepted);
+    EXPECT_EQ(fused->statistics().visibility.binsRemoved,
+              twoSteps->statistics().visibility.binsRemoved);
+    EXPECT_EQ(fused->statistics().visibility.binsWeakened,
+              twoSteps->statistics().visibility.binsWeakened);
+    EXPECT_TRUE(binBytes(multibin::MapInternals::grid(*fused)) ==
+                binBytes(multibin::MapInternals::grid(*twoSteps)));
 }
 
 TEST(BinGrid, PoseVariancesFewerThanThePointsAreAnErrorNamingThem) {

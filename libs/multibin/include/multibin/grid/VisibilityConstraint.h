@@ -4,8 +4,9 @@
 #include <Eigen/Core>
 #include <cstddef>
 
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/MapTypes.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/BinUpdate.h"
+#include "multibin/grid/VisibilityParams.h"
 
 namespace multibin {
 

@@ -9,7 +9,7 @@
 #include <emmintrin.h>
 #endif
 
-#include "multibin/map/VisibilityStages.h"
+#include "multibin/grid/VisibilityStages.h"
 
 namespace multibin::visibility {
 

@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/map/BinStore.h"
+#include "multibin/grid/BinStore.h"
 
 #include <cmath>
 #include <cstring>

@@ -1,10 +1,10 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/map/VisibilityRule.h"
+#include "multibin/grid/VisibilityRule.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "multibin/map/CellSurface.h"
+#include "multibin/grid/CellSurface.h"
 
 namespace multibin {
 

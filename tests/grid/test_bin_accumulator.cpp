@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "multibin/map/BinAccumulator.h"
+#include "multibin/grid/BinAccumulator.h"
 
 using namespace multibin;
 

@@ -3,8 +3,8 @@
 
 #include <memory>
 
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/MapTypes.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/BinUpdate.h"
 
 namespace multibin {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstddef>
 
-#include "multibin/map/VisibilityStages.h"
+#include "multibin/grid/VisibilityStages.h"
 
 namespace multibin::visibility {
 

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "multibin/geometry/Lattice.h"
-#include "multibin/map/Bin.h"
-#include "multibin/map/TileStoreFile.h"
+#include "multibin/grid/Bin.h"
+#include "multibin/grid/TileStoreFile.h"
 
 namespace multibin {
 

@@ -11,9 +11,9 @@
 #include <cstring>
 #include <random>
 
-#include "multibin/map/VisibilityConstraint.h"
-#include "multibin/map/VisibilityRule.h"
-#include "multibin/map/VisibilityStages.h"
+#include "multibin/grid/VisibilityConstraint.h"
+#include "multibin/grid/VisibilityRule.h"
+#include "multibin/grid/VisibilityStages.h"
 #include "visibility_test_util.h"
 
 using namespace multibin;

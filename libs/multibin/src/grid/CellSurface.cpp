@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/map/CellSurface.h"
+#include "multibin/grid/CellSurface.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "multibin/map/BinUpdate.h"
+#include "multibin/grid/BinUpdate.h"
 
 namespace multibin {
 

@@ -23,10 +23,10 @@
 #include <utility>
 #include <vector>
 
-#include "multibin/map/BinGrid.h"
-#include "multibin/map/MapTypes.h"
-#include "multibin/map/VisibilityConstraint.h"
-#include "multibin/map/VisibilityRule.h"
+#include "multibin/grid/BinGrid.h"
+#include "multibin/grid/VisibilityConstraint.h"
+#include "multibin/grid/VisibilityParams.h"
+#include "multibin/grid/VisibilityRule.h"
 
 namespace multibin::visibility {
 

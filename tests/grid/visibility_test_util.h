@@ -7,7 +7,7 @@
 #include <cstring>
 #include <vector>
 
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
 
 namespace multibin::test {
 

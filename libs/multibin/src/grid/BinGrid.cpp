@@ -1,12 +1,12 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/map/BinGrid.h"
+#include "multibin/grid/BinGrid.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "multibin/geometry/PosePropagation.h"
-#include "multibin/map/BinAccumulator.h"
+#include "multibin/grid/BinAccumulator.h"
 #include "multibin/util/Counters.h"
 #include "multibin/util/VectorClones.h"
 

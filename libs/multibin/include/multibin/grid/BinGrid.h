@@ -8,11 +8,11 @@
 
 #include "multibin/geometry/Lattice.h"
 #include "multibin/geometry/PointsWithCovariance.h"
-#include "multibin/map/Bin.h"
-#include "multibin/map/BinStore.h"
-#include "multibin/map/BinUpdate.h"
-#include "multibin/map/MapTypes.h"
-#include "multibin/map/VisibilityIndex.h"
+#include "multibin/grid/Bin.h"
+#include "multibin/grid/BinStore.h"
+#include "multibin/grid/BinUpdate.h"
+#include "multibin/grid/InsertStats.h"
+#include "multibin/grid/VisibilityIndex.h"
 
 namespace multibin {
 
@@ -24,7 +24,7 @@ struct PoseVariances;
  * bin's update through BinAccumulator.h) and the visibility index kept in step with both
  * (VisibilityIndex: update cycles, block height bounds), as OctoMap's OccupancyOcTreeBase adds its
  * update rule to the storage of OcTreeBaseImpl. The insertion on two cores runs through
- * src/map/InsertionPipeline.h. Memory: 16 B per cell of an allocated tile (4 B store, 12 B index:
+ * src/grid/InsertionPipeline.h. Memory: 16 B per cell of an allocated tile (4 B store, 12 B index:
  * 64 KB per tile of 64 x 64 cells), 4 B per block of 256 cells and 64 B per bin (Bin.h). */
 class BinGrid {
 public:

@@ -5,8 +5,8 @@
 #include <cstdint>
 #include <limits>
 
-#include "multibin/map/Bin.h"
-#include "multibin/map/BinUpdate.h"
+#include "multibin/grid/Bin.h"
+#include "multibin/grid/BinUpdate.h"
 #include "multibin/util/Counters.h"
 
 namespace multibin {

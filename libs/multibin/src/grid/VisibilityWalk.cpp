@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "multibin/map/VisibilityStages.h"
+#include "multibin/grid/VisibilityStages.h"
 
 namespace multibin::visibility {
 

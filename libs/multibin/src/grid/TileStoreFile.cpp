@@ -1,5 +1,5 @@
 /* Part of the multibin elevation-mapping library. */
-#include "multibin/map/TileStoreFile.h"
+#include "multibin/grid/TileStoreFile.h"
 
 #include <fcntl.h>
 #include <unistd.h>

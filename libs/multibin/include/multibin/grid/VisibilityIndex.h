@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "multibin/map/BinStore.h"
+#include "multibin/grid/BinStore.h"
 
 namespace multibin {
 

@@ -7,11 +7,24 @@
 #include <cstdint>
 #include <cstring>
 
-#include "multibin/map/Bin.h"
-#include "multibin/map/MapTypes.h"
+#include "multibin/grid/Bin.h"
 #include "multibin/util/Counters.h"
 
 namespace multibin {
+
+/** Parameters of the per-point bin update (eqs 13-15). */
+struct BinUpdateParams {
+    double binHeight_m = 0.05;               //!< vertical bin size [m]
+    float certaintyIncrement = 1.0f;         //!< `a` of eqs 13-14
+    double maxElevationUncertainty_m = 0.1;  //!< Delta_max: a point counts if 3 sigma_z <= this [m]
+    double varianceFloor_m2 = 0.002 * 0.002;  //!< reported variance never falls below this [m^2]
+
+    /** Eq 13 gate: a height with this variance [m^2] counts only if its 99.7 % interval
+     * (3 sigma) lies within Delta_max. */
+    bool passesEq13(double variance_m2) const {
+        return !(9.0 * variance_m2 > maxElevationUncertainty_m * maxElevationUncertainty_m);
+    }
+};
 
 /** @name The update rule of a bin: eq 15, a static 1-D Kalman filter over heights. The one home
  * of its arithmetic: the per-point update, runs of points fused at once, bins fused from another
