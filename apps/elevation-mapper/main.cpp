@@ -39,6 +39,7 @@
 #include "RawlogSource.h"
 #include "RunWarnings.h"
 #include "multibin/fill/HeightRaster.h"
+#include "multibin/fill/SparseFill.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/NumberText.h"
 #include "multibin/io/OutputFile.h"
@@ -413,7 +414,7 @@ int run(const Arguments& args, std::string& stage) {
     outputs.addSince(outputs0);
     outputs.subtract(scoring);
 
-    const auto& fs_ = elevation->lastFill().stats;
+    const auto& fs_ = elevation->lastFilledCells().stats;
     std::cout << elevation->asString() << "\n"
               << insertSummary(elevation->insertStats()) << "\n"
               << "observations with the default pose covariance: " << elevation->poseFallbackCount()

@@ -17,6 +17,7 @@
 #include "ArrayInput.h"
 #include "HeightQuery.h"
 #include "multibin/fill/HeightRaster.h"
+#include "multibin/fill/SparseFill.h"
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/EsriAsciiGrid.h"
@@ -317,7 +318,7 @@ py::dict ElevationMap::fill() {
         py::gil_scoped_release nogil;
         m_map->dem_update_map();
     }
-    const fill::FillResult::Stats& s = m_map->lastFill().stats;
+    const fill::FillResult::Stats& s = m_map->lastFilledCells().stats;
     py::dict d;
     d["measured"] = s.measured;
     d["median"] = s.median;

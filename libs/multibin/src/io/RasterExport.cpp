@@ -202,12 +202,19 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         const auto& rgb = colourAt(lut, (v - lo) / span);
         return {rgb[2], rgb[1], rgb[0]};
     };
+    // Each sample's colour once, row by row (the raster is column-major), then copied to its
+    // pixels: the panel is the preview's largest part.
+    std::vector<cv::Vec3b> rowColours(static_cast<size_t>(cols));
+    int colouredRow = -1;
     for (int py = 0; py < H; py++) {
         const int r = rows - 1 - std::min(rows - 1, int(py / scale));  // north up
-        for (int px = 0; px < W; px++) {
-            const int c = std::min(cols - 1, int(px / scale));
-            img.at<cv::Vec3b>(T + py, L + px) = colourOf(raster.heights_m(r, c));
+        if (r != colouredRow) {
+            for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
+            colouredRow = r;
         }
+        cv::Vec3b* pixel = img.ptr<cv::Vec3b>(T + py) + L;
+        for (int px = 0; px < W; px++)
+            pixel[px] = rowColours[size_t(std::min(cols - 1, int(px / scale)))];
     }
     cv::rectangle(img, {L - 1, T - 1}, {L + W, T + H}, kBlack);
 
