@@ -393,16 +393,20 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     const multibin::fill::FilledCells& f = m_impl->filled;
     const multibin::CellWindow& fw = m_impl->fillWindow;
     const bool withFill = insertionOptions.dem_return_filled;
+    // The filled cells' tile of the store tile being read, found once per tile (not per cell).
+    const multibin::fill::FilledCell* filledTile = nullptr;
     const auto mayBeKnown = [&](int ix, int iy) {
         return m_impl->holdsBins(ix, iy, isDualGrid()) ||
-               (withFill && fw.contains(ix, iy) && f.find(ix, iy));
+               (filledTile && fw.contains(ix, iy) &&
+                filledTile[multibin::fill::TiledCells<int>::inTile(ix, iy)].source !=
+                    multibin::HeightSource::Unknown);
     };
     using Store = multibin::BinStore;
     static_assert(Store::kTileCells == multibin::fill::TiledCells<int>::kSide,
                   "the filled cells' tiles are the store's");
     const auto tileMayHoldKnown = [&](int tx, int ty) {
-        return isDualGrid() || grid.store().tileNumber(tx, ty) != 0 ||
-               (withFill && f.cells.findTile(tx, ty));
+        filledTile = withFill ? f.cells.findTile(tx, ty) : nullptr;
+        return isDualGrid() || grid.store().tileNumber(tx, ty) != 0 || filledTile;
     };
     const auto readCell = [&](int ix, int iy) {
         if (!mayBeKnown(ix, iy)) return;
