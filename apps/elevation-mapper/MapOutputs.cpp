@@ -46,7 +46,7 @@ const Group kGroups[] = {
     {"scene", &OutputSelection::scene, "elevation.3Dscene (3D view, opens in SceneViewer3D)"},
     {"png", &OutputSelection::png,
      "elevation_{height,sigma,source}.png (previews: axes [m], scale, legend;\n"
-     "        downsampled beyond 2048 cells a side)"},
+     "        downsampled beyond 1024 cells a side)"},
     {"asc", &OutputSelection::asc,
      "elevation_{height,sigma,certainty,source}.asc (ESRI ASCII; dense: up to 4096 x 4096\n"
      "        known cells)"},

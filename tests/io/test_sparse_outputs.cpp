@@ -7,6 +7,8 @@
 #include <geovalues.h>
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
+#include <mrpt/opengl/CMesh.h>
+#include <mrpt/opengl/CSetOfObjects.h>
 #include <tiffio.h>
 #include <xtiffio.h>
 
@@ -15,12 +17,17 @@
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 
+#include "multibin/fill/SparseFill.h"
+#include "multibin/grid/BinGrid.h"
 #include "multibin/io/GeoTiff.h"
 #include "multibin/io/MapLayerFiles.h"
 #include "multibin/io/TiledRaster.h"
+#include "multibin/map/MapInternals.h"
+#include "multibin/map/TerrainView.h"
 
 namespace fs = std::filesystem;
 using multibin::CellWindow;
@@ -277,11 +284,11 @@ TEST(TiledRaster, BlockReductionAndPreviewOfALongRoute) {
     EXPECT_GT(compared, 800);
     const multibin::EsriAsciiGrid p =
         multibin::previewRasters({route}, {multibin::MapLayer::Height}, box).front();
-    EXPECT_EQ(p.cols(), (6010 + 2) / 3);  // k = 3 brings 6010 cells within 2048
+    EXPECT_EQ(p.cols(), (6010 + 5) / 6);  // k = 6 brings 6010 cells within 1024
     EXPECT_LE(std::max(p.rows(), p.cols()), multibin::kPreviewMaxSide_px);
     EXPECT_EQ(strip.largestRequest_cells, size_t(256 * 256));
     // The route stays visible along the whole diagonal.
-    for (const int k : {10, 1000, 1990}) EXPECT_TRUE(std::isfinite(p.heights_m(k, k))) << k;
+    for (const int k : {5, 500, 995}) EXPECT_TRUE(std::isfinite(p.heights_m(k, k))) << k;
     EXPECT_FALSE(
         multibin::layerPreviewPngs({route}, {multibin::MapLayer::Height}, box).front().empty());
 }
@@ -381,4 +388,119 @@ TEST(SparseMapOutputs, GetAsImageOfALongWindowIsDownsampled) {
             coloured += (p[0] | p[1] | p[2]) != 0;
         }
     EXPECT_EQ(coloured, 2u);
+}
+
+namespace {
+/** The cells of the map's stored tiles and of the filled cells' tiles: what an output that
+ * follows the data reads at most once. */
+size_t storedTileCells(const Map& map) {
+    return (multibin::MapInternals::grid(map).store().tileCount() +
+            map.lastFilledCells().cells.tileCount()) *
+           multibin::BinStore::kTileSlots;
+}
+}  // namespace
+
+// Issue 35, "no stage costs more than insertion on a sparse map": each output reads the cells of
+// the map's stored 64 x 64 tiles once (the 3D view twice: its box, then its raster), not the
+// 256 x 256 tiles it writes nor the window. Counted (rasterReadCounters()), not timed; reading
+// every cell of the tiles written, as before, visits 4 to 16 x more here.
+TEST(SparseMapOutputs, EachOutputReadsTheStoredTilesNotTheWindow) {
+    const double d = 300 / std::sqrt(2.0);
+    const auto map = patchMap({{0, 0}, {d, d}});
+    const size_t stored = storedTileCells(*map);
+    EXPECT_LE(stored, size_t(8 * 4096));  // two 40 x 40-cell patches: at most 4 tiles each
+    auto& visited = multibin::rasterReadCounters().cellsVisited;
+    const auto layers = multibin::tiledLayers(
+        *map, {multibin::MapLayer::Height, multibin::MapLayer::Sigma, multibin::MapLayer::Source});
+    EXPECT_EQ(layers[0].tiles.size(), 2u);  // two 256 x 256 tiles written: 131 072 cells
+    visited = 0;
+    const CellWindow box = multibin::knownWindow(layers[0], 5);
+    EXPECT_GT(visited, 0u);
+    EXPECT_LE(visited, stored) << "the known box";
+    visited = 0;
+    multibin::saveSparseGeoTiff(layers[0], (scratchDir("counts") / "h.tif").string(), {});
+    EXPECT_GT(visited, 0u);
+    EXPECT_LE(visited, stored) << "the GeoTIFF";
+    visited = 0;
+    multibin::layerPreviewPngs(
+        layers, {multibin::MapLayer::Height, multibin::MapLayer::Sigma, multibin::MapLayer::Source},
+        box);
+    EXPECT_LE(visited, stored) << "three previews";
+    visited = 0;
+    mrpt::opengl::CSetOfObjects view;
+    multibin::buildTerrainView(*map, multibin::SceneColouring::Height, view);
+    EXPECT_LE(visited, 2 * stored) << "the 3D view";
+}
+
+// The 3D view's meshes cover the tiles of its raster holding data: every known cell is a vertex
+// (masked in) at its centre with its height, as in one mesh over the raster; two patches 200 m
+// apart take a few tiles of vertices, not their box (606 x 606 vertices).
+TEST(SparseMapOutputs, TheSceneMeshesHoldEveryKnownCellAndOnlyTilesAroundTheData) {
+    const double d = 200 / std::sqrt(2.0);
+    const auto map = patchMap({{0, 0}, {d, d}});
+    mrpt::opengl::CSetOfObjects view;
+    multibin::buildTerrainView(*map, multibin::SceneColouring::Height, view);
+    size_t vertices = 0, meshes = 0;
+    std::set<std::pair<long, long>> known;  // cells, once (neighbouring meshes share a row)
+    for (const auto& o : view) {
+        const auto m = std::dynamic_pointer_cast<mrpt::opengl::CMesh>(o);
+        if (!m || m->getName() != "CMultiBinElevationMap") continue;
+        meshes++;
+        mrpt::math::CMatrixFloat Z, mask;
+        m->getZ(Z);
+        m->getMask(mask);
+        vertices += size_t(Z.rows() * Z.cols());
+        const double dx = (m->getxMax() - m->getxMin()) / (Z.rows() - 1),
+                     dy = (m->getyMax() - m->getyMin()) / (Z.cols() - 1);
+        for (int i = 0; i < Z.rows(); i++)
+            for (int j = 0; j < Z.cols(); j++) {
+                if (mask(i, j) == 0.f) continue;
+                const double x = m->getxMin() + i * dx, y = m->getyMin() + j * dy;
+                double h = 0, s = 0;
+                ASSERT_TRUE(map->cellHeight(x, y, h, s)) << x << " " << y;
+                EXPECT_EQ(Z(i, j), float(h)) << x << " " << y;
+                known.emplace(std::lround(x / 0.25 - 0.5), std::lround(y / 0.25 - 0.5));
+            }
+    }
+    EXPECT_EQ(known.size(), 2u * 40 * 40);
+    EXPECT_GE(meshes, 2u);
+    EXPECT_LE(vertices, size_t(8 * 65 * 65));
+}
+
+// The rasters read tile by tile hold, at every cell of the window, what the map's cell query
+// answers: height, sigma, source, and a certainty where measured (0 where filled).
+TEST(SparseMapOutputs, RastersOfTheWindowAreTheCellQueriesCellForCell) {
+    Map map;
+    map.creationOptions.resolution_m = 0.25;
+    map.setCreationOptions(map.creationOptions);
+    for (const double x0 : {0.0, 40.0})
+        for (int i = 0; i < 40; i++)
+            for (int j = 0; j < 40; j++)
+                if (std::abs(i - 20) > 1 || std::abs(j - 20) > 1)  // a hole to fill
+                    map.insertIndividualPoint(x0 + 0.125 + 0.25 * i, 0.125 + 0.25 * j,
+                                              0.3 + 0.01 * i - 0.005 * j);
+    map.dem_update_map();
+    using L = Map::RasterLayer;
+    const std::vector<multibin::EsriAsciiGrid> g = map.toRasters(
+        {L::Height, L::Sigma, L::Source, L::Certainty}, multibin::MapInternals::grid(map).window());
+    size_t knownCells = 0, filled = 0;
+    for (int r = 0; r < g[0].rows(); r++)
+        for (int c = 0; c < g[0].cols(); c++) {
+            const double x = g[0].xllcenter_m + c * g[0].cellsize_m,
+                         y = g[0].yllcenter_m + r * g[0].cellsize_m;
+            double h = 0, s = 0;
+            const Map::HeightSource src = map.cellElevation(x, y, h, s, true);
+            if (src == Map::HeightSource::Unknown) {
+                for (int k = 0; k < 4; k++) ASSERT_TRUE(std::isnan(g[k].heights_m(r, c)));
+                continue;
+            }
+            knownCells++;
+            filled += src != Map::HeightSource::Measured;
+            ASSERT_EQ(g[0].heights_m(r, c), float(h)) << x << " " << y;
+            ASSERT_EQ(g[1].heights_m(r, c), float(s));
+            ASSERT_EQ(g[2].heights_m(r, c), float(int(src)));
+            ASSERT_EQ(g[3].heights_m(r, c) > 0, src == Map::HeightSource::Measured);
+        }
+    EXPECT_EQ(knownCells, 2u * 40 * 40);
+    EXPECT_EQ(filled, 2u * 9);
 }

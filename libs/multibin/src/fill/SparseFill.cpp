@@ -199,8 +199,9 @@ HeightRaster SparseHeights::toRaster(const CellWindow& w) const {
 }
 
 FillResult FilledCells::toResult(const SparseHeights& in) const {
-    // In one pass over the window (no HeightRaster of it): measured cells from in's tiles, then
-    // the filled ones, as detail::initResult and fillGaps() set them.
+    // In one pass over the window (no HeightRaster of it): the filled cells, then the measured
+    // ones from in's tiles (disjoint after a fill; a cell measured since answers with its
+    // measurement, as the queries do).
     FillResult out;
     out.lattice = lattice;
     out.height_m.assign(lattice.cellCount(), detail::kNaN);
@@ -208,6 +209,10 @@ FillResult FilledCells::toResult(const SparseHeights& in) const {
     out.source.assign(lattice.cellCount(), HeightSource::Unknown);
     const CellWindow& w = lattice.window;
     constexpr int kSide = TiledCells<MeasuredCell>::kSide;
+    forEachFilled([&](int ix, int iy, const FilledCell& c) {
+        const size_t k = out.index(ix - w.ix0, iy - w.iy0);
+        out.height_m[k] = c.height_m, out.sigma_m[k] = c.sigma_m, out.source[k] = c.source;
+    });
     in.cells.forEachTile([&](int tx, int ty, const MeasuredCell* t) {
         for (size_t k = 0; k < TiledCells<MeasuredCell>::kTileCells; k++) {
             const int ix = tx * kSide + int(k) % kSide, iy = ty * kSide + int(k) / kSide;
@@ -216,10 +221,6 @@ FillResult FilledCells::toResult(const SparseHeights& in) const {
             out.height_m[q] = t[k].height_m, out.sigma_m[q] = t[k].sigma_m;
             out.source[q] = HeightSource::Measured;
         }
-    });
-    forEachFilled([&](int ix, int iy, const FilledCell& c) {
-        const size_t k = out.index(ix - w.ix0, iy - w.iy0);
-        out.height_m[k] = c.height_m, out.sigma_m[k] = c.sigma_m, out.source[k] = c.source;
     });
     out.stats = stats;
     return out;

@@ -54,6 +54,9 @@ void setTags(TIFF* tif, const TiledRaster& raster, const CellWindow& bounds,
     need(TIFFSetField(tif, TIFFTAG_TILELENGTH, uint32_t(kGeoTiffTile)), "TileLength");
     need(TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_ADOBE_DEFLATE), "Compression");
     need(TIFFSetField(tif, TIFFTAG_PREDICTOR, PREDICTOR_FLOATINGPOINT), "Predictor");
+    // Deflate's fastest level: the tiles are mostly NaN (a route's thin strip), which any level
+    // packs to almost nothing, while level 6 (libtiff's default) takes most of the writing.
+    need(TIFFSetField(tif, TIFFTAG_ZIPQUALITY, 1), "ZipQuality");
     need(TIFFSetField(tif, TIFFTAG_GDAL_NODATA, "nan"), "GDAL_NODATA");
     if (!options.description.empty())
         need(TIFFSetField(tif, TIFFTAG_IMAGEDESCRIPTION, options.description.c_str()),

@@ -161,6 +161,28 @@ int textWidth(const std::string& s, double size = 0.4) {
     return cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, size, 1, &base).width;
 }
 
+/** The map panel of a preview: pixel (px, py) of rectangle `panel` shows sample
+ * (rows - 1 - py / scale, px / scale) (north up) in colourOf(value). */
+template <typename ColourOf>
+void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv::Rect& panel,
+               const ColourOf& colourOf) {
+    const int rows = raster.rows(), cols = raster.cols();
+    // Each sample's colour once, row by row (the raster is column-major), then copied to its
+    // pixels: the panel is the preview's largest part.
+    std::vector<cv::Vec3b> rowColours(static_cast<size_t>(cols));
+    int colouredRow = -1;
+    for (int py = 0; py < panel.height; py++) {
+        const int r = rows - 1 - std::min(rows - 1, int(py / scale));  // north up
+        if (r != colouredRow) {
+            for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
+            colouredRow = r;
+        }
+        cv::Vec3b* pixel = img.ptr<cv::Vec3b>(panel.y + py) + panel.x;
+        for (int px = 0; px < panel.width; px++)
+            pixel[px] = rowColours[size_t(std::min(cols - 1, int(px / scale)))];
+    }
+}
+
 }  // namespace
 
 std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const PreviewStyle& style) {
@@ -202,13 +224,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         const auto& rgb = colourAt(lut, (v - lo) / span);
         return {rgb[2], rgb[1], rgb[0]};
     };
-    for (int py = 0; py < H; py++) {
-        const int r = rows - 1 - std::min(rows - 1, int(py / scale));  // north up
-        for (int px = 0; px < W; px++) {
-            const int c = std::min(cols - 1, int(px / scale));
-            img.at<cv::Vec3b>(T + py, L + px) = colourOf(raster.heights_m(r, c));
-        }
-    }
+    drawPanel(img, raster, scale, {L, T, W, H}, colourOf);
     cv::rectangle(img, {L - 1, T - 1}, {L + W, T + H}, kBlack);
 
     // Axes in metres: ticks at cell edges' coordinates, nice steps.

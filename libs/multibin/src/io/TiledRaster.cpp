@@ -21,6 +21,11 @@ CellWindow intersection(const CellWindow& a, const CellWindow& b) {
 }
 }  // namespace
 
+RasterReadCounters& rasterReadCounters() {
+    thread_local RasterReadCounters counters;
+    return counters;
+}
+
 CellWindow tileOfCell(int ix, int iy, int tileCells) {
     return CellWindow{floorDiv(ix, tileCells) * tileCells, floorDiv(iy, tileCells) * tileCells,
                       tileCells, tileCells};

@@ -85,10 +85,6 @@ const multibin::BinGrid& CMultiBinElevationMap::localGrid() const {
     return m_impl->local;
 }
 bool CMultiBinElevationMap::fillIsStale() const { return m_impl->fillStale; }
-const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const {
-    prepareForReading();
-    return m_impl->fill;
-}
 multibin::MapStatistics CMultiBinElevationMap::statistics() const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     return {m_impl->stats,         m_impl->visibilityStats, m_impl->sensorState.stats,
@@ -142,6 +138,7 @@ void CMultiBinElevationMap::internal_clear() {
     m_impl->lastRobotPose.reset();
     m_impl->sensorState.reset();
     m_impl->fill = {};
+    m_impl->fillRasterBuilt = false;
     m_impl->filled = {};
     m_impl->fillWindow = {};
     m_impl->fillStale = true;

@@ -67,14 +67,25 @@ void CMultiBinElevationMap::fillNow() const {
     const multibin::fill::SparseHeights in = fillInput();
     m_impl->filled = multibin::fill::fillSparse(in, insertionOptions.fill);
     m_impl->fillWindow = in.lattice.window;
-    // One raster for lastFill() and the traversability layers, where the window allows it.
-    if (in.lattice.cellCount() <= kMaxWholeWindowCells) {
-        m_impl->fill = m_impl->filled.toResult(in);
-    } else {
-        m_impl->fill = {};
-        m_impl->fill.stats = m_impl->filled.stats;
-    }
+    // lastFill()'s raster of the window is built when first asked for: the statistics now.
+    m_impl->fill = {};
+    m_impl->fill.stats = m_impl->filled.stats;
+    m_impl->fillRasterBuilt = false;
     m_impl->fillStale = false;
+}
+
+const multibin::fill::FillResult& CMultiBinElevationMap::lastFill() const {
+    prepareForReading();
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    const std::lock_guard<std::mutex> build(m_impl->fillRasterMutex.m);
+    if (!m_impl->fillRasterBuilt && m_impl->fillWindow.cellCount() > 0 &&
+        m_impl->fillWindow.cellCount() <= kMaxWholeWindowCells) {
+        // The measured cells as the queries answer them now (the same as at the fill unless
+        // observations came since), the filled ones of the fill.
+        m_impl->fill = m_impl->filled.toResult(fillInput());
+    }
+    m_impl->fillRasterBuilt = true;
+    return m_impl->fill;
 }
 
 const multibin::fill::FilledCells& CMultiBinElevationMap::lastFilledCells() const {

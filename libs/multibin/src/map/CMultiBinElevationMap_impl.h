@@ -5,6 +5,7 @@
 
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
+#include <mutex>
 #include <optional>
 
 #include "MapLock.h"
@@ -37,9 +38,18 @@ struct CMultiBinElevationMap::Impl {
     /** The last gap filling's filled cells, over fillWindow of grid (absolute cell indices): what
      * the queries and rasters read. */
     multibin::fill::FilledCells filled;
-    /** The same as one raster over fillWindow (lastFill(), the traversability layers); empty
-     * beyond kMaxWholeWindowCells. */
+    /** The same as one raster over fillWindow, for lastFill() only: built on its first call
+     * (9 B per window cell, which the mapper and the queries never pay), under fillRasterMutex;
+     * statistics only until then and beyond kMaxWholeWindowCells. */
     multibin::fill::FillResult fill;
+    bool fillRasterBuilt = false;
+    /** Readers share the map's lock: the first lastFill() builds `fill` under this one. */
+    struct CopyableMutex {
+        std::mutex m;
+        CopyableMutex() = default;
+        CopyableMutex(const CopyableMutex&) {}
+        CopyableMutex& operator=(const CopyableMutex&) { return *this; }
+    } fillRasterMutex;
     multibin::CellWindow fillWindow;
     bool fillStale = true;
     /** One writer or concurrent readers: every public entry point takes it (MapLock.h). */

@@ -387,49 +387,71 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     g.yllcenter_m += o.y();
     std::vector<multibin::EsriAsciiGrid> out(layers.size(), g);
     // A cell without a bin in either grid and without a filled value is unknown: most cells of
-    // a sparse route's tiles, skipped without a query.
+    // a sparse route's tiles, skipped without a query; and a tile of the grid's store with
+    // neither (most of a long route's window) skipped whole, so the cost follows the tiles that
+    // hold data, not the window.
     const multibin::fill::FilledCells& f = m_impl->filled;
     const multibin::CellWindow& fw = m_impl->fillWindow;
     const bool withFill = insertionOptions.dem_return_filled;
+    // The filled cells' tile of the store tile being read, found once per tile (not per cell).
+    const multibin::fill::FilledCell* filledTile = nullptr;
     const auto mayBeKnown = [&](int ix, int iy) {
         return m_impl->holdsBins(ix, iy, isDualGrid()) ||
-               (withFill && fw.contains(ix, iy) && f.find(ix, iy));
+               (filledTile && fw.contains(ix, iy) &&
+                filledTile[multibin::fill::TiledCells<int>::inTile(ix, iy)].source !=
+                    multibin::HeightSource::Unknown);
     };
-    for (int r = 0; r < w.ny; r++)
-        for (int c = 0; c < w.nx; c++) {
-            const int ix = w.ix0 + c, iy = w.iy0 + r;
-            if (!mayBeKnown(ix, iy)) continue;
-            double h, s;
-            const HeightSource src =
-                cellElevation(o.x() + grid.cellCenter_m(ix), o.y() + grid.cellCenter_m(iy), h, s,
-                              insertionOptions.dem_return_filled);
-            if (src == HeightSource::Unknown) continue;
-            for (size_t k = 0; k < layers.size(); k++) {
-                float& v = out[k].heights_m(r, c);
-                switch (layers[k]) {
-                    case RasterLayer::Height:
-                        v = float(h);
-                        break;
-                    case RasterLayer::Sigma:
-                        v = float(s);
-                        break;
-                    case RasterLayer::Source:
-                        v = float(static_cast<int>(src));
-                        break;
-                    case RasterLayer::Certainty: {
-                        // The certainty of the surface the height layer reports (0 where
-                        // filled).
-                        multibin::CellSurface cs;
-                        v = src == HeightSource::Measured &&
-                                    multibin::surfaceAt(
-                                        grid, isDualGrid() ? &m_impl->local : nullptr,
-                                        grid.cellCenter_m(ix), grid.cellCenter_m(iy),
-                                        binUpdateParams(), false, cs)
-                                ? float(cs.certainty)
-                                : 0.f;
-                    } break;
-                }
+    using Store = multibin::BinStore;
+    static_assert(Store::kTileCells == multibin::fill::TiledCells<int>::kSide,
+                  "the filled cells' tiles are the store's");
+    const auto tileMayHoldKnown = [&](int tx, int ty) {
+        filledTile = withFill ? f.cells.findTile(tx, ty) : nullptr;
+        return isDualGrid() || grid.store().tileNumber(tx, ty) != 0 || filledTile;
+    };
+    const auto readCell = [&](int ix, int iy) {
+        if (!mayBeKnown(ix, iy)) return;
+        double h, s;
+        const HeightSource src =
+            cellElevation(o.x() + grid.cellCenter_m(ix), o.y() + grid.cellCenter_m(iy), h, s,
+                          insertionOptions.dem_return_filled);
+        if (src == HeightSource::Unknown) return;
+        for (size_t k = 0; k < layers.size(); k++) {
+            float& v = out[k].heights_m(iy - w.iy0, ix - w.ix0);
+            switch (layers[k]) {
+                case RasterLayer::Height:
+                    v = float(h);
+                    break;
+                case RasterLayer::Sigma:
+                    v = float(s);
+                    break;
+                case RasterLayer::Source:
+                    v = float(static_cast<int>(src));
+                    break;
+                case RasterLayer::Certainty: {
+                    // The certainty of the surface the height layer reports (0 where
+                    // filled).
+                    multibin::CellSurface cs;
+                    v = src == HeightSource::Measured &&
+                                multibin::surfaceAt(grid, isDualGrid() ? &m_impl->local : nullptr,
+                                                    grid.cellCenter_m(ix), grid.cellCenter_m(iy),
+                                                    binUpdateParams(), false, cs)
+                            ? float(cs.certainty)
+                            : 0.f;
+                } break;
             }
+        }
+    };
+    for (int ty = Store::tileOf(w.iy0); w.nx > 0 && ty <= Store::tileOf(w.iy0 + w.ny - 1); ty++)
+        for (int tx = Store::tileOf(w.ix0); tx <= Store::tileOf(w.ix0 + w.nx - 1); tx++) {
+            if (!tileMayHoldKnown(tx, ty)) continue;
+            // Multiplied, not shifted: tile indices are negative left of the origin.
+            const int xa = std::max(tx * Store::kTileCells, w.ix0),
+                      xb = std::min((tx + 1) * Store::kTileCells, w.ix0 + w.nx);
+            const int ya = std::max(ty * Store::kTileCells, w.iy0),
+                      yb = std::min((ty + 1) * Store::kTileCells, w.iy0 + w.ny);
+            multibin::rasterReadCounters().cellsVisited += size_t(xb - xa) * size_t(yb - ya);
+            for (int iy = ya; iy < yb; iy++)
+                for (int ix = xa; ix < xb; ix++) readCell(ix, iy);
         }
     return out;
 }

@@ -161,7 +161,7 @@ void CMultiBinElevationMap::updateTraversability() const {
         cache.options = o;
     }
     // Which cells changed: their digest.
-    const multibin::fill::FillResult& fill = m_impl->fill;
+    const multibin::fill::FilledCells& fill = m_impl->filled;
     const multibin::CellWindow& fw = m_impl->fillWindow;
     std::vector<uint8_t> changed(lattice.cellCount(), full ? 1 : 0);
     std::vector<float> filled(lattice.cellCount(), NAN), filledSigma(lattice.cellCount(), NAN);
@@ -170,11 +170,9 @@ void CMultiBinElevationMap::updateTraversability() const {
         for (int col = 0; col < lattice.nx(); col++) {
             const int ix = lattice.window.ix0 + col, iy = lattice.window.iy0 + row;
             const size_t c = lattice.index(col, row);
-            if (!fill.source.empty() && fw.contains(ix, iy)) {
-                const size_t f = fill.index(ix - fw.ix0, iy - fw.iy0);
-                if (fill.isFilled(f))
-                    filled[c] = fill.height_m[f], filledSigma[c] = fill.sigma_m[f];
-            }
+            if (fw.contains(ix, iy))
+                if (const multibin::fill::FilledCell* f = fill.find(ix, iy))
+                    filled[c] = f->height_m, filledSigma[c] = f->sigma_m;
             const uint64_t d = cellDigest(grid, ix, iy, filled[c]);
             if (d != cache.signature[c] || full) changed[c] = 1, any = true;
             cache.signature[c] = d;

@@ -82,7 +82,7 @@ namespace {
 /** The rasters a view is drawn from: the heights and the colouring layer, block-reduced to at
  * most kPreviewMaxSide_px a side, relative to the map origin. */
 std::vector<EsriAsciiGrid> viewRasters(const CMultiBinElevationMap& map, Layer shown) {
-    // Read tile by tile, one vertex per cell up to 2048 a side, else per block.
+    // Read tile by tile, one vertex per cell up to kPreviewMaxSide_px a side, else per block.
     std::vector<TiledRaster> layers = tiledLayers(map, {Layer::Height, shown});
     for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
     const CellWindow box = knownWindow(layers[0], 1);
@@ -133,34 +133,61 @@ mrpt::img::TColor cellColour(float v, SceneColouring colouring, const ColourLut&
     return mrpt::img::TColor(128, 128, 128);
 }
 
-/** The terrain: a CMesh, Z(i, j) with i along x and j along y, vertices at cell centres; its
- * texture has one texel per vertex (the image's rows follow i, its columns j). */
-mrpt::opengl::CMesh::Ptr terrainMesh(const EsriAsciiGrid& heights, const EsriAsciiGrid& values,
-                                     SceneColouring colouring, const ViewRanges& r) {
+/** The side of the terrain's meshes [raster cells]: one per tile holding a known cell, so the
+ * scene's size (and the cost of building and saving it) follows the data, not its bounding box. */
+constexpr int kSceneTile_cells = 64;
+
+/** The terrain: CMeshes over tiles of kSceneTile_cells x kSceneTile_cells cells of the raster,
+ * those holding a known cell; each has one row and column of vertices more where the raster goes
+ * on, so the quads between tiles are drawn. Z(i, j) with i along x and j along y, vertices at cell
+ * centres; the texture has one texel per vertex (the image's rows follow i, its columns j). A
+ * raster of at most kSceneTile_cells + 1 vertices a side is one mesh. */
+std::vector<mrpt::opengl::CMesh::Ptr> terrainMeshes(const EsriAsciiGrid& heights,
+                                                    const EsriAsciiGrid& values,
+                                                    SceneColouring colouring, const ViewRanges& r) {
     const int nx = heights.cols(), ny = heights.rows();
     const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
-    mrpt::math::CMatrixDynamic<float> Z(nx, ny), mask(nx, ny);
-    mrpt::img::CImage texture(ny, nx, mrpt::img::CH_RGB);
-    for (int ix = 0; ix < nx; ix++)
-        for (int iy = 0; iy < ny; iy++) {
-            const float h = heights.heights_m(iy, ix), v = values.heights_m(iy, ix);
-            const bool known = std::isfinite(h);
-            Z(ix, iy) = known ? h : r.zLo_m;
-            mask(ix, iy) = known ? 1.f : 0.f;
-            texture.setPixel(iy, ix,
-                             known && std::isfinite(v) ? cellColour(v, colouring, lut, r)
-                                                       : mrpt::img::TColor(128, 128, 128));
+    const auto known = [&](int ix, int iy) { return std::isfinite(heights.heights_m(iy, ix)); };
+    std::vector<mrpt::opengl::CMesh::Ptr> meshes;
+    for (int y0 = 0; y0 < ny - 1; y0 += kSceneTile_cells)
+        for (int x0 = 0; x0 < nx - 1; x0 += kSceneTile_cells) {
+            const int mx = std::min(kSceneTile_cells, nx - 1 - x0) + 1;
+            const int my = std::min(kSceneTile_cells, ny - 1 - y0) + 1;
+            bool any = false;
+            for (int iy = y0; iy < y0 + my && !any; iy++)
+                for (int ix = x0; ix < x0 + mx && !any; ix++) any = known(ix, iy);
+            if (!any) continue;
+            mrpt::math::CMatrixDynamic<float> Z(mx, my), mask(mx, my);
+            mrpt::img::CImage texture(my, mx, mrpt::img::CH_RGB);
+            for (int i = 0; i < mx; i++) {
+                // Texel row i written in place (B, G, R as CImage::setPixel stores them):
+                // setPixel checks and converts per texel.
+                uint8_t* texel = texture.ptrLine<uint8_t>(unsigned(i));
+                for (int j = 0; j < my; j++, texel += 3) {
+                    const int ix = x0 + i, iy = y0 + j;
+                    const float h = heights.heights_m(iy, ix), v = values.heights_m(iy, ix);
+                    Z(i, j) = known(ix, iy) ? h : r.zLo_m;
+                    mask(i, j) = known(ix, iy) ? 1.f : 0.f;
+                    const mrpt::img::TColor c = known(ix, iy) && std::isfinite(v)
+                                                    ? cellColour(v, colouring, lut, r)
+                                                    : mrpt::img::TColor(128, 128, 128);
+                    texel[0] = c.B, texel[1] = c.G, texel[2] = c.R;
+                }
+            }
+            auto mesh = mrpt::opengl::CMesh::Create();
+            mesh->setName("CMultiBinElevationMap");
+            const double cs = heights.cellsize_m;
+            mesh->setGridLimits(
+                heights.xllcenter_m + x0 * cs, heights.xllcenter_m + (x0 + mx - 1) * cs,
+                heights.yllcenter_m + y0 * cs, heights.yllcenter_m + (y0 + my - 1) * cs);
+            mesh->assignImageAndZ(texture, Z);
+            mesh->setMask(mask);
+            meshes.push_back(mesh);
         }
-    auto mesh = mrpt::opengl::CMesh::Create();
-    mesh->setName("CMultiBinElevationMap");
-    mesh->setGridLimits(heights.xllcenter_m, heights.xMax_m(), heights.yllcenter_m,
-                        heights.yMax_m());
-    mesh->assignImageAndZ(texture, Z);
-    mesh->setMask(mask);
-    return mesh;
+    return meshes;
 }
 
-/** The known cells the mesh does not draw (it draws a quad only between four known vertices:
+/** The known cells the meshes do not draw (they draw a quad only between four known vertices:
  * a cell with no such quad around it, on a thin wall or alone, would not show), as points of
  * their colour, 2 pixels wide at any distance. */
 mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
@@ -346,7 +373,7 @@ void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring
     mrpt::opengl::CSetOfObjects& into = atZero ? out : *placed;
 
     const ViewRanges r = viewRanges(heights, values, colouring);
-    into.insert(terrainMesh(heights, values, colouring, r));
+    for (const auto& mesh : terrainMeshes(heights, values, colouring, r)) into.insert(mesh);
     if (auto lone = loneCells(heights, values, colouring, r); lone->size() > 0) into.insert(lone);
     addScaleGrid(heights, r.zLo_m, into);
     addLegend(legendFrame(heights, r), colouring, r, into);

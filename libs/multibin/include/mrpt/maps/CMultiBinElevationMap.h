@@ -472,9 +472,9 @@ private:
     friend struct multibin::MapInternals;  // grid(), localGrid(), lastFill(): tests and tools
 
     /** The grid (the global one with the dual grid), the precise local grid (empty unless dual
-     * grid), the last gap filling's result over the window it ran on as one raster (empty, stats
-     * only, beyond kMaxWholeWindowCells; lastFilledCells() holds it at any size), and whether
-     * observations arrived after it. */
+     * grid), the last gap filling's result over the window it ran on as one raster, built on its
+     * first call (empty, stats only, beyond kMaxWholeWindowCells; lastFilledCells() holds it at
+     * any size), and whether observations arrived after it. */
     const multibin::BinGrid& grid() const;
     const multibin::BinGrid& localGrid() const;
     const multibin::fill::FillResult& lastFill() const;

@@ -73,8 +73,9 @@ inline const std::array<uint8_t, 3>& colourAt(const ColourLut& lut, float t) {
 }
 
 /** The longest side of encodePreviewPng()'s map panel [px]: rasters beyond it are given
- * downsampled (blockReduced(), TiledRaster.h). */
-constexpr int kPreviewMaxSide_px = 2048;
+ * downsampled (blockReduced(), TiledRaster.h). Encoding costs about 100 instructions a pixel:
+ * 1024 keeps three previews of a long route's box (mostly unknown) to a million pixels each. */
+constexpr int kPreviewMaxSide_px = 1024;
 
 /** A PNG preview of a raster layer: north up, x and y axes with ticks in metres, a scale bar, a
  * colour bar (or a categorical legend) and unknown cells in a grey that no colormap uses. The

@@ -38,6 +38,16 @@ struct TiledRaster {
     double cellCenterY_m(int iy) const { return originY_m + (iy + 0.5) * cellSize_m; }
 };
 
+/** What the calling thread's raster reads cost (CMultiBinElevationMap::toRasters() and the
+ * outputs built on it): the cells they visited, counted from the thread's start or the last
+ * reset, so a test checks that an output's work follows the tiles holding data, not the window.
+ */
+struct RasterReadCounters {
+    size_t cellsVisited = 0;  //!< cells of tiles holding data inside the windows read
+};
+/** This thread's counters (thread_local). */
+RasterReadCounters& rasterReadCounters();
+
 /** The aligned tile holding cell (ix, iy). */
 CellWindow tileOfCell(int ix, int iy, int tileCells);
 
