@@ -9,16 +9,23 @@
 #        bash scripts/evaluate-traversability.sh --tune [OUTDIR]
 # --tune maps only the tuning mock-up (matched and independent noise) with the hexapod preset's
 # limits and no calibration, and fits the calibration on its cells (scripts/fit-traversability.py).
-# Needs a configured build; builds terrain-sim and elevation-mapper. About 2 minutes on 2 cores.
+# Then MRPT's PlannerSimple2D on each scenario's exported grid against the truth's grid
+# (build/tests/traversability/traversability_planning: PLAN_PAIRS start/goal pairs, default 100,
+# seed 1, at each P(untraversable) limit of PLAN_P_MAX; the row "lattice": the truth's heights
+# at the cells' centres thresholded, the best a map on this lattice can do).
+# Needs a configured build; builds terrain-sim, elevation-mapper and traversability_planning.
+# About 2 minutes on 2 cores.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build_dir=${MULTIBIN_BUILD_DIR:-$root/build}
 tune=0
 if [ "${1:-}" = --tune ]; then tune=1; shift; fi
 out=${1:-$build_dir/traversability}
-cmake --build "$build_dir" --target terrain-sim elevation-mapper >/dev/null
+cmake --build "$build_dir" --target terrain-sim elevation-mapper traversability_planning >/dev/null
 sim="$build_dir/apps/terrain-sim/terrain-sim"
 mapper="$build_dir/apps/elevation-mapper/elevation-mapper"
+planning="$build_dir/tests/traversability/traversability_planning"
+read -r -a plan_p_max <<<"${PLAN_P_MAX:-0.6 0.5 0.4 0.3 0.2 0.1}"
 boards="$root/rawlogs/terrain/littledog"
 mkdir -p "$out"
 
@@ -39,7 +46,7 @@ run() {  # scenario noise
     cat - <(if [ $tune = 1 ]; then grep -Ev '_(bias|gain|model_sigma)' "$root/ini/traversability-hexapod.ini"
             else cat "$root/ini/traversability-hexapod.ini"; fi) >"$prefix-hexapod.ini"
   "$mapper" --config "$prefix-hexapod.ini" --rawlog "$prefix.rawlog" \
-    --ground-truth "${prefix}_gt.asc" --eval-area "${area[$s]}" --no-plots --outputs map \
+    --ground-truth "${prefix}_gt.asc" --eval-area "${area[$s]}" --no-plots --outputs map,gridmap \
     --out "$prefix-boards" >"$prefix-boards.log"
   rm -f "$prefix.simplemap"
 }
@@ -74,3 +81,13 @@ print("Reliability, score-mockup independent, multibin: | P decile | cells | mea
 for b, d in enumerate(r["reliability"]):
     print(f"| {b / 10:.1f}-{(b + 1) / 10:.1f} | {d['cells']} | {d['mean_p']:.3f} | {d['observed']:.3f} |")
 PY
+
+echo
+echo "PlannerSimple2D on the exported grid against the truth's grid (${PLAN_PAIRS:-100} pairs, seed 1):"
+echo "| scenario | noise | P max | pairs | truth found | map found there | map found, truth none | unsafe paths | unsafe cells / path cells | length <= 1.15 x | max ratio |"
+echo "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+for sn in score-mockup-matched score-mockup-independent score-walk-matched score-walk-independent \
+  tune-mockup-matched; do
+  "$planning" "$out/$sn-boards" "$out/${sn}_gt.asc" "${PLAN_PAIRS:-100}" 1 "${plan_p_max[@]}" |
+    sed "s/^|/| ${sn%-*} | ${sn##*-} |/"
+done

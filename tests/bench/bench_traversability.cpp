@@ -71,6 +71,8 @@ BENCHMARK(BM_MockupWithTraversability)
 // with the layers up to date, then each of those scans inserted and the layers brought up to date
 // after it, the two timed apart (CPU time of the thread) in the same run. Counters: the insertion
 // and the update per scan [ms] and their ratio (issue 34's bound: update / insertion <= 0.2).
+// Arg: monte_carlo_draws (128 the default; 0 the features of the map's surface alone, no
+// uncertainty: the floor of any design that computes the features of each dirty cell).
 static void BM_LaserScanUpdateOverInsertion(benchmark::State& state) {
     mrpt::maps::CSimpleMap simplemap;
     if (!loadMockup(simplemap)) {
@@ -97,6 +99,7 @@ static void BM_LaserScanUpdateOverInsertion(benchmark::State& state) {
             });
         const size_t first = all.size() > kTimedScans ? all.size() - kTimedScans : 0;
         mrpt::maps::CMultiBinElevationMap map = mockupMap();
+        map.traversabilityOptions.monte_carlo_draws = int(state.range(0));
         for (size_t i = 0; i < first; i++) map.insertObservation(*all[i].first, all[i].second);
         map.updateTraversability();
         state.ResumeTiming();
@@ -113,7 +116,11 @@ static void BM_LaserScanUpdateOverInsertion(benchmark::State& state) {
     state.counters["update_ms_per_scan"] = update_ms / double(timed);
     state.counters["update_over_insert"] = update_ms / insert_ms;
 }
-BENCHMARK(BM_LaserScanUpdateOverInsertion)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LaserScanUpdateOverInsertion)
+    ->Arg(128)
+    ->Arg(0)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond);
 
 // The layers of the whole mock-up map computed once from nothing (what a batch run's export
 // costs).
