@@ -81,22 +81,34 @@ print("Reliability, score-mockup independent, multibin: | P decile | cells | mea
 for b, d in enumerate(r["reliability"]):
     print(f"| {b / 10:.1f}-{(b + 1) / 10:.1f} | {d['cells']} | {d['mean_p']:.3f} | {d['observed']:.3f} |")
 print()
-# The truth's untraversable cells the layer misses, by the truth's step: above 0.15 m are the
-# seams between boards (slots down to the ground no ray reaches the bottom of).
-print("| scenario | noise | truth step | truth untraversable | P > 0.5 | P < 0.3 |")
-print("| --- | --- | --- | ---: | ---: | ---: |")
+# The truth's untraversable cells the layer misses, by the truth's step (above 0.15 m: the seams
+# between boards, slots down to the ground) and by whether the map measured the cell (else filled).
+def asc(path):
+    with open(path) as f:
+        h = {k.lower(): float(v) for k, v in (f.readline().split() for _ in range(6))}
+        z = [[float(v) for v in line.split()] for line in f if line.strip()]
+    def at(x, y):
+        c = round((x - h["xllcenter"]) / h["cellsize"])
+        r = len(z) - 1 - round((y - h["yllcenter"]) / h["cellsize"])
+        return 0 <= r < len(z) and 0 <= c < len(z[0]) and z[r][c] != h["nodata_value"]
+    return at
+print("| scenario | noise | truth step | truth untraversable | P > 0.5 | P < 0.3 | of them measured |")
+print("| --- | --- | --- | ---: | ---: | ---: | ---: |")
 import csv
 for s, n in (("score-mockup", "matched"), ("score-mockup", "independent"),
              ("score-walk", "matched"), ("score-walk", "independent"), ("tune-mockup", "matched")):
-    lim = json.load(open(f"{out}/{s}-{n}-boards/traversability.json"))["limits"]
-    rows = list(csv.DictReader(open(f"{out}/{s}-{n}-boards/traversability_cells.csv")))
+    d = f"{out}/{s}-{n}-boards"
+    lim = json.load(open(f"{d}/traversability.json"))["limits"]
+    measured = asc(f"{d}/eval_multibin.asc")
+    rows = list(csv.DictReader(open(f"{d}/traversability_cells.csv")))
     bad = [r for r in rows if float(r["truth_step_m"]) > lim["max_step_m"]
            or float(r["truth_slope_deg"]) > lim["max_slope_deg"]
            or float(r["truth_roughness_m"]) > lim["max_roughness_m"]]
     for label, seam in (("> 0.15 m", True), ("<= 0.15 m", False)):
         b = [r for r in bad if (float(r["truth_step_m"]) > 0.15) == seam]
+        missed = [r for r in b if float(r["untraversable"]) < 0.3]
         print(f"| {s} | {n} | {label} | {len(b)} | {sum(float(r['untraversable']) > 0.5 for r in b)} | "
-              f"{sum(float(r['untraversable']) < 0.3 for r in b)} |")
+              f"{len(missed)} | {sum(measured(float(r['x_m']), float(r['y_m'])) for r in missed)} |")
 PY
 
 echo
