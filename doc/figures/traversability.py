@@ -13,28 +13,16 @@ import os
 import sys
 
 import matplotlib
-import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+# The mapper's reader of ESRI ASCII grids (row 0 north, NaN nodata, extent for imshow).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../../apps/elevation-mapper"))
+from plot_report import load_asc  # noqa: E402
+
 out = sys.argv[1] if len(sys.argv) > 1 else "build/traversability"
 shown = "score-mockup-matched"  # the scenario whose layer is drawn beside the truth
-
-
-def load_asc(path):
-    """An ESRI ASCII grid as (array with row 0 north, NaN nodata, extent for imshow)."""
-    header = {}
-    with open(path) as f:
-        for _ in range(6):
-            key, value = f.readline().split()
-            header[key.lower()] = float(value)
-        z = np.loadtxt(f)
-    z[z == header.get("nodata_value", -9999)] = np.nan
-    d = header["cellsize"]
-    x0 = header.get("xllcenter", header.get("xllcorner", 0) + d / 2) - d / 2
-    y0 = header.get("yllcenter", header.get("yllcorner", 0) + d / 2) - d / 2
-    return z, (x0, x0 + d * z.shape[1], y0, y0 + d * z.shape[0])
 
 
 fig = plt.figure(figsize=(14, 4.4), dpi=100)
