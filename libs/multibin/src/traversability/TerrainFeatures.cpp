@@ -444,9 +444,9 @@ void computeCellLinear(const std::vector<Known>& known, int groups, const Traver
     step.reset(sources), foot.reset(sources), clear.reset(sources);
     for (const Known& p : known) {
         mean.add(p, p.h_m);
-        const float w = float(reliefHalfWidth_m(p.relief_m2));  // as DiscAccumulator::add
+        const float half = float(reliefHalfWidth_m(p.relief_m2));  // as DiscAccumulator::add
         if (p.discs & kDisc)
-            step.add(p.h_m - w, p.sigma_m, p.draw), step.add(p.h_m + w, p.sigma_m, p.draw);
+            step.add(p.h_m - half, p.sigma_m, p.draw), step.add(p.h_m + half, p.sigma_m, p.draw);
         if (p.discs & kFoot) foot.add(p.h_m, p.sigma_m, p.draw);
         if (p.discs & kClear) clear.add(p.h_m, p.sigma_m, p.draw);
     }
