@@ -33,8 +33,9 @@ mrpt::maps::CMultiBinElevationMap mockupMap() {
 
 // Every laser scan (arg 1) or stereo frame (arg 0) of the shipped mock-up into a fresh map as
 // ini/mockup.ini configures it, with (arg 2 = 1) the traversability layers brought up to date
-// after each one (the hexapod defaults) or not (0). The update's cost per observation is the
-// difference of the two, divided by `observations`.
+// after each one (the hexapod defaults) or not (0), by Monte Carlo (arg 3 = 0) or the closed form
+// (1, linear_uncertainty). The update's cost per observation is the difference of the two, divided
+// by `observations`.
 static void BM_MockupWithTraversability(benchmark::State& state) {
     mrpt::maps::CSimpleMap simplemap;
     if (!loadMockup(simplemap)) {
@@ -42,11 +43,14 @@ static void BM_MockupWithTraversability(benchmark::State& state) {
         return;
     }
     const bool lasers = state.range(0) != 0, update = state.range(1) != 0;
+    const bool linear = state.range(2) != 0;
     state.SetLabel(std::string(lasers ? "laser" : "stereo") +
-                   (update ? ", layers updated after each" : ", insertion only"));
+                   (update ? ", layers updated after each" : ", insertion only") +
+                   (update ? (linear ? " (closed form)" : " (Monte Carlo)") : ""));
     size_t observations = 0;
     for (auto _ : state) {
         mrpt::maps::CMultiBinElevationMap map = mockupMap();
+        map.traversabilityOptions.linear_uncertainty = linear;
         observations = 0;
         mrpt::maps::CMultiBinElevationMap::forEachObservationWithPosePdf(
             simplemap,
@@ -61,16 +65,21 @@ static void BM_MockupWithTraversability(benchmark::State& state) {
     state.counters["observations"] = double(observations);
 }
 BENCHMARK(BM_MockupWithTraversability)
-    ->Args({1, 0})
-    ->Args({1, 1})
-    ->Args({0, 0})
-    ->Args({0, 1})
+    ->Args({1, 0, 0})
+    ->Args({1, 1, 0})
+    ->Args({1, 1, 1})
+    ->Args({0, 0, 0})
+    ->Args({0, 1, 0})
+    ->Args({0, 1, 1})
     ->Unit(benchmark::kMillisecond);
 
 // Issue 34's bound, one laser scan at a time: the mock-up mapped up to its last 20 laser scans
 // with the layers up to date, then each of those scans inserted and the layers brought up to date
 // after it, the two timed apart (CPU time of the thread) in the same run. Counters: the insertion
 // and the update per scan [ms] and their ratio (issue 34's bound: update / insertion <= 0.2).
+// Args: monte_carlo_draws (128 the default; 0 the features of the map's surface alone, no
+// uncertainty: the floor of any design that computes the features of each dirty cell), and
+// linear_uncertainty (1: the closed form instead of the draws).
 static void BM_LaserScanUpdateOverInsertion(benchmark::State& state) {
     mrpt::maps::CSimpleMap simplemap;
     if (!loadMockup(simplemap)) {
@@ -97,6 +106,8 @@ static void BM_LaserScanUpdateOverInsertion(benchmark::State& state) {
             });
         const size_t first = all.size() > kTimedScans ? all.size() - kTimedScans : 0;
         mrpt::maps::CMultiBinElevationMap map = mockupMap();
+        map.traversabilityOptions.monte_carlo_draws = int(state.range(0));
+        map.traversabilityOptions.linear_uncertainty = state.range(1) != 0;
         for (size_t i = 0; i < first; i++) map.insertObservation(*all[i].first, all[i].second);
         map.updateTraversability();
         state.ResumeTiming();
@@ -113,7 +124,12 @@ static void BM_LaserScanUpdateOverInsertion(benchmark::State& state) {
     state.counters["update_ms_per_scan"] = update_ms / double(timed);
     state.counters["update_over_insert"] = update_ms / insert_ms;
 }
-BENCHMARK(BM_LaserScanUpdateOverInsertion)->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LaserScanUpdateOverInsertion)
+    ->Args({128, 0})
+    ->Args({128, 1})
+    ->Args({0, 0})
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond);
 
 // The layers of the whole mock-up map computed once from nothing (what a batch run's export
 // costs).

@@ -3,13 +3,11 @@
  * no longer than 1.15 x the truth's. */
 #include <gtest/gtest.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
-#include <mrpt/maps/COccupancyGridMap2D.h>
-#include <mrpt/nav/planners/PlannerSimple2D.h>
 
 #include <cmath>
-#include <deque>
 #include <random>
 
+#include "PlanningCheck.h"
 #include "multibin/traversability/TerrainFeatures.h"
 
 using mrpt::maps::CMultiBinElevationMap;
@@ -54,14 +52,16 @@ CMultiBinElevationMap mapOfTerrain(unsigned seed) {
     return map;
 }
 
-/** The truth's grid: the features of the terrain sampled every 2 mm over each cell's disc. */
-mrpt::maps::COccupancyGridMap2D truthGrid(const traversability::TraversabilityOptions& o,
-                                          std::vector<uint8_t>& untraversable) {
-    mrpt::maps::COccupancyGridMap2D g(0, float(kSideX), 0, float(kSideY), float(kCell));
-    untraversable.assign(g.getSizeX() * g.getSizeY(), 0);
-    for (unsigned cy = 0; cy < g.getSizeY(); cy++)
-        for (unsigned cx = 0; cx < g.getSizeX(); cx++) {
-            const double x0 = g.idx2x(cx), y0 = g.idx2y(cy);
+/** The truth's classes on `lattice`'s cells: the features of the terrain sampled every 2 mm over
+ * each cell's disc. */
+planning::TruthCells truthCells(const traversability::TraversabilityOptions& o,
+                                const mrpt::maps::COccupancyGridMap2D& lattice) {
+    planning::TruthCells t;
+    t.nx = lattice.getSizeX(), t.ny = lattice.getSizeY();
+    t.cls.assign(size_t(t.nx) * t.ny, 0);
+    for (unsigned cy = 0; cy < t.ny; cy++)
+        for (unsigned cx = 0; cx < t.nx; cx++) {
+            const double x0 = lattice.idx2x(cx), y0 = lattice.idx2y(cy);
             traversability::DiscAccumulator acc;
             for (double dy = -o.radius_m; dy <= o.radius_m; dy += 0.002)
                 for (double dx = -o.radius_m; dx <= o.radius_m; dx += 0.002)
@@ -69,18 +69,11 @@ mrpt::maps::COccupancyGridMap2D truthGrid(const traversability::TraversabilityOp
                         acc.add(dx, dy, terrain(x0 + dx, y0 + dy));
             traversability::DiscFeatures f;
             acc.features(f);
-            const bool bad = f.step_m > o.max_step_m || f.slope_deg > o.max_slope_deg ||
-                             f.roughness_m > o.max_roughness_m;
-            untraversable[cy * g.getSizeX() + cx] = bad;
-            g.setCell(int(cx), int(cy), bad ? 0.f : 1.f);
+            t.cls[size_t(cy) * t.nx + cx] = f.step_m > o.max_step_m ||
+                                            f.slope_deg > o.max_slope_deg ||
+                                            f.roughness_m > o.max_roughness_m;
         }
-    return g;
-}
-
-double lengthOf(const std::deque<mrpt::math::TPoint2D>& path) {
-    double l = 0;
-    for (size_t i = 1; i < path.size(); i++) l += (path[i] - path[i - 1]).norm();
-    return l;
+    return t;
 }
 }  // namespace
 
@@ -88,36 +81,93 @@ TEST(TraversabilityPlanning, PlannerSimple2DOnTheExportedGridMatchesTheTruths) {
     CMultiBinElevationMap map = mapOfTerrain(3);
     mrpt::maps::COccupancyGridMap2D grid;
     map.getAsOccupancyGrid(grid);
-    std::vector<uint8_t> truthBad;
-    const mrpt::maps::COccupancyGridMap2D truth = truthGrid(map.traversabilityOptions, truthBad);
-    ASSERT_EQ(grid.getSizeX(), truth.getSizeX());
-    ASSERT_EQ(grid.getSizeY(), truth.getSizeY());
+    const planning::TruthCells truth = truthCells(map.traversabilityOptions, grid);
+    const mrpt::maps::COccupancyGridMap2D truthGrid = truth.grid(grid);
 
     mrpt::nav::PlannerSimple2D planner;
     planner.robotRadius = 0.0f;  // the layer's disc is the robot's footprint already
     planner.minStepInReturnedPath = 0.0f;
     // Start and goal pairs across the obstacles, and one the wall and ramp shut off with the step
     // side (y in 0.7..1.0 is open at the wall but the ramp blocks y > 0.45 beyond it).
-    const std::vector<std::pair<mrpt::poses::CPose2D, mrpt::poses::CPose2D>> pairs = {
+    const std::vector<std::pair<planning::Pose, planning::Pose>> pairs = {
         {{0.1, 0.1, 0}, {1.5, 0.1, 0}},  {{0.1, 0.9, 0}, {1.5, 0.9, 0}},
         {{0.1, 0.5, 0}, {0.8, 0.2, 0}},  {{0.7, 0.9, 0}, {1.4, 0.3, 0}},
         {{0.1, 0.2, 0}, {0.45, 0.5, 0}}, {{1.3, 0.1, 0}, {0.05, 0.95, 0}}};
-    int found = 0;
-    for (const auto& [start, goal] : pairs) {
-        std::deque<mrpt::math::TPoint2D> truthPath, path;
-        bool truthNotFound = true, notFound = true;
-        planner.computePath(truth, start, goal, truthPath, truthNotFound);
-        planner.computePath(grid, start, goal, path, notFound);
-        EXPECT_EQ(notFound, truthNotFound) << start << " -> " << goal;
-        if (notFound || truthNotFound) continue;
-        found++;
-        for (const auto& p : path) {
-            const int cx = truth.x2idx(p.x), cy = truth.y2idx(p.y);
-            EXPECT_FALSE(truthBad[size_t(cy) * truth.getSizeX() + size_t(cx)])
-                << "the path " << start << " -> " << goal << " crosses (" << p.x << ", " << p.y
-                << "), untraversable in truth";
+    const planning::PlanningScore s =
+        planning::comparePlans(grid, truthGrid, truth, pairs, planner);
+    EXPECT_EQ(s.foundWhereTruth, s.truthFound);  // a path wherever the truth has one
+    EXPECT_EQ(s.foundWhereNone, 0);              // and none where it has none
+    EXPECT_EQ(s.unsafeCells, 0) << "of " << s.pathCells << " path cells";
+    EXPECT_EQ(s.ratiosWithin(1.15), int(s.lengthRatios.size())) << "longest " << s.maxRatio();
+    EXPECT_GE(s.truthFound, 4);  // most pairs have a path (the test is not vacuous)
+}
+
+namespace {
+/** A 3 m x 1 m lattice of 0.1 m cells, every cell free. */
+mrpt::maps::COccupancyGridMap2D openGrid() {
+    mrpt::maps::COccupancyGridMap2D g(0, 3.0f, 0, 1.0f, 0.1f);
+    for (unsigned cy = 0; cy < g.getSizeY(); cy++)
+        for (unsigned cx = 0; cx < g.getSizeX(); cx++) g.setCell(int(cx), int(cy), 1.f);
+    return g;
+}
+}  // namespace
+
+// The comparison itself, on a hand-made case: the truth walls the lattice off at x in [1.5, 1.6]
+// where the map sees open ground; the map's straight path along its row crosses the wall in
+// exactly one cell and is counted as found where the truth has none.
+TEST(TraversabilityPlanning, ComparePlansCountsAPathThroughATruthWall) {
+    const mrpt::maps::COccupancyGridMap2D map = openGrid();
+    planning::TruthCells truth;
+    truth.nx = map.getSizeX(), truth.ny = map.getSizeY();
+    truth.cls.assign(size_t(truth.nx) * truth.ny, 0);
+    for (unsigned cy = 0; cy < truth.ny; cy++)
+        truth.cls[cy * truth.nx + unsigned(map.x2idx(1.55))] = 1;
+    mrpt::nav::PlannerSimple2D planner;
+    planner.robotRadius = 0, planner.minStepInReturnedPath = 0;
+    const planning::PlanningScore s = planning::comparePlans(
+        map, truth.grid(map), truth, {{{0.25, 0.55, 0}, {2.75, 0.55, 0}}}, planner);
+    EXPECT_EQ(s.truthFound, 0);
+    EXPECT_EQ(s.foundWhereNone, 1);
+    EXPECT_EQ(s.unsafePaths, 1);
+    EXPECT_EQ(s.unsafeCells, 1);
+    EXPECT_EQ(s.pathCells, 25);  // cells 3..26 of the row, then the goal point
+}
+
+// The pairs' rule: starts and goals on truth-traversable cells of opposite bands (the westmost and
+// eastmost tenth of the known cells' x range, then the southmost and northmost tenth of y).
+TEST(TraversabilityPlanning, OppositeSidePairsLieInOppositeBandsOnTraversableCells) {
+    const mrpt::maps::COccupancyGridMap2D g = openGrid();
+    planning::TruthCells truth;
+    truth.nx = g.getSizeX(), truth.ny = g.getSizeY();
+    truth.cls.assign(size_t(truth.nx) * truth.ny, 0);
+    truth.cls[0] = 1;  // an untraversable cell in the west band: never a start
+    const auto pairs = planning::oppositeSidePairs(g, truth, 40, 5);
+    ASSERT_EQ(pairs.size(), 40u);
+    for (size_t k = 0; k < pairs.size(); k++) {
+        const auto& [s, e] = pairs[k];
+        EXPECT_EQ(truth.at(g, s.x(), s.y()), 0);
+        if (k % 2 == 0) {  // 30 columns: bands of 3
+            EXPECT_LT(s.x(), 0.3);
+            EXPECT_GT(e.x(), 2.7);
+        } else {  // 10 rows: bands of 1
+            EXPECT_LT(s.y(), 0.1);
+            EXPECT_GT(e.y(), 0.9);
         }
-        EXPECT_LE(lengthOf(path), 1.15 * lengthOf(truthPath)) << start << " -> " << goal;
     }
-    EXPECT_GE(found, 4);  // most pairs have a path (the test is not vacuous)
+}
+
+// MRPT's planner keeps a cell free only where its P(free) is above occupancyThreshold: at the
+// default 0.5, an unknown cell (0.5) is an obstacle; below 0.5 it is passable.
+TEST(TraversabilityPlanning, UnknownCellsBlockPlannerSimple2DAtItsDefaultThreshold) {
+    mrpt::maps::COccupancyGridMap2D g = openGrid();
+    for (unsigned cy = 0; cy < g.getSizeY(); cy++) g.setCell(g.x2idx(1.55), int(cy), 0.5f);
+    mrpt::nav::PlannerSimple2D planner;
+    planner.robotRadius = 0, planner.minStepInReturnedPath = 0;
+    planning::Path path;
+    bool notFound = false;
+    planner.computePath(g, {0.25, 0.55, 0}, {2.75, 0.55, 0}, path, notFound);
+    EXPECT_TRUE(notFound);
+    planner.occupancyThreshold = 0.49f;
+    planner.computePath(g, {0.25, 0.55, 0}, {2.75, 0.55, 0}, path, notFound);
+    EXPECT_FALSE(notFound);
 }

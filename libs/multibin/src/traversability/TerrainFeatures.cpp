@@ -30,7 +30,7 @@ void DiscAccumulator::add(double dx_m, double dy_m, double h_m, double reliefVar
     add(dx_m, dy_m, h_m);
     if (!(reliefVariance_m2 > 0)) return;
     m_relief += reliefVariance_m2;
-    const double halfWidth = std::sqrt(3 * reliefVariance_m2);
+    const double halfWidth = reliefHalfWidth_m(reliefVariance_m2);
     addStepOnly(h_m - halfWidth);
     addStepOnly(h_m + halfWidth);
 }
@@ -39,7 +39,7 @@ void DiscAccumulator::addStepOnly(double h_m) {
     m_max = std::max(m_max, h_m), m_min = std::min(m_min, h_m);
 }
 
-bool DiscAccumulator::features(DiscFeatures& out) const {
+bool DiscAccumulator::plane(DiscPlane& out) const {
     if (m_n < 3) return false;
     const double n = double(m_n), mx = m_sx / n, my = m_sy / n, mh = m_sh / n;
     const double cxx = m_sxx - n * mx * mx, cxy = m_sxy - n * mx * my, cyy = m_syy - n * my * my;
@@ -47,9 +47,16 @@ bool DiscAccumulator::features(DiscFeatures& out) const {
     const double det = cxx * cyy - cxy * cxy;
     if (!(det > 1e-12 * (cxx + cyy) * (cxx + cyy))) return false;  // collinear points
     const double b = (cyy * cxh - cxy * cyh) / det, c = (cxx * cyh - cxy * cxh) / det;
+    out = {mx, my, m_h0 + mh, b, c, cxx, cxy, cyy, std::max(0.0, chh - b * cxh - c * cyh)};
+    return true;
+}
+
+bool DiscAccumulator::features(DiscFeatures& out) const {
+    DiscPlane p;
+    if (!plane(p)) return false;
     out.step_m = m_max - m_min;
-    out.slope_deg = std::atan(std::hypot(b, c)) * kRadToDeg;
-    out.roughness_m = std::sqrt((std::max(0.0, chh - b * cxh - c * cyh) + m_relief) / n);
+    out.slope_deg = std::atan(std::hypot(p.gx, p.gy)) * kRadToDeg;
+    out.roughness_m = std::sqrt((p.rss_m2 + m_relief) / double(m_n));
     return true;
 }
 
@@ -346,6 +353,160 @@ void computeCell(const std::vector<Known>& known, const std::vector<float>& z, i
     out.roughnessSigma_m[k] = total(rough, o.roughness);
 }
 
+/** P(x <= limit) for x ~ N(mean, sigma^2); a step where sigma is 0. */
+double below(double mean_, double sigma, double limit) {
+    if (!(sigma > 0)) return mean_ <= limit ? 1.0 : 0.0;
+    return 0.5 * std::erfc((mean_ - limit) / (sigma * std::sqrt(2.0)));
+}
+
+/** A range (highest minus lowest) over points of several independent error sources, linearised.
+ * An end is the highest (lowest) point of one source, but which one is uncertain where several
+ * are near: the end moves with source g by p_g s_g k, p_g its share of the pairwise chances
+ * P(g's point beyond the top one's) (1/2 for the top one, so m tied sources share 1/m each), s_g
+ * its sigma, and k such that the end's variance is (sum p s^2) sqrt(sum p^2): within 3 % of the
+ * variance of the largest of m equal Gaussians for m = 1..5, and a single source's sigma when one
+ * dominates. */
+class SourcedRange {
+public:
+    void reset(size_t sources) {
+        m_hi.assign(sources, -1e30f), m_lo.assign(sources, 1e30f);
+        m_hiSigma.assign(sources, 0.f), m_loSigma.assign(sources, 0.f);
+        m_top = m_bottom = -1;
+    }
+    void add(float h, float sigma, int g) {
+        const size_t i = size_t(g);
+        if (h > m_hi[i]) m_hi[i] = h, m_hiSigma[i] = sigma;
+        if (h < m_lo[i]) m_lo[i] = h, m_loSigma[i] = sigma;
+        if (m_top < 0 || h > m_hi[size_t(m_top)]) m_top = g;
+        if (m_bottom < 0 || h < m_lo[size_t(m_bottom)]) m_bottom = g;
+    }
+    bool empty() const { return m_top < 0; }
+    double range() const { return double(m_hi[size_t(m_top)]) - double(m_lo[size_t(m_bottom)]); }
+    /** d range / d z_g added to d[g] (d sized as the sources). */
+    void derivatives(std::vector<double>& d, std::vector<double>& share) const {
+        end(m_hi, m_hiSigma, m_top, 1, d, share);
+        end(m_lo, m_loSigma, m_bottom, -1, d, share);
+    }
+
+private:
+    /** The highest end (sign 1) or the lowest (sign -1). */
+    static void end(const std::vector<float>& h, const std::vector<float>& s, int top, int sign,
+                    std::vector<double>& d, std::vector<double>& share) {
+        share.assign(h.size(), 0.0);
+        const size_t t = size_t(top);
+        double sum = 0;
+        for (size_t g = 0; g < h.size(); g++) {
+            if (std::abs(h[g]) >= 1e29f) continue;                    // no point of this source
+            const double gap = sign * (double(h[t]) - double(h[g]));  // >= 0
+            const double spread = std::hypot(double(s[g]), double(s[t]));
+            if (g == t || (spread == 0 && gap == 0))
+                share[g] = 0.5;
+            else if (spread > 0 && gap < 5 * spread)
+                share[g] = 0.5 * std::erfc(gap / (spread * std::sqrt(2.0)));
+            sum += share[g];
+        }
+        double a = 0, b = 0, c = 0;  // sum p s^2, sum p^2, sum p^2 s^2
+        for (size_t g = 0; g < h.size(); g++) {
+            const double p = share[g] /= sum, s2 = double(s[g]) * s[g];
+            a += p * s2, b += p * p, c += p * p * s2;
+        }
+        const double k = c > 0 ? std::sqrt(a * std::sqrt(b) / c) : 0;
+        for (size_t g = 0; g < h.size(); g++) d[g] += sign * share[g] * s[g] * k;
+    }
+    std::vector<float> m_hi, m_lo, m_hiSigma, m_loSigma;
+    int m_top = -1, m_bottom = -1;
+};
+
+/** What computeCellLinear reuses from cell to cell. */
+struct LinearScratch {
+    std::vector<double> perSource, stepD, footD, clearD, share;
+    SourcedRange step, foot, clear;
+};
+
+/** sqrt(sum of squares) of `d`. */
+double norm(const std::vector<double>& d) {
+    double s = 0;
+    for (const double v : d) s += v * v;
+    return std::sqrt(s);
+}
+
+/** One cell's layers with the samples' errors propagated linearly (options.linear_uncertainty):
+ * each feature as a function of the error sources (one standard normal per stencil cell and kind,
+ * Known::draw) linearised at the map's surface. The plane's gradient is linear in the heights; the
+ * roughness r moves by sum e_i dh_i / (n r) (e the residuals); a range as SourcedRange. The
+ * calibrated features are then Gaussian (the model error added), and P(untraversable) = 1 - the
+ * product of the three P(feature <= limit): their correlation is left out. */
+void computeCellLinear(const std::vector<Known>& known, int groups, const TraversabilityOptions& o,
+                       TraversabilityLayers& out, size_t k, LinearScratch& w) {
+    const size_t sources = size_t(groups) * 3;
+    Realisation mean;
+    SourcedRange &step = w.step, &foot = w.foot, &clear = w.clear;
+    step.reset(sources), foot.reset(sources), clear.reset(sources);
+    for (const Known& p : known) {
+        mean.add(p, p.h_m);
+        const float half = float(reliefHalfWidth_m(p.relief_m2));  // as DiscAccumulator::add
+        if (p.discs & kDisc)
+            step.add(p.h_m - half, p.sigma_m, p.draw), step.add(p.h_m + half, p.sigma_m, p.draw);
+        if (p.discs & kFoot) foot.add(p.h_m, p.sigma_m, p.draw);
+        if (p.discs & kClear) clear.add(p.h_m, p.sigma_m, p.draw);
+    }
+    DiscFeatures f;
+    DiscPlane pl;
+    if (!mean.disc.features(f) || !mean.disc.plane(pl)) return;  // stays unknown: no plane
+    const DiscFeatures fc = calibrated(f, o);
+    out.step_m[k] = float(fc.step_m);
+    out.slope_deg[k] = float(fc.slope_deg);
+    out.roughness_m[k] = float(fc.roughness_m);
+    // Per source: the sums the gradient (x, y) and the roughness (residual) move by.
+    std::vector<double>& perSource = w.perSource;
+    perSource.assign(sources * 3, 0.0);
+    for (const Known& p : known) {
+        if (!(p.discs & kDisc) || p.stepOnly) continue;
+        const double x = p.dx_m - pl.mx_m, y = p.dy_m - pl.my_m;
+        const double e = p.h_m - pl.mh_m - pl.gx * x - pl.gy * y;
+        double* v = &perSource[size_t(p.draw) * 3];
+        v[0] += x * p.sigma_m, v[1] += y * p.sigma_m, v[2] += e * p.sigma_m;
+    }
+    const double det = pl.cxx * pl.cyy - pl.cxy * pl.cxy, n = double(mean.disc.count());
+    const double g = std::hypot(pl.gx, pl.gy), r = f.roughness_m;
+    const double ux = g > 1e-12 ? pl.gx / g : 1.0, uy = g > 1e-12 ? pl.gy / g : 0.0;
+    const double slopePerGradient_deg = kRadToDeg / (1 + g * g);  // d atan(g) / dg
+    double mapVar[3] = {0, 0, 0}, calVar[3] = {0, 0, 0};          // step, slope, roughness
+    w.stepD.assign(sources, 0.0);
+    step.derivatives(w.stepD, w.share);
+    for (size_t src = 0; src < sources; src++) {
+        const double* v = &perSource[src * 3];
+        const double dgx = (pl.cyy * v[0] - pl.cxy * v[1]) / det;
+        const double dgy = (pl.cxx * v[1] - pl.cxy * v[0]) / det;
+        double d[3] = {0, slopePerGradient_deg * (ux * dgx + uy * dgy),
+                       r > 1e-9 ? v[2] / (n * r) : 0};
+        d[0] = w.stepD[src];
+        const double c[3] = {
+            o.step.gain * d[0] + o.step_roughness_gain * d[2] + o.step_slope_gain * d[1],
+            o.slope.gain * d[1], o.roughness.gain * d[2]};
+        for (int j = 0; j < 3; j++) mapVar[j] += d[j] * d[j], calVar[j] += c[j] * c[j];
+    }
+    const TraversabilityOptions::FeatureCalibration* cal[3] = {&o.step, &o.slope, &o.roughness};
+    const double value[3] = {fc.step_m, fc.slope_deg, fc.roughness_m};
+    const double limit[3] = {o.max_step_m, o.max_slope_deg, o.max_roughness_m};
+    float* sigmaOut[3] = {&out.stepSigma_m[k], &out.slopeSigma_deg[k], &out.roughnessSigma_m[k]};
+    double traversable = 1;
+    for (int j = 0; j < 3; j++) {
+        const double ms = cal[j]->model_sigma;
+        *sigmaOut[j] = float(std::hypot(cal[j]->gain * std::sqrt(mapVar[j]), ms));
+        traversable *= below(value[j], std::sqrt(calVar[j] + ms * ms), limit[j]);
+    }
+    out.untraversable[k] = float(1 - traversable);
+    if (foot.empty() || clear.empty()) {
+        out.foothold[k] = 0.f;
+        return;
+    }
+    w.footD.assign(sources, 0.0), w.clearD.assign(sources, 0.0);
+    foot.derivatives(w.footD, w.share), clear.derivatives(w.clearD, w.share);
+    out.foothold[k] = float(below(foot.range(), norm(w.footD), o.foothold_flatness_m) *
+                            below(clear.range(), norm(w.clearD), o.max_step_m));
+}
+
 }  // namespace
 
 void computeLayers(const SurfaceSamples& s, const TraversabilityOptions& o,
@@ -353,9 +514,12 @@ void computeLayers(const SurfaceSamples& s, const TraversabilityOptions& o,
     if (!(out.lattice == s.lattice)) out = TraversabilityLayers(s.lattice);
     const Stencil st = makeStencil(s.lattice.cellSize_m, s.perCell, o);
     // Per draw: the surface's errors (3 per stencil cell), then the features' model errors (3).
-    const std::vector<float> z =
-        fixedNormalDraws(size_t(std::max(0, o.monte_carlo_draws)) * (size_t(st.groups) * 3 + 3));
+    // With 0 draws the layers are thresholded, linear_uncertainty or not.
+    const bool linear = o.linear_uncertainty && o.monte_carlo_draws > 0;
+    const std::vector<float> z = fixedNormalDraws(
+        linear ? 0 : size_t(std::max(0, o.monte_carlo_draws)) * (size_t(st.groups) * 3 + 3));
     std::vector<Known> known;
+    LinearScratch scratch;
     for (int row = 0; row < s.lattice.ny(); row++)
         for (int col = 0; col < s.lattice.nx(); col++) {
             const size_t k = s.lattice.index(col, row);
@@ -364,7 +528,11 @@ void computeLayers(const SurfaceSamples& s, const TraversabilityOptions& o,
                  {&out.step_m, &out.stepSigma_m, &out.slope_deg, &out.slopeSigma_deg,
                   &out.roughness_m, &out.roughnessSigma_m, &out.untraversable, &out.foothold})
                 (*v)[k] = kNaN;
-            if (gatherCell(s, st, o, col, row, known)) computeCell(known, z, st.groups, o, out, k);
+            if (!gatherCell(s, st, o, col, row, known)) continue;
+            if (linear)
+                computeCellLinear(known, st.groups, o, out, k, scratch);
+            else
+                computeCell(known, z, st.groups, o, out, k);
         }
 }
 

@@ -22,6 +22,7 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("foothold_clearance_m", o.foothold_clearance_m, atLeast(0, "m"));
     visit("samples_per_cell", o.samples_per_cell, between(1, 8));
     visit("monte_carlo_draws", o.monte_carlo_draws, between(0, 4096));
+    visit("linear_uncertainty", o.linear_uncertainty);
     visit("min_known_fraction", o.min_known_fraction, between(0.05, 1));
     visit("use_bins", o.use_bins);
     visit("bin_min_certainty_share", o.bin_min_certainty_share, between(0, 1));

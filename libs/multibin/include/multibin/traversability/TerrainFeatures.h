@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -18,6 +19,18 @@ struct DiscFeatures {
     double roughness_m = 0;
 };
 
+/** The least-squares plane z = mh + g . ((x, y) - (mx, my)) of a disc's points, and their
+ * centred second moments (cxx = sum (x - mx)^2, ...). */
+struct DiscPlane {
+    double mx_m = 0, my_m = 0, mh_m = 0;  //!< the points' mean offset and height [m]
+    double gx = 0, gy = 0;                //!< the gradient [-]
+    double cxx = 0, cxy = 0, cyy = 0;     //!< [m^2]
+    double rss_m2 = 0;                    //!< residual sum of squares about the plane [m^2]
+};
+
+/** Half the range of relief of variance var spread uniformly: sqrt(3 var) [m]. */
+inline double reliefHalfWidth_m(double variance_m2) { return std::sqrt(3 * variance_m2); }
+
 /** Accumulates points of a disc (offsets from its centre [m] and heights [m]) and gives their
  * DiscFeatures: the one home of the feature definitions, for the map's surface and the truth's. */
 class DiscAccumulator {
@@ -32,6 +45,9 @@ public:
     size_t count() const { return m_n; }
     /** False with fewer than 3 points or collinear ones (no plane). */
     bool features(DiscFeatures& out) const;
+    /** The plane features() reads; false as features(). */
+    bool plane(DiscPlane& out) const;
+    double reliefSum_m2() const { return m_relief; }
 
 private:
     size_t m_n = 0;
@@ -102,6 +118,8 @@ struct TraversabilityLayers {
  * samples' heights and the bins); its sigma and the probabilities are Monte Carlo over
  * options.monte_carlo_draws draws of the samples' errors (fixed draws: the same map gives the same
  * layers). With 0 draws the probabilities are the thresholded features (0 or 1) and the sigmas 0.
+ * With options.linear_uncertainty, the sigmas and probabilities are propagated linearly instead
+ * (closed form, no draws; doc/traversability.md).
  */
 void computeLayers(const SurfaceSamples& samples, const TraversabilityOptions& options,
                    TraversabilityLayers& out, const std::vector<uint8_t>& cellMask = {});

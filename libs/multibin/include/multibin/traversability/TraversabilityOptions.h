@@ -38,6 +38,10 @@ struct TraversabilityOptions {
     int samples_per_cell = 2;
     /** [monte_carlo_draws] draws of the map's height errors per cell [-] */
     int monte_carlo_draws = 128;
+    /** [linear_uncertainty] the features' sigmas and P(untraversable) by linear propagation of the
+     * samples' errors through the features (Gaussian, closed form) instead of Monte Carlo draws;
+     * the foothold too */
+    bool linear_uncertainty = false;
     /** [min_known_fraction] a cell whose disc has a smaller share of known samples is unknown
      * [-] */
     double min_known_fraction = 0.5;
