@@ -169,8 +169,9 @@ TEST(RandomScenes, TodaysBoundsOnAHandfulOfScoringScenes) {
 
 // The fill bounded by the clearance (the lowest line of sight over a cell the laser never hit,
 // FillOptions::clearance): on the CI scenes the filled cells in MRPT's gaps are lower in error
-// than the same maps filled without it, and no measured cell changes (the clearance touches only
-// filled cells: the static and query figures, which read measured cells, are the same).
+// than the same maps filled without it (12.8, 29.8, 21.9, 8.8 mm against 15.1, 30.7, 30.3,
+// 9.0 mm), and no measured cell changes (the static figure, read from measured cells, is the
+// same to the bit).
 TEST(RandomScenes, ClearanceLowersTheFilledCellsError) {
     double sumWith_m2 = 0, sumWithout_m2 = 0;
     for (const ScoredScene& s : ciScenes()) {
@@ -188,7 +189,7 @@ TEST(RandomScenes, ClearanceLowersTheFilledCellsError) {
         sumWith_m2 += std::pow(s.scores.filledRmse_m, 2);
         sumWithout_m2 += std::pow(without.filledRmse_m, 2);
     }
-    EXPECT_LT(sumWith_m2, 0.9 * sumWithout_m2);
+    EXPECT_LT(sumWith_m2, 0.8 * sumWithout_m2);  // measured 0.74 (1 without the clearance)
 }
 
 // The stale bins a vacated place keeps, on two scoring scenes where the visibility rule decides

@@ -49,11 +49,6 @@ FanOutcome testRays(RayFan fan, const BinGrid& grid, const Region& region,
 }
 }  // namespace visibility
 
-/** The constraint's bin edits (applyVisibilityConstraint without the clearances). */
-static VisibilityStats editStaleBins(BinGrid& grid, const Eigen::Vector3d& sensor_m,
-                                     const VisibilityParams& vis, const BinUpdateParams& binParams,
-                                     RayFan fan);
-
 namespace {
 /** This thread's scratch arrays. Out of line so that the caller holds a plain reference: named
  * directly, a thread_local of this shared library is looked up again (__tls_get_addr) at almost
@@ -95,17 +90,9 @@ void noteClearances(BinGrid& grid, const Eigen::Vector3d& sensor_m, double maxRi
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
                                           const VisibilityParams& vis,
                                           const BinUpdateParams& binParams, RayFan fan) {
-    VisibilityStats stats;
-    if (!vis.enabled) return stats;
-    noteClearances(grid, sensor_m, kClearanceRise_m);  // before the stages' early returns
-    return editStaleBins(grid, sensor_m, vis, binParams, fan);
-}
-
-static VisibilityStats editStaleBins(BinGrid& grid, const Eigen::Vector3d& sensor_m,
-                                     const VisibilityParams& vis, const BinUpdateParams& binParams,
-                                     RayFan fan) {
     using namespace visibility;
     VisibilityStats stats;
+    if (!vis.enabled) return stats;
     const ConflictTest conflicts(vis, binParams);
     const BoundTest bounds{conflicts.minMargin_m()};
     const double step = 0.5 * grid.cellSize_m();

@@ -27,8 +27,7 @@ namespace multibin {
  * in five stages (VisibilityStages.h): the update's region, the rectangle towards the sensor, a
  * test of all the rays at once (the fan or the envelope test, below), a ray's block columns, and
  * the rule's samples over the columns left. The cost grows with the distinct updated cells, not
- * with the points, and with the relief near the lines of sight (doc/visibility.md). Before
- * the constraint, the update's clearances are noted (noteClearances, below; no bin edited). */
+ * with the points, and with the relief near the lines of sight (doc/visibility.md). */
 /** How the updated cells' lines of sight are tested before any walk: the fan test, each ray
  * against the blocks within its angle (a scan's few hundred rays: laser, lidar), or the envelope
  * test, the rays' lower envelope by direction against the cells near them (a camera frame's
@@ -46,8 +45,9 @@ VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& 
  * risen `maxRise_m` above its end or has crossed 16 cells (a shallow line's cost): the ground
  * there lies below the line, whose height at the sample is the cell's clearance. A line ends at
  * the highest bin its cell ever held, and only cells with two points or more of the update end
- * one (a lone point may be a range outlier beyond the surface). Edits no bin. Called first by
- * applyVisibilityConstraint (with kClearanceRise_m), when it is enabled. */
+ * one (a lone point may be a range outlier beyond the surface). Edits no bin. The map calls it
+ * (with kClearanceRise_m) before applyVisibilityConstraint when the constraint is enabled and the
+ * fill reads clearances (fill_enabled, fill_clearance). */
 void noteClearances(BinGrid& grid, const Eigen::Vector3d& sensor_m, double maxRise_m);
 /** How far above its end a line of sight is followed for the clearance [m]: beyond, it is far
  * above any fill a gap's rim gives (0.14 m along a ray 30 deg below the horizontal; 0.15 m measured
