@@ -542,3 +542,50 @@ TEST(Visibility, SubCellAnswerWeighsWhatTheConstraintTookFromAFace) {
     EXPECT_GE(standing, 0.2);
     EXPECT_LT(weakened, standing);
 }
+
+TEST(Visibility, ClearanceIsTheLowestLineOfSightOverACellWithinTheRiseLimit) {
+    // By hand: sensor at (0.05, 0.05, 0.5), target cell 20 (centre x = 2.05) at 0 m: the line
+    // towards the sensor rises 0.25 m per m, so over cell k (x from 0.1 k to 0.1 k + 0.1) it lies
+    // between 0.25 (2.05 - 0.1 k - 0.1) and 0.25 (2.05 - 0.1 k) m. The walk stops once the line
+    // is kClearanceRise_m above the target (d = 0.32 m), so cells 19, 18, 17 (samples at
+    // d = 0.1, 0.2, 0.3 m) get one and cell 16 (d = 0.4 m) none. No bin changes.
+    ASSERT_DOUBLE_EQ(kClearanceRise_m, 0.08);  // the hand computation's limit
+    BinUpdateParams p;
+    BinGrid g(0.1);
+    g.reset(0.1, CellWindow{-5, -5, 30, 10});
+    auto lineOver = [](int k, double tz_m) {  // the line's lowest and highest over cell k
+        return std::make_pair(tz_m + 0.25 * (2.05 - 0.1 * k - 0.1), tz_m + 0.25 * (2.05 - 0.1 * k));
+    };
+    g.beginCycle();
+    g.insertPoints({pointAt(2.05, 0.05, 0.0, 0.005), pointAt(2.05, 0.05, 0.0, 0.005)}, p);
+    const auto before = binsOf(g);
+    noteClearances(g, {0.05, 0.05, 0.5}, kClearanceRise_m);
+    EXPECT_EQ(binsOf(g), before);
+    for (int k = 17; k <= 19; k++) {
+        const auto [low, high] = lineOver(k, 0.0);
+        EXPECT_GE(g.clearance_m(k, 0), low - 1e-6) << k;
+        EXPECT_LE(g.clearance_m(k, 0), high + 1e-6) << k;
+    }
+    EXPECT_EQ(g.clearance_m(16, 0), std::numeric_limits<float>::infinity());
+    EXPECT_EQ(g.clearance_m(20, 0), std::numeric_limits<float>::infinity());  // the target
+    EXPECT_EQ(g.clearance_m(21, 0), std::numeric_limits<float>::infinity());  // beyond it
+    EXPECT_EQ(g.clearance_m(19, 1), std::numeric_limits<float>::infinity());  // beside the line
+    // A lower sensor's line (0.3 / 2.0 m per m) lowers it; points below the cell's surface
+    // (0.2 m under it) do not: the line ends at the highest bin the cell held.
+    g.beginCycle();
+    g.insertPoints({pointAt(2.05, 0.05, 0.0, 0.005), pointAt(2.05, 0.05, 0.0, 0.005)}, p);
+    noteClearances(g, {0.05, 0.05, 0.3}, kClearanceRise_m);
+    const float lowered_m = g.clearance_m(19, 0);
+    EXPECT_GE(lowered_m, 0.15 * 0.05 - 1e-6);
+    EXPECT_LE(lowered_m, 0.15 * 0.15 + 1e-6);
+    g.beginCycle();
+    g.insertPoints({pointAt(2.05, 0.05, -0.2, 0.005), pointAt(2.05, 0.05, -0.2, 0.005)}, p);
+    noteClearances(g, {0.05, 0.05, 0.5}, kClearanceRise_m);
+    EXPECT_EQ(g.clearance_m(19, 0), lowered_m);
+    // A lone point of an update (a range outlier, maybe) ends no line: cell 23 holds it.
+    g.beginCycle();
+    g.insertPoints({pointAt(2.35, 0.05, 0.0, 0.005)}, p);
+    noteClearances(g, {0.05, 0.05, 0.5}, kClearanceRise_m);
+    ASSERT_NE(g.winningBin(23, 0), nullptr);
+    EXPECT_EQ(g.clearance_m(22, 0), std::numeric_limits<float>::infinity());
+}

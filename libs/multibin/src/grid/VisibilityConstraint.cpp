@@ -11,6 +11,11 @@
 namespace multibin {
 
 namespace {
+/** The most cells a line of sight is followed for the clearance [cells]. */
+constexpr int kClearanceReach_cells = 16;
+/** The fewest points of one update a cell needs to end a line of sight for the clearance. */
+constexpr uint32_t kClearanceMinPoints = 2;
+
 /** The visibility keys of `o` (a VisibilityParams or a const one), for the options protocol
  * (multibin/io/OptionKeys.h). */
 template <class Params, class Visit>
@@ -53,6 +58,34 @@ __attribute__((noinline)) visibility::VisibilityScratch& threadScratch() {
     return scratch;
 }
 }  // namespace
+
+void noteClearances(BinGrid& grid, const Eigen::Vector3d& sensor_m, double maxRise_m) {
+    const double cell_m = grid.cellSize_m();
+    // A shallow line (a lidar's far rays) also stops after kClearanceReach_cells: its cost.
+    const double maxReach_m = kClearanceReach_cells * cell_m;
+    for (BinGrid::UpdatedCell u : grid.updatedCells()) {
+        // A lone point may be a range outlier beyond the surface, whose line runs under the
+        // ground before it: only cells two points or more of this update agree on end a line.
+        if (u.points < kClearanceMinPoints) continue;
+        // The line ends at the highest bin the cell ever held, not at this update's point: a
+        // point below the surface (a range outlier, a mixed pixel) would draw a line under the
+        // ground before it, and one such line sets the clearance for good.
+        u.maxHeight_m = std::max(u.maxHeight_m, grid.cellMaxHeight_m(u.ix, u.iy));
+        SightLine ray;
+        // A line rising towards the sensor stops at maxRise_m; one that does not (a sensor below
+        // its point) bounds nothing near the point and is not followed.
+        if (!ray.set(grid, u, sensor_m) || !(ray.slope > 0)) continue;
+        const double stop_m = ray.tz_m + std::min(maxRise_m, ray.slope * maxReach_m);
+        // One sample a cell (the rule takes two): a cell a diagonal line only grazes may be
+        // missed, at half the cost. The cell's clearance is the line's height at the sample.
+        for (double d = cell_m; d < ray.walk_m; d += cell_m) {
+            const double z_m = ray.tz_m + ray.slope * d;
+            if (z_m > stop_m) break;
+            grid.noteClearance(ray.cellOf(grid, ray.tx_m + ray.ux * d),
+                               ray.cellOf(grid, ray.ty_m + ray.uy * d), z_m);
+        }
+    }
+}
 
 VisibilityStats applyVisibilityConstraint(BinGrid& grid, const Eigen::Vector3d& sensor_m,
                                           const VisibilityParams& vis,

@@ -12,6 +12,7 @@
 #include <set>
 #include <utility>
 
+#include "multibin/fill/BoundedByClearance.h"
 #include "multibin/fill/SparseFill.h"
 #include "multibin/grid/BinStore.h"
 
@@ -66,6 +67,10 @@ void CMultiBinElevationMap::fillNow() const {
     // Tiled: the cost follows the cells near data, not the window (a long route's box).
     const multibin::fill::SparseHeights in = fillInput();
     m_impl->filled = multibin::fill::fillSparse(in, insertionOptions.fill);
+    // The lines of sight bound the fill from above; a map read from a file has no clearances.
+    const multibin::BinGrid& grid = m_impl->grid;
+    multibin::fill::boundByClearance(m_impl->filled, insertionOptions.fill,
+                                     [&](int ix, int iy) { return grid.clearance_m(ix, iy); });
     m_impl->fillWindow = in.lattice.window;
     // lastFill()'s raster of the window is built when first asked for: the statistics now.
     m_impl->fill = {};

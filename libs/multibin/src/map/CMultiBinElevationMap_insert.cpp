@@ -390,6 +390,10 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     const multibin::InsertStats s = fuse(grid, params);
     m_impl->stats += s;
     if (sensorOrigin_m) {
+        // The clearances bound the gap fill (fill::boundByClearance): kept only if it reads them.
+        const multibin::fill::FillOptions& fill = insertionOptions.fill;
+        if (insertionOptions.visibility.enabled && fill.enabled && fill.clearance)
+            multibin::noteClearances(grid, *sensorOrigin_m, multibin::kClearanceRise_m);
         const multibin::VisibilityStats v = multibin::applyVisibilityConstraint(
             grid, *sensorOrigin_m, insertionOptions.visibility, params,
             cameraFrame ? multibin::RayFan::Skip : multibin::RayFan::Test);

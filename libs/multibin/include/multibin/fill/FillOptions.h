@@ -131,6 +131,14 @@ struct FillOptions {
     /** [fill_shadow_reach_cells] an occluder's top is hidden from the fill up to this many cells
      * from its rim cell [cells]. */
     int shadowReach_cells = 4;
+    /** [fill_clearance] a filled cell lies no higher than its clearance (the lowest line of
+     * sight that passed over it without a return there, kept by the map's visibility stage)
+     * plus fill_clearance_margin_m: a cell the laser never hit lies below the rays over it
+     * (BoundedByClearance.h). */
+    bool clearance = true;
+    /** [fill_clearance_margin_m] what a filled cell may lie above its clearance [m]: the ray's
+     * own error near its end point and the cell's relief under a line crossing it. */
+    double clearanceMargin_m = 0.0;
     /** [fill_model_averaging] kriging only: average the fills of the m visited by the search
      * with Akaike weights exp(-dAIC/2) (and add their spread to the variance) instead of
      * keeping the single best m. */

@@ -166,6 +166,16 @@ public:
     }
     /** Highest bin height ever stored (an upper bound on every bin's height) [m]. */
     double maxHeight_m() const { return m_index.maxHeight_m(); }
+    /** See VisibilityIndex::noteClearance; nothing outside the window or in an unallocated tile. */
+    void noteClearance(int ix, int iy, double height_m) {
+        if (window().contains(ix, iy))
+            m_index.noteClearance(m_store.slot(ix, iy), static_cast<float>(height_m));
+    }
+    /** See VisibilityIndex::clearance_m; +infinity outside the window. */
+    float clearance_m(int ix, int iy) const {
+        return window().contains(ix, iy) ? m_index.clearance_m(m_store.slot(ix, iy))
+                                         : std::numeric_limits<float>::infinity();
+    }
     static int blockOf(int cellIndex) { return VisibilityIndex::blockOf(cellIndex); }
     /** See VisibilityIndex::blockMaxHeight_m. */
     float blockMaxHeight_m(int bx, int by) const {

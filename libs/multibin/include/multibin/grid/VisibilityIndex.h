@@ -13,9 +13,10 @@ namespace multibin {
 
 /** What the visibility constraint needs to know about a grid beyond its bins: which cells the
  * current observation updated (update cycles) and upper bounds on the bins' heights, per cell
- * and per block of cells. Kept beside a BinStore with its slot numbering (per tile); BinGrid
- * keeps the two in step. Memory: 12 B per cell of an allocated tile (update-cycle stamp and
- * index, height bound), 4 B per block of 256 cells. */
+ * and per block of cells; and what the lines of sight say of the ground, the clearance of each
+ * cell (for the gap fill). Kept beside a BinStore with its slot numbering (per tile); BinGrid
+ * keeps the two in step. Memory: 16 B per cell of an allocated tile (update-cycle stamp and
+ * index, height bound, clearance), 4 B per block of 256 cells. */
 class VisibilityIndex {
 public:
     /** A cell updated in the current cycle, with the highest height accepted into it [m]. */
@@ -61,6 +62,20 @@ public:
      * the visibility constraint tests a cell's bins only where this says they may conflict. */
     float cellMaxHeight_m(size_t slot) const { return m_stamps[slot].maxHeight_m; }
 
+    /** @name Clearance: the lowest height at which a line of sight passed over a cell without a
+     * return there, an upper bound on its ground (the gap fill bounds filled cells by it). Kept
+     * while the cell's tile stays allocated; +infinity where no line passed (and in the empty
+     * tile, which is never written).
+     * @{ */
+    /** A line of sight passed over the cell at `slot` at `height_m` [m]. */
+    void noteClearance(size_t slot, float height_m) {
+        if (slot < BinStore::kTileSlots) return;  // the empty tile: read only
+        float& c = m_stamps[slot].clearance_m;
+        c = std::min(c, height_m);
+    }
+    float clearance_m(size_t slot) const { return m_stamps[slot].clearance_m; }
+    /** @} */
+
     /** @name Local height bound: blocks of kBlockCells x kBlockCells cells. Block (bx, by) holds
      * cells bx kBlockCells .. bx kBlockCells + kBlockCells - 1 (and likewise in y), so a cell's
      * block is (ix >> kBlockShift, iy >> kBlockShift); a tile of the store holds
@@ -105,6 +120,7 @@ private:
         uint32_t cycle = 0;         //!< the update cycle that last updated the cell
         uint32_t updatedIndex = 0;  //!< its entry in m_updated, valid in that cycle
         float maxHeight_m = -std::numeric_limits<float>::infinity();  //!< cellMaxHeight_m
+        float clearance_m = std::numeric_limits<float>::infinity();   //!< clearance_m
     };
     std::vector<CellStamp> m_stamps;     //!< per slot of the store
     std::vector<UpdatedCell> m_updated;  //!< cells updated in this cycle, in first-update order
