@@ -224,12 +224,7 @@ TEST(VisibilityStages, RaysClearTowardsTheSensorOrByTheFanTestMeetNoConflict) {
     size_t clearByRectangle = 0, clearByFan = 0, walked = 0;
     onRandomScenes(20261129, 25, [&](Scene& s, int id) {
         FirstStages st(s);
-        const VisibilityParams& v = st.v;
-        const BinUpdateParams& p = st.p;
-        const BoundTest& bounds = st.bounds;
-        VisibilityScratch& scratch = st.scratch;
-        const Region& region = st.region;
-        const TowardsSensor& towards = st.towards;
+        [[maybe_unused]] auto& [v, p, conflictTest, bounds, scratch, region, towards] = st;
         std::vector<RayState> state;
         const FanOutcome fan =
             testRays(RayFan::Test, s.grid, region, towards, s.sensor_m, bounds, scratch, state);
@@ -264,12 +259,7 @@ TEST(VisibilityStages, RaysClearByTheEnvelopeTestMeetNoConflict) {
     size_t clear = 0, walk = 0;
     onRandomScenes(20261131, 25, [&](Scene& s, int id) {
         FirstStages st(s);
-        const VisibilityParams& v = st.v;
-        const BinUpdateParams& p = st.p;
-        const BoundTest& bounds = st.bounds;
-        VisibilityScratch& scratch = st.scratch;
-        const Region& region = st.region;
-        const TowardsSensor& towards = st.towards;
+        [[maybe_unused]] auto& [v, p, conflictTest, bounds, scratch, region, towards] = st;
         std::vector<RayState> state;
         const FanOutcome out =
             testRays(RayFan::Skip, s.grid, region, towards, s.sensor_m, bounds, scratch, state);
@@ -322,13 +312,7 @@ TEST(VisibilityStages, ColumnStretchesHoldEveryConflictAndTheirWalkEditsAsTheRul
     size_t conflicts = 0, rays = 0;
     onRandomScenes(20261130, 25, [&](Scene& s, int id) {
         FirstStages st(s);
-        const VisibilityParams& v = st.v;
-        const BinUpdateParams& p = st.p;
-        const ConflictTest& conflictTest = st.conflicts;
-        const BoundTest& bounds = st.bounds;
-        VisibilityScratch& scratch = st.scratch;
-        const Region& region = st.region;
-        const TowardsSensor& towards = st.towards;
+        [[maybe_unused]] auto& [v, p, conflictTest, bounds, scratch, region, towards] = st;
         const double stopHeight_m =
             std::min(s.grid.maxHeight_m(), BoundTest::tolerant_m(region.maxBound_m)) + v.margin_m;
         const double step = 0.5 * s.grid.cellSize_m();
@@ -366,8 +350,8 @@ TEST(VisibilityStages, ColumnStretchesHoldEveryConflictAndTheirWalkEditsAsTheRul
             const double ruleTarget = targetCertainty(rule, u, p);
             forEachCellOnSightLine(rule, ray, u.ix, u.iy, s.grid.maxHeight_m() + v.margin_m,
                                    [&](int ix, int iy, double, double rayHigh_m) {
-                                       editOccluder(
-                                           rule, ix, iy, rayHigh_m, conflictTest,
+                                       editOccluder(  // st: a lambda captures no binding
+                                           rule, ix, iy, rayHigh_m, st.conflicts,
                                            [&] { return ruleTarget; }, 1.0f, rs);
                                    });
             ASSERT_EQ(ws.binsRemoved, rs.binsRemoved) << id << " ray " << i;
