@@ -44,15 +44,28 @@ bool CMultiBinElevationMap::cellHeight(double x_m, double y_m, double& height_m,
     return surfaceQuery(false, x_m, y_m, height_m, sigma_m);
 }
 
+// The caller holds the map's lock (asString() takes it once, not again per edge).
 double CMultiBinElevationMap::windowEdge_m(int edge) const {
-    const multibin::MapLock::Shared lock(m_impl->lock);  // growth moves the window
     const double origin_m = edge < 2 ? m_impl->origin_m.x() : m_impl->origin_m.y();
     return origin_m + m_impl->grid.lattice().area_m()[edge];
 }
-double CMultiBinElevationMap::getXMin() const { return windowEdge_m(0); }
-double CMultiBinElevationMap::getXMax() const { return windowEdge_m(1); }
-double CMultiBinElevationMap::getYMin() const { return windowEdge_m(2); }
-double CMultiBinElevationMap::getYMax() const { return windowEdge_m(3); }
+// Under the lock: growth moves the window.
+double CMultiBinElevationMap::getXMin() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    return windowEdge_m(0);
+}
+double CMultiBinElevationMap::getXMax() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    return windowEdge_m(1);
+}
+double CMultiBinElevationMap::getYMin() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    return windowEdge_m(2);
+}
+double CMultiBinElevationMap::getYMax() const {
+    const multibin::MapLock::Shared lock(m_impl->lock);
+    return windowEdge_m(3);
+}
 
 double CMultiBinElevationMap::dem_get_resolution() const { return m_impl->grid.cellSize_m(); }
 size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_impl->grid.window().nx); }
