@@ -302,7 +302,7 @@ SupersampledLayers SupersampledLayers::of(const CMultiBinElevationMap& map, cons
         g->yllcenter_m = y0 + 0.5 * cell_m;
         g->cellsize_m = cell_m;
     }
-    const bool filled = map.insertionOptions.dem_return_filled;
+    const bool filled = map.insertionOptions.query.dem_return_filled;
     for (int r = 0; r < rows; r++)
         for (int c = 0; c < cols; c++) {
             const double x = out.height.xllcenter_m + c * cell_m;

@@ -286,7 +286,7 @@ int run(const Arguments& args, std::string& stage) {
                                  "' defines no multiBinElevationMap in [" + args.section +
                                  "] (choose the section with --section)");
 
-    selection.sceneColouring = elevation->insertionOptions.color_by_sigma
+    selection.sceneColouring = elevation->insertionOptions.render.color_by_sigma
                                    ? multibin::SceneColouring::Sigma
                                    : multibin::SceneColouring::Height;
     if (!args.sceneColour.empty()) {

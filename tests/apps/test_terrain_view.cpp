@@ -193,11 +193,11 @@ INSTANTIATE_TEST_SUITE_P(EachColouring, TerrainView,
 // renders (it used to fail "mask.cols() == cols && mask.rows() == rows" in SceneViewer3D).
 TEST(TerrainViewMap, ColorBySigmaWritesASceneThatRenders) {
     CMultiBinElevationMap& map = rampMap();
-    map.insertionOptions.color_by_sigma = true;
+    map.insertionOptions.render.color_by_sigma = true;
     mrpt::opengl::COpenGLScene scene;
     auto view = mrpt::opengl::CSetOfObjects::Create();
     map.getVisualizationInto(*view);
-    map.insertionOptions.color_by_sigma = false;
+    map.insertionOptions.render.color_by_sigma = false;
     scene.insert(view);
     const fs::path file = fs::path(MULTIBIN_BINARY_DIR) / "test_terrain_view" / "by_sigma.3Dscene";
     fs::create_directories(file.parent_path());

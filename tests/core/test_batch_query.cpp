@@ -112,7 +112,8 @@ TEST(BatchQuery, MockupMapAnswersAsHeightBitForBit) {
 
     // The `nearest` query (each cell's value): the same answers as its height().
     Map nearest = map;
-    nearest.insertionOptions.height_query = Map::TInsertionOptions::HeightQuery::Nearest;
+    nearest.insertionOptions.query.height_query =
+        Map::TInsertionOptions::TQueryOptions::HeightQuery::Nearest;
     expectBatchAsSingle(nearest, x, y, counts);
     EXPECT_GT(counts[int(Source::Measured)], 2000u);
 }

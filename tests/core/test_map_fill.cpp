@@ -51,9 +51,9 @@ TEST(MapFill, FillingIsLazyAndFilledCellsAreMarked) {
     EXPECT_GT(certainty.heights_m(0, 0), 0.f);
 
     // MRPT's documented behaviour on request: unobserved cells are not returned.
-    map.insertionOptions.dem_return_filled = false;
+    map.insertionOptions.query.dem_return_filled = false;
     EXPECT_FALSE(map.dem_get_z(hx, hy, z));
-    map.insertionOptions.dem_return_filled = true;
+    map.insertionOptions.query.dem_return_filled = true;
 
     // A new observation makes the fill stale; a cell measured since answers with its data.
     CMultiBinElevationMap::TPointInsertParams ip;

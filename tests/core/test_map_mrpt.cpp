@@ -328,7 +328,7 @@ TEST(CMultiBinElevationMap, IniOptionsRoundTripAndMalformedValuesAreRefused) {
     in.max_elevation_uncertainty_m = 0.0731;
     in.default_pose_sigmas = {0.1, 0.2, 0.3, 0.01, 0.02, 0.03};
     in.sensor_labels = {"STEREO"};
-    in.colormap = mrpt::img::cmHOT;
+    in.render.colormap = mrpt::img::cmHOT;
     mrpt::config::CConfigFileMemory ini;
     c.saveToConfigFile(ini, "c");
     in.saveToConfigFile(ini, "i");
@@ -343,7 +343,7 @@ TEST(CMultiBinElevationMap, IniOptionsRoundTripAndMalformedValuesAreRefused) {
     EXPECT_EQ(in2.max_elevation_uncertainty_m, in.max_elevation_uncertainty_m);
     EXPECT_EQ(in2.default_pose_sigmas, in.default_pose_sigmas);
     EXPECT_EQ(in2.sensor_labels, in.sensor_labels);
-    EXPECT_EQ(in2.colormap, in.colormap);
+    EXPECT_EQ(in2.render.colormap, in.render.colormap);
 
     auto expectRefused = [](const std::string& text, const std::string& mention) {
         mrpt::config::CConfigFileMemory bad(text);

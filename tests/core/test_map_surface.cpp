@@ -25,7 +25,7 @@ void insert(CMultiBinElevationMap& map, double x, double y, double z, double sig
 TEST(CellSurface, AdjacentBinsThatAgreeAreOneSurface) {
     // A surface at 0.05 m (a bin boundary) measured with sigma 3 mm: points fall in bins 0 and 1.
     CMultiBinElevationMap map = fixedMap(0.1);
-    map.insertionOptions.relief_sigma = false;
+    map.insertionOptions.query.relief_sigma = false;
     const double heights[] = {0.048, 0.052, 0.047, 0.053, 0.049, 0.051};
     for (double z : heights) insert(map, 0.55, 0.55, z, 0.003);
     double h, s;
@@ -35,7 +35,7 @@ TEST(CellSurface, AdjacentBinsThatAgreeAreOneSurface) {
 
     // Two surfaces 0.1 m apart stay two hypotheses: the more certain one wins alone.
     CMultiBinElevationMap two = fixedMap(0.1);
-    two.insertionOptions.relief_sigma = false;
+    two.insertionOptions.query.relief_sigma = false;
     for (int i = 0; i < 3; i++) insert(two, 0.55, 0.55, 0.01, 0.003);
     for (int i = 0; i < 2; i++) insert(two, 0.55, 0.55, 0.11, 0.003);
     ASSERT_TRUE(two.cellHeight(0.55, 0.55, h, s));
@@ -55,7 +55,7 @@ TEST(CellSurface, ReliefOfASlopeAddsItsHeightSpreadToSigma) {
     ASSERT_TRUE(map.cellHeight(0.05, 0.05, h, s));
     // sigma^2 = max(Kalman, floor) + (g s)^2 / 12; Kalman = floor = 1 mm here.
     EXPECT_NEAR(s, std::sqrt(sigma * sigma + std::pow(slope * cell, 2) / 12.0), 1e-6);
-    map.insertionOptions.relief_sigma = false;
+    map.insertionOptions.query.relief_sigma = false;
     ASSERT_TRUE(map.cellHeight(0.05, 0.05, h, s));
     EXPECT_NEAR(s, sigma, 1e-6);
 }
@@ -72,7 +72,7 @@ TEST(CellSurface, OtherSurfacesInTheCellAddTheirCertaintyWeightedSpreadToSigma) 
     EXPECT_NEAR(h, 0.11, 1e-6);
     const double kalman2 = 0.003 * 0.003 / 3;  // the winning bin: 3 points of 3 mm
     EXPECT_NEAR(s * s, kalman2 + 2.0 / 5.0 * 0.1 * 0.1, 1e-9);
-    map.insertionOptions.relief_sigma = false;  // the paper's sigma: the winning bin's alone
+    map.insertionOptions.query.relief_sigma = false;  // the paper's sigma: the winning bin's alone
     ASSERT_TRUE(map.cellHeight(0.55, 0.55, h, s));
     EXPECT_NEAR(s * s, kalman2, 1e-9);
 }
@@ -82,7 +82,7 @@ TEST(CellSurface, EveryLayerDescribesTheSameSurface) {
     // and sigma layers report the merged surface, so the certainty layer must count all six
     // points' certainty (6), not the winning bin's share (3).
     CMultiBinElevationMap map = fixedMap(0.1);
-    map.insertionOptions.relief_sigma = false;
+    map.insertionOptions.query.relief_sigma = false;
     for (double z : {0.048, 0.052, 0.047, 0.053, 0.049, 0.051}) insert(map, 0.55, 0.55, z, 0.003);
     double h, s;
     ASSERT_TRUE(map.cellHeight(0.55, 0.55, h, s));

@@ -103,7 +103,7 @@ TEST(OptionKeys, SavedOptionsReadBackToTheSameText) {
     a.certainty_increment = 2.5f;
     a.default_pose_sigmas = {0.1, 0.2, 0.3, 0.01, 0.02, 0.03};
     a.sensor_labels = {"LASER", "STEREO"};
-    a.colormap = mrpt::img::cmHOT;
+    a.render.colormap = mrpt::img::cmHOT;
     a.visibility.margin_m = 0.031;
     a.fill.residualModel = multibin::fill::ResidualModel::Biharmonic;
     a.fill.sigmaFloor_m = 0.0041;
@@ -155,7 +155,7 @@ TEST(OptionKeys, ValuesSetInCodeAreCheckedByTheKeysRules) {
     o.sensors.stereo.sgbmMode = "fast";
     expectRefused(o, "stereo_sgbm_mode", "sgbm_3way");
     o = {};
-    o.colormap = mrpt::img::cmNONE;
+    o.render.colormap = mrpt::img::cmNONE;
     expectRefused(o, "colormap", "jet");
 }
 

@@ -135,10 +135,10 @@ TEST(SubCellSurface, NeverAcrossAStep) {
 TEST(SubCellSurface, NearestKeepsTheCellValue) {
     CMultiBinElevationMap map = fixedMap();
     map.insertPoints(samplePoints(10, 5, terrain));
-    using Q = CMultiBinElevationMap::TInsertionOptions::HeightQuery;
+    using Q = CMultiBinElevationMap::TInsertionOptions::TQueryOptions::HeightQuery;
     for (const double x : {0.101, 0.2345, 0.4567}) {
         for (const Q mode : {Q::Nearest, Q::Plane}) {
-            map.insertionOptions.height_query = mode;
+            map.insertionOptions.query.height_query = mode;
             double hg, sg, hWant, sWant, z;
             ASSERT_TRUE(map.getHeight(x, 0.3, hg, sg));
             ASSERT_TRUE(mode == Q::Nearest ? map.cellHeight(x, 0.3, hWant, sWant)

@@ -153,8 +153,8 @@ TEST(SparseFill, FillInputHoldsEveryMeasuredCellOfTheWindowWithOneGridOrTwo) {
                 multibin::CellSurface c;
                 const bool known = multibin::surfaceAt(
                     g, dual ? &multibin::MapInternals::localGrid(map) : nullptr, g.cellCenter_m(ix),
-                    g.cellCenter_m(iy), map.binUpdateParams(), map.insertionOptions.relief_sigma,
-                    c);
+                    g.cellCenter_m(iy), map.binUpdateParams(),
+                    map.insertionOptions.query.relief_sigma, c);
                 measured += known;
                 const auto& m = in.cells.get(ix, iy);
                 differ += known != in.isMeasured(ix, iy) ||

@@ -444,7 +444,7 @@ TEST(Visibility, MovedObjectIsForgottenAndItsSurroundingsKept) {
         // Judged on the winning surface and its Kalman sigma: with relief_sigma, box bins left
         // in a cell raise that cell's sigma (their honest effect on the reported uncertainty),
         // which would hide whether the surface itself came back to the ground.
-        map.insertionOptions.relief_sigma = false;
+        map.insertionOptions.query.relief_sigma = false;
         terrain.boxPresent = true;
         drive(map, terrain);
         double h, s;

@@ -68,6 +68,9 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("fill_harmonic_sigma_gain", o.harmonicSigmaGain, atLeast(0));
     visit({"fill_sigma_floor_m", "fill_sigma_floor"}, o.sigmaFloor_m, atLeast(0, "m"));
 }
+
+/** visitKeys as one callable, for readOptionKeys() and loadOptionKeys(). */
+const auto kKeys = [](auto& o, auto&& visit) { visitKeys(o, visit); };
 }  // namespace
 
 GaussianFitOptions FillOptions::gaussianFitOptions() const {
@@ -81,15 +84,10 @@ GaussianFitOptions FillOptions::gaussianFitOptions() const {
     return g;
 }
 
-void FillOptions::read(StrictConfigSection& s) {
-    visitKeys(*this, OptionReader{s});
-    validateAsReadFrom(s, *this);
-}
-
+void FillOptions::read(StrictConfigSection& s) { readOptionKeys(s, *this, kKeys); }
 void FillOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                      const std::string& section) {
-    loadStrictly(source, section, *this,
-                 [&](StrictConfigSection& s) { visitKeys(*this, OptionReader{s}); });
+    loadOptionKeys(source, section, *this, kKeys);
 }
 
 void FillOptions::write(mrpt::config::CConfigFileBase& c, const std::string& section) const {

@@ -163,9 +163,10 @@ std::string CMultiBinElevationMap::asString() const {
     const multibin::MapLock::Shared lock(m_impl->lock);
     std::ostringstream os;
     os << "CMultiBinElevationMap: " << m_impl->grid.window().nx << " x " << m_impl->grid.window().ny
-       << " cells of " << m_impl->grid.cellSize_m() << " m, x in [" << windowEdge_m(0) << ", "
-       << windowEdge_m(1) << "], y in [" << windowEdge_m(2) << ", " << windowEdge_m(3) << "] m, "
-       << m_impl->grid.binCount() << " bins of " << creationOptions.bin_height_m << " m";
+       << " cells of " << m_impl->grid.cellSize_m() << " m, x in [" << m_impl->windowEdge_m(0)
+       << ", " << m_impl->windowEdge_m(1) << "], y in [" << m_impl->windowEdge_m(2) << ", "
+       << m_impl->windowEdge_m(3) << "] m, " << m_impl->grid.binCount() << " bins of "
+       << creationOptions.bin_height_m << " m";
     return os.str();
 }
 

@@ -79,7 +79,8 @@ void CMultiBinElevationMap::heights(const double* x_m, const double* y_m, size_t
     }
     prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
-    if (insertionOptions.height_query != TInsertionOptions::HeightQuery::Plane) {
+    if (insertionOptions.query.height_query !=
+        TInsertionOptions::TQueryOptions::HeightQuery::Plane) {
         for (size_t i = 0; i < n; i++) out[i] = height(x_m[i], y_m[i]);  // one cell each
         return;
     }
@@ -96,7 +97,7 @@ void CMultiBinElevationMap::heights(const double* x_m, const double* y_m, size_t
         y = {std::min(y.lo, ly.lo), std::max(y.hi, ly.hi)};
     }
     const Eigen::Vector2d& o = m_impl->origin_m;
-    const bool reliefSigma = insertionOptions.relief_sigma;
+    const bool reliefSigma = insertionOptions.query.relief_sigma;
     std::vector<double> xs, ys;  // relative to the origin, as the grids' cells are
     std::vector<std::pair<double, double>> sorted;
     for (size_t b = 0; b < n; b += kChunk) {
@@ -123,7 +124,7 @@ void CMultiBinElevationMap::heights(const double* x_m, const double* y_m, size_t
             }
             double h = 0, s = 0;
             a = HeightAnswer{};
-            if (insertionOptions.dem_return_filled) a.source = filledQuery(xk_m, yk_m, h, s);
+            if (insertionOptions.query.dem_return_filled) a.source = filledQuery(xk_m, yk_m, h, s);
             if (a.known()) a.height_m = h, a.sigma_m = s;
         }
     }

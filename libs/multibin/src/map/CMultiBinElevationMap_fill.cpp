@@ -119,8 +119,9 @@ CMultiBinElevationMap::HeightSource CMultiBinElevationMap::getElevation(double x
                                                                         double& sigma_m,
                                                                         bool includeFilled) const {
     prepareForReading();
-    return elevationQuery(insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane,
-                          x_m, y_m, height_m, sigma_m, includeFilled);
+    return elevationQuery(
+        insertionOptions.query.height_query == TInsertionOptions::TQueryOptions::HeightQuery::Plane,
+        x_m, y_m, height_m, sigma_m, includeFilled);
 }
 
 CMultiBinElevationMap::HeightSource CMultiBinElevationMap::cellElevation(double x_m, double y_m,
@@ -170,9 +171,9 @@ CMultiBinElevationMap::HeightAnswer CMultiBinElevationMap::height(double x_m, do
     prepareForReading();
     HeightAnswer a;
     double h = 0, s = 0;
-    a.source =
-        elevationQuery(insertionOptions.height_query == TInsertionOptions::HeightQuery::Plane, x_m,
-                       y_m, h, s, insertionOptions.dem_return_filled);
+    a.source = elevationQuery(
+        insertionOptions.query.height_query == TInsertionOptions::TQueryOptions::HeightQuery::Plane,
+        x_m, y_m, h, s, insertionOptions.query.dem_return_filled);
     if (a.known()) a.height_m = h, a.sigma_m = s;
     return a;
 }

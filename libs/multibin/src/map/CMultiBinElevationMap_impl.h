@@ -59,6 +59,11 @@ struct CMultiBinElevationMap::Impl {
     std::shared_ptr<multibin::TileStoreFile> tileFile;
     size_t peakResidentBytes = 0;
     bool budgetWarned = false;
+    /** One edge of the window in the pose frame [m]: 0 x min, 1 x max, 2 y min, 3 y max. The
+     * caller holds `lock` (growth moves the window). */
+    double windowEdge_m(int edge) const {
+        return (edge < 2 ? origin_m.x() : origin_m.y()) + grid.lattice().area_m()[edge];
+    }
     /** Whether cell (ix, iy) of `grid` holds a bin, or with the dual grid the local grid's cell at
      * its centre does: a cell without is unknown, skipped without a surface query. */
     bool holdsBins(int ix, int iy, bool dual) const {

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "multibin/geometry/PosePropagation.h"
+#include "multibin/grid/PointsPerCell.h"
 #include "multibin/grid/VisibilityConstraint.h"
 #include "multibin/sensors/DepthModel.h"
 #include "multibin/sensors/SensorDispatch.h"
@@ -260,18 +261,11 @@ bool CMultiBinElevationMap::insertWithPosePdf(const mrpt::obs::CObservation& obs
         multibin::BinGrid& grid = gridFor(obs);
         size_t ownGateRejected = 0;
         if (sensed.depthFrameError) {
-            ownGateRejected = multibin::sensors::addFrameSharedCovariance(
-                mapPoints, sensor_m, insertionOptions.sensors.depth,
-                [&](const PointsWithCov& pts, std::vector<Eigen::Vector2i>& cells,
-                    std::vector<uint8_t>& failsOwnGate) {
-                    for (size_t i = 0; i < pts.size(); i++) {
-                        const PointWithCov& p = pts[i];
-                        cells[i] = {grid.cellIndex(p.point_m.x()), grid.cellIndex(p.point_m.y())};
-                        // What the grid would count as too uncertain (inside the window or not).
-                        failsOwnGate[i] = p.point_m.allFinite() && std::isfinite(p.cov_m2.zz) &&
-                                          !params.passesEq13(p.cov_m2.zz);
-                    }
-                });
+            // The gate is each point's own variance's; the frame's shared error comes after.
+            ownGateRejected = multibin::removeFailingOwnGate(mapPoints, params);
+            multibin::sensors::addFrameSharedCovariance(mapPoints, sensor_m,
+                                                        insertionOptions.sensors.depth,
+                                                        multibin::pointsPerCell(grid, mapPoints));
         }
         return insertIntoGrid(
                    grid, params,

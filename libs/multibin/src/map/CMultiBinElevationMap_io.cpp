@@ -392,7 +392,7 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     // hold data, not the window.
     const multibin::fill::FilledCells& f = m_impl->filled;
     const multibin::CellWindow& fw = m_impl->fillWindow;
-    const bool withFill = insertionOptions.dem_return_filled;
+    const bool withFill = insertionOptions.query.dem_return_filled;
     // The filled cells' tile of the store tile being read, found once per tile (not per cell).
     const multibin::fill::FilledCell* filledTile = nullptr;
     const auto mayBeKnown = [&](int ix, int iy) {
@@ -413,7 +413,7 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
         double h, s;
         const HeightSource src =
             cellElevation(o.x() + grid.cellCenter_m(ix), o.y() + grid.cellCenter_m(iy), h, s,
-                          insertionOptions.dem_return_filled);
+                          insertionOptions.query.dem_return_filled);
         if (src == HeightSource::Unknown) return;
         for (size_t k = 0; k < layers.size(); k++) {
             float& v = out[k].heights_m(iy - w.iy0, ix - w.ix0);
@@ -477,7 +477,7 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
                 m_impl->grid.cellIndex(l.cellCenter_m(iy)));
         });
     }
-    if (insertionOptions.dem_return_filled)  // the filled cells, tile by tile
+    if (insertionOptions.query.dem_return_filled)  // the filled cells, tile by tile
         m_impl->filled.forEachFilled(
             [&](int ix, int iy, const multibin::fill::FilledCell&) { add(ix, iy); });
     std::vector<multibin::CellWindow> tiles;
@@ -518,7 +518,7 @@ void CMultiBinElevationMap::getAsImage(mrpt::img::CImage& img, bool sigma) const
             const float v = g.heights_m(r, c);
             if (std::isnan(v)) continue;
             float R, G, B;
-            mrpt::img::colormap(insertionOptions.colormap, (v - lo) / span, R, G, B);
+            mrpt::img::colormap(insertionOptions.render.colormap, (v - lo) / span, R, G, B);
             img.setPixel(c, rows - 1 - r,
                          mrpt::img::TColor(uint8_t(255 * R), uint8_t(255 * G), uint8_t(255 * B)));
         }

@@ -118,7 +118,7 @@ void visitCreationKeys(Options& o, Visit&& visit) {
     visit("tile_store_dir", o.tile_store_dir);
 }
 
-using HeightQuery = CMultiBinElevationMap::TInsertionOptions::HeightQuery;
+using HeightQuery = CMultiBinElevationMap::TInsertionOptions::TQueryOptions::HeightQuery;
 const OptionNames<HeightQuery> kHeightQueries{{"plane", HeightQuery::Plane},
                                               {"nearest", HeightQuery::Nearest}};
 
@@ -140,11 +140,11 @@ void visitInsertionKeys(Options& o, Visit&& visit) {
     visit({"max_range_m", "max_range"}, o.max_range_m, positive("m"));
     visit("sensor_labels", o.sensor_labels);
     visit("global_sensor_labels", o.global_sensor_labels);
-    visit("colormap", o.colormap, kColormaps);
-    visit("color_by_sigma", o.color_by_sigma);
-    visit("dem_return_filled", o.dem_return_filled);
-    visit("relief_sigma", o.relief_sigma);
-    visit("height_query", o.height_query, kHeightQueries);
+    visit("colormap", o.render.colormap, kColormaps);
+    visit("color_by_sigma", o.render.color_by_sigma);
+    visit("dem_return_filled", o.query.dem_return_filled);
+    visit("relief_sigma", o.query.relief_sigma);
+    visit("height_query", o.query.height_query, kHeightQueries);
     visit("insertion_threads", o.insertion_threads, between(1, 2));
 }
 

@@ -25,7 +25,7 @@ bool CMultiBinElevationMap::surfaceQuery(bool subCell, double x_m, double y_m, d
     const auto estimate = subCell ? multibin::heightAt : multibin::surfaceAt;
     multibin::CellSurface c;
     if (!estimate(m_impl->grid, isDualGrid() ? &m_impl->local : nullptr, x_m - o.x(), y_m - o.y(),
-                  binUpdateParams(), insertionOptions.relief_sigma, c))
+                  binUpdateParams(), insertionOptions.query.relief_sigma, c))
         return false;
     height_m = c.height_m;
     sigma_m = std::sqrt(sharedPosePart ? c.reportedVariance_m2() : c.variance_m2);
@@ -44,28 +44,19 @@ bool CMultiBinElevationMap::cellHeight(double x_m, double y_m, double& height_m,
     return surfaceQuery(false, x_m, y_m, height_m, sigma_m);
 }
 
-// The caller holds the map's lock (asString() takes it once, not again per edge).
-double CMultiBinElevationMap::windowEdge_m(int edge) const {
-    const double origin_m = edge < 2 ? m_impl->origin_m.x() : m_impl->origin_m.y();
-    return origin_m + m_impl->grid.lattice().area_m()[edge];
+namespace {
+// Under the lock: growth moves the window. (A template: Impl is the map's private type.)
+template <class Impl>
+double lockedWindowEdge_m(Impl& impl, int edge) {
+    const multibin::MapLock::Shared lock(impl.lock);
+    return impl.windowEdge_m(edge);
 }
-// Under the lock: growth moves the window.
-double CMultiBinElevationMap::getXMin() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    return windowEdge_m(0);
-}
-double CMultiBinElevationMap::getXMax() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    return windowEdge_m(1);
-}
-double CMultiBinElevationMap::getYMin() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    return windowEdge_m(2);
-}
-double CMultiBinElevationMap::getYMax() const {
-    const multibin::MapLock::Shared lock(m_impl->lock);
-    return windowEdge_m(3);
-}
+}  // namespace
+
+double CMultiBinElevationMap::getXMin() const { return lockedWindowEdge_m(*m_impl, 0); }
+double CMultiBinElevationMap::getXMax() const { return lockedWindowEdge_m(*m_impl, 1); }
+double CMultiBinElevationMap::getYMin() const { return lockedWindowEdge_m(*m_impl, 2); }
+double CMultiBinElevationMap::getYMax() const { return lockedWindowEdge_m(*m_impl, 3); }
 
 double CMultiBinElevationMap::dem_get_resolution() const { return m_impl->grid.cellSize_m(); }
 size_t CMultiBinElevationMap::dem_get_size_x() const { return size_t(m_impl->grid.window().nx); }

@@ -64,18 +64,7 @@ SceneColouring sceneColouringFromName(const std::string& name) {
                                 "' (known: height, sigma, certainty, source)");
 }
 
-const char* sceneColouringName(SceneColouring c) {
-    switch (c) {
-        case SceneColouring::Sigma:
-            return "sigma";
-        case SceneColouring::Certainty:
-            return "certainty";
-        case SceneColouring::Source:
-            return "source";
-        default:
-            return "height";
-    }
-}
+const char* sceneColouringName(SceneColouring c) { return mapLayerName(layerOf(c)); }
 
 namespace {
 
@@ -428,7 +417,8 @@ void CMultiBinElevationMap::getVisualizationInto(mrpt::opengl::CSetOfObjects& ou
     const multibin::MapLock::Shared lock(m_impl->lock);
     if (!genericMapParams.enableSaveAs3DObject) return;
     multibin::buildTerrainView(*this,
-                               insertionOptions.color_by_sigma ? multibin::SceneColouring::Sigma
-                                                               : multibin::SceneColouring::Height,
+                               insertionOptions.render.color_by_sigma
+                                   ? multibin::SceneColouring::Sigma
+                                   : multibin::SceneColouring::Height,
                                outObj);
 }

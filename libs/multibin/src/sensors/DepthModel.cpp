@@ -9,7 +9,6 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -162,46 +161,14 @@ void frameSharedTerms(const DepthModelOptions& opts, const double* xs, const dou
 }
 }  // namespace
 
-size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
-                                const DepthModelOptions& opts, const CellsAndGate& cellsAndGate) {
-    const size_t before = mapPoints.size();
-    std::vector<Eigen::Vector2i> cell(before);
-    std::vector<uint8_t> failsOwnGate(before);
-    cellsAndGate(mapPoints, cell, failsOwnGate);
-    // The points that fail their own gate leave, with their cells.
-    size_t n = 0;
-    for (size_t i = 0; i < before; i++) {
-        if (failsOwnGate[i]) continue;
-        mapPoints[n] = mapPoints[i];
-        cell[n++] = cell[i];
-    }
-    mapPoints.resize(n);
-    cell.resize(n);
-    if (n == 0) return before;
-    // Counting pass, then the covariance pass: scratch arrays, no allocation per point. The
-    // counts live in a dense array over the frame's cells, or a hash map if that is too large.
-    Eigen::Vector2i lo = Eigen::Vector2i::Constant(std::numeric_limits<int>::max()), hi = -lo;
-    for (size_t i = 0; i < n; i++) {
-        lo = lo.cwiseMin(cell[i]);
-        hi = hi.cwiseMax(cell[i]);
-    }
-    const int64_t nx = int64_t(hi.x()) - lo.x() + 1, ny = int64_t(hi.y()) - lo.y() + 1;
-    std::vector<uint32_t> perPoint(n);
-    if (nx * ny <= int64_t(4 * n + (1 << 20))) {
-        std::vector<uint32_t> dense(size_t(nx * ny), 0);
-        auto at = [&](const Eigen::Vector2i& c) -> uint32_t& {
-            return dense[size_t((int64_t(c.y()) - lo.y()) * nx + (int64_t(c.x()) - lo.x()))];
-        };
-        for (size_t i = 0; i < n; i++) at(cell[i])++;
-        for (size_t i = 0; i < n; i++) perPoint[i] = at(cell[i]);
-    } else {
-        std::unordered_map<int64_t, uint32_t> sparse;
-        auto key = [](const Eigen::Vector2i& c) {
-            return (int64_t(c.x()) << 32) ^ uint32_t(c.y());
-        };
-        for (size_t i = 0; i < n; i++) sparse[key(cell[i])]++;
-        for (size_t i = 0; i < n; i++) perPoint[i] = sparse[key(cell[i])];
-    }
+void addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
+                              const DepthModelOptions& opts,
+                              const std::vector<uint32_t>& pointsInCell) {
+    if (pointsInCell.size() != mapPoints.size())
+        throw std::invalid_argument(
+            "addFrameSharedCovariance: " + std::to_string(pointsInCell.size()) +
+            " cell counts for " + std::to_string(mapPoints.size()) + " points");
+    const size_t n = mapPoints.size();
     // The covariance pass, a block at a time: the terms in arrays (vectorised), then added.
     alignas(64) double x[kBlock], y[kBlock], z[kBlock], term[6][kBlock];
     alignas(64) uint8_t hasDirection[kBlock];
@@ -213,7 +180,7 @@ size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d&
             y[i] -= sensor_m.y();
             z[i] -= sensor_m.z();
         }
-        frameSharedTerms(opts, x, y, z, perPoint.data() + begin, m, term, hasDirection);
+        frameSharedTerms(opts, x, y, z, pointsInCell.data() + begin, m, term, hasDirection);
         for (size_t i = 0; i < m; i++) {
             if (!hasDirection[i]) continue;  // the map counts it as it is
             SymmetricCov3& c = mapPoints[begin + i].cov_m2;
@@ -225,7 +192,6 @@ size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d&
             c.zz += float(term[5][i]);
         }
     }
-    return before - n;
 }
 
 }  // namespace multibin::sensors

@@ -38,6 +38,9 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("step_roughness_gain", o.step_roughness_gain, finite());
     visit("step_slope_gain", o.step_slope_gain, finite("m"));
 }
+
+/** visitKeys as one callable, for readOptionKeys() and loadOptionKeys(). */
+const auto kKeys = [](auto& o, auto&& visit) { visitKeys(o, visit); };
 }  // namespace
 
 TraversabilityOptions TraversabilityOptions::uncalibrated() const {
@@ -51,15 +54,10 @@ double TraversabilityOptions::reach_m() const {
     return std::max(radius_m, foot_radius_m + foothold_clearance_m);
 }
 
-void TraversabilityOptions::read(StrictConfigSection& s) {
-    visitKeys(*this, OptionReader{s});
-    validateAsReadFrom(s, *this);
-}
-
+void TraversabilityOptions::read(StrictConfigSection& s) { readOptionKeys(s, *this, kKeys); }
 void TraversabilityOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& source,
                                                const std::string& section) {
-    loadStrictly(source, section, *this,
-                 [&](StrictConfigSection& s) { visitKeys(*this, OptionReader{s}); });
+    loadOptionKeys(source, section, *this, kKeys);
 }
 
 void TraversabilityOptions::write(mrpt::config::CConfigFileBase& c,

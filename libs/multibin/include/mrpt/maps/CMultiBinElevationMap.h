@@ -191,26 +191,33 @@ public:
         multibin::VisibilityParams visibility;
         /** Sensor models: laser, stereo, depth camera (keys `laser_*`, `stereo_*`, `depth_*`). */
         multibin::sensors::SensorModelOptions sensors;
-        mrpt::img::TColormap colormap = mrpt::img::cmJET;  //!< getAsImage() only
-        bool color_by_sigma = false;  //!< 3D view coloured by sigma instead of height
         /** Gap filling (keys `fill_*`, see multibin::fill::FillOptions); it runs lazily in
          * dem_update_map(). */
         multibin::fill::FillOptions fill;
-        /** DEM queries (dem_get_z, dem_get_z_by_cell) and rasters also return filled heights
-         * (key `dem_return_filled`). MRPT documents dem_get_z as false for unobserved cells; set
-         * false for that behaviour. */
-        bool dem_return_filled = true;
-        /** The reported sigma of a cell includes its relief (key `relief_sigma`): (g s)^2 / 12
-         * with g the local slope from the neighbours and s the cell size (the cell's one height
-         * stands for a sloped patch), plus the certainty-weighted spread of the cell's other
-         * certain bins around the reported height (a cell holding a step holds surfaces at
-         * several heights). Off: the bins' Kalman sigma alone (the paper's). */
-        bool relief_sigma = true;
-        /** What getHeight(), dem_get_z() (and so intersectLine3D()) answer at a point (key
-         * `height_query`): `plane` (default) the sub-cell surface of heightAt(); `nearest` the
-         * value of the cell containing the point (cellHeight(), the answer before the sub-cell
-         * surface). Rasters and gap filling always use the cell values. */
-        enum class HeightQuery { Plane, Nearest } height_query = HeightQuery::Plane;
+        /** What the height queries answer (keys `dem_return_filled`, `relief_sigma`,
+         * `height_query`, in this section). */
+        struct TQueryOptions {
+            /** DEM queries (dem_get_z, dem_get_z_by_cell) and rasters also return filled heights
+             * (key `dem_return_filled`). MRPT documents dem_get_z as false for unobserved cells;
+             * set false for that behaviour. */
+            bool dem_return_filled = true;
+            /** The reported sigma of a cell includes its relief (key `relief_sigma`): (g s)^2 / 12
+             * with g the local slope from the neighbours and s the cell size (the cell's one height
+             * stands for a sloped patch), plus the certainty-weighted spread of the cell's other
+             * certain bins around the reported height (a cell holding a step holds surfaces at
+             * several heights). Off: the bins' Kalman sigma alone (the paper's). */
+            bool relief_sigma = true;
+            /** What getHeight(), dem_get_z() (and so intersectLine3D()) answer at a point (key
+             * `height_query`): `plane` (default) the sub-cell surface of heightAt(); `nearest` the
+             * value of the cell containing the point (cellHeight(), the answer before the sub-cell
+             * surface). Rasters and gap filling always use the cell values. */
+            enum class HeightQuery { Plane, Nearest } height_query = HeightQuery::Plane;
+        } query;
+        /** How the map is drawn (keys `colormap`, `color_by_sigma`, in this section). */
+        struct TRenderOptions {
+            mrpt::img::TColormap colormap = mrpt::img::cmJET;  //!< getAsImage() only
+            bool color_by_sigma = false;  //!< 3D view coloured by sigma instead of height
+        } render;
         /** Threads of the insertion (key `insertion_threads`, 1 or 2): with 2, a large
          * observation (a lidar revolution, a stereo or depth frame: 4 096 points or more) is
          * propagated and classified on a helper thread while the calling thread updates the
@@ -361,7 +368,7 @@ public:
         Source      //!< HeightSource as a number: 1 measured, 2 median-filled, 3 surface-filled
     };
     /** One layer over the grid window as a raster, NaN where unknown; row 0 is the southernmost
-     * row. Filled cells are included when insertionOptions.dem_return_filled is set. */
+     * row. Filled cells are included when insertionOptions.query.dem_return_filled is set. */
     multibin::EsriAsciiGrid toRaster(RasterLayer layer = RasterLayer::Height) const;
     /** The layer over any window of cells (cell indices of grid(): multibin/geometry/Lattice.h),
      * NaN where unknown: a large map's outputs read it tile by tile (occupiedTiles()). */
@@ -373,9 +380,9 @@ public:
      * multibin/io/TiledRaster.h) that may hold a known cell (a bin of either grid, or a filled
      * cell), row by row from the south: where the data is, whatever the window's extent. */
     std::vector<multibin::CellWindow> occupiedTiles(int tileCells = 256) const;
-    /** Colour image of the heights (or sigmas) with insertionOptions.colormap, north up; black
-     * where unknown. One pixel per cell of the window; a window longer than 4096 cells is drawn
-     * one pixel per k x k block of cells (their mean), k the smallest that fits 4096. */
+    /** Colour image of the heights (or sigmas) with insertionOptions.render.colormap, north up;
+     * black where unknown. One pixel per cell of the window; a window longer than 4096 cells is
+     * drawn one pixel per k x k block of cells (their mean), k the smallest that fits 4096. */
     void getAsImage(mrpt::img::CImage& img, bool sigma = false) const;
     /** @name Traversability (multibin/traversability/TerrainFeatures.h, doc/traversability.md)
      * @{ */
@@ -488,9 +495,6 @@ private:
         const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const override;
     bool internal_canComputeObservationLikelihood(
         const mrpt::obs::CObservation& obs) const override;
-
-    /** One edge of the window in the pose frame [m]: 0 x min, 1 x max, 2 y min, 3 y max. */
-    double windowEdge_m(int edge) const;
 
     /** heightAt() (subCell) or cellHeight(): the map's surface at (x, y) in the pose frame;
      * sigma without the pose part the points share if not `sharedPosePart` (the gap filling's

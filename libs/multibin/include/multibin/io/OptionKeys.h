@@ -285,6 +285,19 @@ void loadStrictly(const mrpt::config::CConfigFileBase& source, const std::string
     s.finish();
     validateAsReadFrom(s, options);
 }
+/** An options struct's read(section) and loadFromConfigFile(), given its key list as a callable
+ * `keys(options, visitor)` (its visitKeys). */
+template <class Options, class Keys>
+void readOptionKeys(StrictConfigSection& section, Options& options, Keys&& keys) {
+    keys(options, OptionReader{section});
+    validateAsReadFrom(section, options);
+}
+template <class Options, class Keys>
+void loadOptionKeys(const mrpt::config::CConfigFileBase& source, const std::string& section,
+                    Options& options, Keys&& keys) {
+    loadStrictly(source, section, options,
+                 [&](StrictConfigSection& s) { keys(options, OptionReader{s}); });
+}
 /** @} */
 
 }  // namespace multibin

@@ -5,7 +5,6 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "multibin/geometry/PointsWithCovariance.h"
@@ -22,13 +21,6 @@ void depthScanToPoints(const mrpt::obs::CObservation3DRangeScan& scan,
                        const DepthModelOptions& opts, double minRange_m, double maxRange_m,
                        PointsWithCov& out, DepthStats& stats);
 
-/** What addFrameSharedCovariance() needs of the map, for all points at once: each point's cell
- * (the grid's indices) and whether the grid's eq 13 gate, applied to the point's own variance,
- * would refuse it (finite, inside the window, too uncertain). */
-using CellsAndGate =
-    std::function<void(const PointsWithCov& mapPoints, std::vector<Eigen::Vector2i>& cells,
-                       std::vector<uint8_t>& failsOwnGate)>;
-
 /** The error the points of one depth frame share (DepthModelOptions::frameSigma_m()), in the map
  * frame: n points of a frame in one cell that share an error of sd s carry the information of
  * variance sigma^2 / n + s^2, not sigma^2 / n. Each point gets n s(r)^2 v v^T added to its
@@ -37,9 +29,12 @@ using CellsAndGate =
  * back sigma^2 / n + s^2 only if each bin carries the cell's n), v its unit ray from `sensor_m`
  * and r its range: for equal sigmas the cell's fused variance is exactly sigma^2 / n + s^2 and
  * its weighted mean is unchanged; across frames the shared errors are independent, so more
- * frames still shrink it. The eq 13 gate is a point's own: the points `cellsAndGate` marks are
- * removed first and their number returned (the caller fuses the rest without the gate). */
-size_t addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
-                                const DepthModelOptions& opts, const CellsAndGate& cellsAndGate);
+ * frames still shrink it. `pointsInCell[i]`: n for point i (the grid's pointsPerCell()). The eq
+ * 13 gate is a point's own: the insertion removes the points failing it first
+ * (removeFailingOwnGate()) and fuses the rest with the gate off. Throws std::invalid_argument if
+ * the counts are not one per point. */
+void addFrameSharedCovariance(PointsWithCov& mapPoints, const Eigen::Vector3d& sensor_m,
+                              const DepthModelOptions& opts,
+                              const std::vector<uint32_t>& pointsInCell);
 
 }  // namespace multibin::sensors
