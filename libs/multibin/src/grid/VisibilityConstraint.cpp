@@ -7,8 +7,14 @@
 
 #include "multibin/grid/VisibilityStages.h"
 #include "multibin/io/OptionKeys.h"
+#include "multibin/util/Counters.h"
 
 namespace multibin {
+
+VisibilityStats& VisibilityStats::operator+=(const VisibilityStats& o) {
+    return util::addMembers(*this, o, &VisibilityStats::raysCast, &VisibilityStats::cellsVisited,
+                            &VisibilityStats::binsRemoved, &VisibilityStats::binsWeakened);
+}
 
 namespace {
 /** The most cells a line of sight is followed for the clearance [cells]. */

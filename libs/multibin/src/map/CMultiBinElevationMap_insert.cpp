@@ -388,13 +388,9 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
         const multibin::fill::FillOptions& fill = insertionOptions.fill;
         if (insertionOptions.visibility.enabled && fill.enabled && fill.clearance)
             multibin::noteClearances(grid, *sensorOrigin_m, multibin::kClearanceRise_m);
-        const multibin::VisibilityStats v = multibin::applyVisibilityConstraint(
+        m_impl->visibilityStats += multibin::applyVisibilityConstraint(
             grid, *sensorOrigin_m, insertionOptions.visibility, params,
             cameraFrame ? multibin::RayFan::Skip : multibin::RayFan::Test);
-        m_impl->visibilityStats.raysCast += v.raysCast;
-        m_impl->visibilityStats.cellsVisited += v.cellsVisited;
-        m_impl->visibilityStats.binsRemoved += v.binsRemoved;
-        m_impl->visibilityStats.binsWeakened += v.binsWeakened;
         keepWithinMemoryBudget(*sensorOrigin_m);
     }
     return s;

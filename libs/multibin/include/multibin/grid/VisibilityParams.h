@@ -46,6 +46,7 @@ struct VisibilityStats {
     size_t cellsVisited = 0;  //!< cells tested along the rays
     size_t binsRemoved = 0;   //!< stale bins removed
     size_t binsWeakened = 0;  //!< conflicting bins that lost certainty
+    VisibilityStats& operator+=(const VisibilityStats& o);  //!< saturating, as InsertStats
 };
 
 }  // namespace multibin
