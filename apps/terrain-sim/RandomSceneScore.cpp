@@ -145,22 +145,22 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, Maps& witho
                  RandomSceneScores& s) {
     const int last = sc.passes.back().placement;
     Rms dem, mrptMean, noObject, seenAfter;
-    // The last pass each placement was seen in: a cell of it is seen again if a later pass put a
-    // point in it.
-    std::vector<size_t> lastPassAt(sc.placements.size(), 0);
-    for (size_t p = 0; p < sc.passes.size(); ++p)
-        if (sc.passes[p].placement >= 0) lastPassAt[sc.passes[p].placement] = p;
     double worst = 0;
     for (int r = 0; r < reg.gt.rows(); ++r)
         for (int k = 0; k < reg.gt.cols(); ++k) {
-            bool vacated = false, seenAgain = false;
-            for (int v : sc.vacatedPlacements()) {
-                if (!reg.grown[v](r, k)) continue;
-                vacated = true;
-                for (size_t p = lastPassAt[v] + 1; p < m.hitInPass.size(); ++p)
-                    seenAgain = seenAgain || m.hitInPass[p](r, k);
-            }
+            bool vacated = false;
+            for (int v : sc.vacatedPlacements()) vacated = vacated || reg.grown[v](r, k);
             if (!vacated || (last >= 0 && reg.grown[last](r, k))) continue;
+            // Seen again: a pass after the last one in which the object stood on the cell (any
+            // placement's footprint + 1 cell) put a point in it. A point of a pass in which the
+            // object stood there again (moved within reach of its old place) is the object's.
+            size_t after = 0;
+            for (size_t p = 0; p < sc.passes.size(); ++p)
+                if (sc.passes[p].placement >= 0 && reg.grown[sc.passes[p].placement](r, k))
+                    after = p + 1;
+            bool seenAgain = false;
+            for (size_t p = after; p < m.hitInPass.size(); ++p)
+                seenAgain = seenAgain || m.hitInPass[p](r, k);
             const double x = reg.gt.xllcenter_m + k * reg.gt.cellsize_m;
             const double y = reg.gt.yllcenter_m + r * reg.gt.cellsize_m;
             const double truth = reg.gt.heights_m(r, k);
@@ -176,8 +176,8 @@ void scoreObject(const RandomScene& sc, const Regions& reg, Maps& m, Maps& witho
             if (without.map.dem_get_z(x, y, z0)) noObject.add(z0 - truth);
             worst = std::max(worst, std::abs(z - truth));
             const auto kind = cellKind(m.map, x, y, truth);
-            s.objectSquaredError_m2[kind] += (z - truth) * (z - truth);
-            s.objectCellsOfKind[kind]++;
+            s.objectSquaredError_m2[kind][seenAgain] += (z - truth) * (z - truth);
+            s.objectCellsOfKind[kind][seenAgain]++;
             const auto* c = m.mrptMean->cellByPos(x, y);
             if (c && c->w > 0) mrptMean.add(c->h - truth);
         }

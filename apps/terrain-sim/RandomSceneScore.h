@@ -23,17 +23,20 @@ struct RandomSceneScores {
     double objectRmse_m = kNaN, objectMrptRmse_m = kNaN;
     /** The same cells in the map of the scene with the object never there: the floor [m]. */
     double objectNoObjectRmse_m = kNaN;
-    /** The same over the cells a pass after the object left put a laser point in (the others
-     * no observation could correct) [m], and their number. */
+    /** The same over the cells a pass after the last one in which the object stood on them
+     * (footprint + 1 cell) put a laser point in (the others no observation could correct) [m],
+     * and their number. */
     double objectSeenAgainRmse_m = kNaN;
     size_t objectSeenAgainCells = 0;
     size_t objectCells = 0, objectUnknown = 0;
     double objectWorstError_m = kNaN;  //!< largest |DEM - ground| over those cells [m]
     /** What those cells hold at the end (a bin "at the ground" lies within 30 mm of the truth),
-     * and the squared error [m^2] summed over each kind: why the object's place is wrong. */
+     * and the squared error [m^2] summed over each kind, [kind][1] over the cells seen again
+     * (objectSeenAgainRmse_m), [kind][0] over the others: why the object's place is wrong, and
+     * whether any later observation could have told. */
     enum CellKind { StaleWinsBesideGround, OnlyStale, NoBin, GroundWins, kCellKinds };
-    double objectSquaredError_m2[kCellKinds] = {0, 0, 0, 0};
-    size_t objectCellsOfKind[kCellKinds] = {0, 0, 0, 0};
+    double objectSquaredError_m2[kCellKinds][2] = {};
+    size_t objectCellsOfKind[kCellKinds][2] = {};
     /** Static terrain (every measured cell away from the object's placements), the map with the
      * object and the same scene mapped with the object never there, on the cells both measured. */
     double staticRmse_m = kNaN, staticRmseNoObject_m = kNaN;
