@@ -2,7 +2,7 @@
 # run_sanitizer_tests ROOT BUILD_DIR JOBS [CTEST_ARG...]: the test selection and the sanitizer
 # options of the ASan + UBSan stages, shared by scripts/sanitize.sh (clang) and
 # scripts/sanitize-gcc.sh (gcc). Every report is fatal; LeakSanitizer is on with the
-# suppressions of tests/reliability/lsan.supp.
+# suppressions of tests/common/lsan.supp.
 #
 # Left out of the run:
 # - label slow: minutes even without sanitizers (the Release stage skips them too);
@@ -22,7 +22,7 @@ run_sanitizer_tests() {
   shift 3
   export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1}
   export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-  export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/tests/reliability/lsan.supp:print_suppressions=0}
+  export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$root/tests/common/lsan.supp:print_suppressions=0}
   # Longest first: the Release stage's test times (when this stage follows it) order the tests,
   # so a long one does not start last and leave one core idle at the end.
   local release_costs=${MULTIBIN_BUILD_DIR:-$root/build}/Testing/Temporary/CTestCostData.txt

@@ -14,7 +14,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "../core/test_files.h"
+#include "../common/test_files.h"
 
 namespace mapper_run {
 

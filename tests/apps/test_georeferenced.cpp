@@ -386,13 +386,13 @@ TEST(Georeferenced, ASavedMapKeepsItsOrigin) {
     EXPECT_EQ(emptyLoaded.mapOrigin().x, -2999000.0);
 }
 
-// tests/core/data/map_v2_358b5a2.bin: a map saved by the library before it had an origin (commit
+// tests/map/data/map_v2_358b5a2.bin: a map saved by the library before it had an origin (commit
 // 358b5a2; serialization version 2, options text without the origin keys): a 4 m x 4 m fixed
 // extent at x in [1200, 1204] m with heights 0.25 m at (1201.01, 0.51) and 0.75 m at
 // (1203.33, -1.27). Its cells are relative to (0, 0), not to the kilometre its extent would pick
 // today.
 TEST(Georeferenced, AMapSavedBeforeOriginsExistedLoadsAtOriginZero) {
-    mrpt::io::CFileInputStream f(kSource + "/tests/core/data/map_v2_358b5a2.bin");
+    mrpt::io::CFileInputStream f(kSource + "/tests/map/data/map_v2_358b5a2.bin");
     auto arch = mrpt::serialization::archiveFrom(f);
     Map map;
     arch >> map;

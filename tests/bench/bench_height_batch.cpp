@@ -16,7 +16,7 @@
 #include <random>
 #include <vector>
 
-#include "../core/mockup_map.h"
+#include "../common/mockup_map.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 

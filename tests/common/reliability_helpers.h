@@ -3,6 +3,7 @@
 #pragma once
 
 #include <mrpt/core/bits_math.h>
+#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
@@ -17,11 +18,11 @@
 #include <tuple>
 #include <vector>
 
-#include "../core/test_files.h"
-#include "../core/test_scenes.h"
 #include "multibin/grid/BinGrid.h"
 #include "multibin/map/MapInternals.h"
 #include "multibin/sensors/StereoDisparity.h"
+#include "test_files.h"
+#include "test_scenes.h"
 
 #if defined(__has_feature)
 #if __has_feature(address_sanitizer)
@@ -48,6 +49,15 @@ inline std::filesystem::path scratchDir(const std::string& name) {
 }
 
 using test_files::readAll;
+
+/** The shipped file's bytes, gz-decompressed if it is gz (rawlogs and simplemaps may be either). */
+inline std::string plainBytes(const std::filesystem::path& p) {
+    mrpt::io::CFileGZInputStream in(p.string());
+    std::string out;
+    char buf[65536];
+    for (size_t n; (n = in.Read(buf, sizeof buf)) > 0;) out.append(buf, n);
+    return out;
+}
 
 using Map = mrpt::maps::CMultiBinElevationMap;
 

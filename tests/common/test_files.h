@@ -1,4 +1,4 @@
-/* Files of tests: scratch folders under the build tree and whole-file reads. */
+/* Files of tests: scratch folders under the build tree, whole-file reads and writes. */
 #pragma once
 
 #include <filesystem>
@@ -20,6 +20,12 @@ inline std::filesystem::path scratchDir(const std::string& group, const std::str
 inline std::string readAll(const std::filesystem::path& p) {
     std::ifstream f(p, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+/** Writes `bytes` as the whole file `p`. */
+inline void writeAll(const std::filesystem::path& p, const std::string& bytes) {
+    std::ofstream f(p, std::ios::binary);
+    f << bytes;
 }
 
 }  // namespace test_files

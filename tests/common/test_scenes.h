@@ -1,14 +1,28 @@
-/* Synthetic observations shared by the core tests. */
+/* Synthetic observations and pose PDFs shared by the tests of several folders. */
 #pragma once
 
 #include <mrpt/core/bits_math.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/poses/CPose3D.h>
+#include <mrpt/poses/CPose3DPDFGaussian.h>
 
+#include <array>
 #include <cmath>
 
 namespace test_scenes {
+
+/** A robot pose PDF: `sigmas` (x, y, z [m], yaw, pitch, roll [rad]) on the diagonal, and x
+ * correlated with pitch. */
+inline mrpt::poses::CPose3DPDFGaussian poseWithCov(const mrpt::poses::CPose3D& mean,
+                                                   const std::array<double, 6>& sigmas) {
+    mrpt::poses::CPose3DPDFGaussian pdf;
+    pdf.mean = mean;
+    pdf.cov.setZero();
+    for (int i = 0; i < 6; i++) pdf.cov(i, i) = sigmas[size_t(i)] * sigmas[size_t(i)];
+    pdf.cov(0, 4) = pdf.cov(4, 0) = 0.3 * sigmas[0] * sigmas[4];  // some correlation
+    return pdf;
+}
 
 /** A pitched 2D laser (240 deg, `beams` beams) seeing the plane z = 0 from `height_m`, like the
  * paper's URG-04LX (683 beams, 0.26 m, 45 deg). */

@@ -1,5 +1,5 @@
 /* Evaluation against ground truth: eq 17 (PI) on hand-computed cases, truth on the lattice,
- * raw map, report.json, and the map's exports. */
+ * raw map, report.json. */
 #include <gtest/gtest.h>
 #include <mrpt/containers/yaml.h>
 
@@ -132,20 +132,6 @@ TEST(Evaluation, ReportJsonHasTheDocumentedFields) {
     EXPECT_TRUE(doc["methods"]["raw_all"]["within_3sigma"].isNullNode());
     EXPECT_NEAR(doc["cell_size_m"].as<double>(), 0.02, 1e-12);
     EXPECT_EQ(doc["area_m"].asSequence().size(), 4u);
-}
-
-TEST(Exports, PlyMeshHasOneVertexPerKnownCellAndTwoTrianglesPerKnownQuad) {
-    multibin::EsriAsciiGrid g;
-    g.cellsize_m = 0.1;
-    g.heights_m.setConstant(3, 3, 0.5f);
-    g.heights_m(2, 2) = NAN;  // 8 vertices; quads: 3 full (6 triangles) + 1 with 3 known (1)
-    const auto path = std::filesystem::temp_directory_path() / "multibin_test_mesh.ply";
-    multibin::saveMeshPly(g, path.string());
-    std::ifstream f(path);
-    std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-    EXPECT_NE(text.find("element vertex 8\n"), std::string::npos);
-    EXPECT_NE(text.find("element face 7\n"), std::string::npos);
-    std::filesystem::remove(path);
 }
 
 TEST(Evaluation, AreaScoresCountOnlyTheCellsOfTheSubArea) {

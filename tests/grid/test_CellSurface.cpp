@@ -4,10 +4,10 @@
 
 #include <cmath>
 
+#include "../common/test_scenes.h"
 #include "multibin/grid/BinGrid.h"
 #include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/map/MapInternals.h"
-#include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <random>
 
+#include "../common/test_scenes.h"
 #include "SurfaceAccuracy.h"
 #include "multibin/grid/BinUpdate.h"
-#include "test_scenes.h"
 
 using mrpt::maps::CMultiBinElevationMap;
 

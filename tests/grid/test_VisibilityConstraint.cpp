@@ -7,7 +7,7 @@
 #include <limits>
 #include <random>
 
-#include "../core/test_scenes.h"
+#include "../common/test_scenes.h"
 #include "multibin/grid/CellSurface.h"
 #include "multibin/grid/VisibilityConstraint.h"
 #include "multibin/grid/VisibilityRule.h"

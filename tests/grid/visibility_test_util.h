@@ -1,5 +1,5 @@
-/* Helpers of the visibility constraint's tests (test_visibility.cpp, test_visibility_stages.cpp).
- */
+/* Helpers of the visibility constraint's tests (test_VisibilityConstraint.cpp,
+ * test_VisibilityStages.cpp). */
 #pragma once
 
 #include <array>

@@ -15,12 +15,12 @@
 #include <string>
 #include <tuple>
 
+#include "../common/reliability_helpers.h"
 #include "multibin/grid/BinGrid.h"
 #include "multibin/map/MapInternals.h"
 #include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorDispatch.h"
 #include "multibin/sensors/StereoDisparity.h"
-#include "reliability_helpers.h"
 
 using namespace reliability;
 

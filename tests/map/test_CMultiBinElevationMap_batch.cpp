@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "mockup_map.h"
+#include "../common/mockup_map.h"
 #include "multibin/grid/BinGrid.h"
 #include "multibin/grid/CellSurface.h"
 #include "multibin/map/MapInternals.h"

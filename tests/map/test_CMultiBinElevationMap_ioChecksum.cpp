@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "reliability_helpers.h"
+#include "../common/reliability_helpers.h"
 
 using namespace reliability;
 

@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "../common/reliability_helpers.h"
 #include "multibin/map/MapInternals.h"
-#include "reliability_helpers.h"
 
 using namespace reliability;
 

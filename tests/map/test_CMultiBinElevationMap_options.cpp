@@ -20,9 +20,9 @@
 #include <fstream>
 #include <limits>
 
+#include "../common/reliability_helpers.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/map/MapStatistics.h"
-#include "reliability_helpers.h"
 
 namespace fs = std::filesystem;
 using namespace reliability;

@@ -11,9 +11,9 @@
 #include <thread>
 #include <vector>
 
+#include "../common/reliability_helpers.h"
 #include "multibin/io/EsriAsciiGrid.h"
 #include "multibin/map/MapStatistics.h"
-#include "reliability_helpers.h"
 
 using namespace reliability;
 

@@ -27,7 +27,7 @@
 #include <limits>
 
 #include "../apps/mapper_run.h"
-#include "reliability_helpers.h"
+#include "../common/reliability_helpers.h"
 
 #ifdef ELEVATION_MAPPER_EXE
 namespace fs = std::filesystem;

@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "../apps/mapper_run.h"
+#include "../common/reliability_helpers.h"
 #include "multibin/io/OutputFile.h"
-#include "reliability_helpers.h"
 
 #ifdef ELEVATION_MAPPER_EXE
 namespace fs = std::filesystem;

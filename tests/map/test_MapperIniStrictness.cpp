@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "../apps/mapper_run.h"
+#include "../common/reliability_helpers.h"
 #include "multibin/io/ErrorMessage.h"
-#include "reliability_helpers.h"
 
 using namespace reliability;
 

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "test_scenes.h"
+#include "../common/test_scenes.h"
 
 namespace fs = std::filesystem;
 

@@ -2,7 +2,7 @@
  * with the library's default parameters, every pixel triangulated, the points averaged in MRPT's
  * CHeightGridMap2D (mrSimpleAverage) at the map's cell size. Both scored against the ground truth
  * of a terrain-sim scenario on the cells both hold. Used by tests/bench/compare_stereo_naive (the
- * table in doc/sensor-models.md) and by the CI guard in test_stereo_naive.cpp. */
+ * table in doc/sensor-models.md) and by the CI guard in test_StereoNaive.cpp. */
 #pragma once
 
 #include <mrpt/config/CConfigFile.h>

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "../common/reliability_helpers.h"
 #include "multibin/io/ErrorMessage.h"
-#include "reliability_helpers.h"
 
 using namespace reliability;
 

@@ -1,7 +1,7 @@
 /* MRPT's PlannerSimple2D on the map's occupancy grid against the same planner on the truth's grid
  * (same lattice, same planner settings): the one home of the comparison, used by the synthetic
- * test (test_planning.cpp) and by the scoring boards' check (traversability_planning.cpp,
- * scripts/evaluate-traversability.sh). */
+ * test (test_TraversabilityPlanning.cpp) and by the scoring boards' check
+ * (traversability_planning.cpp, scripts/evaluate-traversability.sh). */
 #pragma once
 
 #include <mrpt/maps/COccupancyGridMap2D.h>
