@@ -22,7 +22,7 @@
 // start-up allocate through them): never instrumented. They forward by a tail call, so that the
 // allocator sees their caller as its own: LeakSanitizer takes the dynamic loader's allocations
 // (dlopen's) for reachable only when the loader called malloc, and reported them as leaks when
-// a frame of this file stood between (a suppression in tests/reliability/lsan.supp hid them).
+// a frame of this file stood between (a suppression in tests/common/lsan.supp hid them).
 #if defined(__clang__)
 #define GUARD_FN __attribute__((no_sanitize("address", "undefined", "thread")))
 #define GUARD_TAIL [[clang::musttail]]

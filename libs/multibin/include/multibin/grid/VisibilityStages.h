@@ -1,7 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #pragma once
 /** The stages of the visibility constraint's fast path (applyVisibilityConstraint), each proven
- * against the rule (VisibilityRule.h) by its own test (tests/core/test_visibility_stages.cpp).
+ * against the rule (VisibilityRule.h) by its own test (tests/grid/test_VisibilityStages.cpp).
  * Internal: the library's and the tests' only. Each stage only rules out bins that cannot
  * conflict, from the grid's local height bounds (BinGrid::blockMaxHeight_m,
  * BinGrid::cellMaxHeight_m), so the bins edited are exactly the rule's:
