@@ -188,7 +188,7 @@ TEST(SparseGeoTiff, ALongDiagonalStripReadsBackWithOnlyItsTiles) {
     EXPECT_EQ(t.tileWidth, 256u);
     EXPECT_EQ(t.tileLength, 256u);
     EXPECT_EQ(t.compression, COMPRESSION_ADOBE_DEFLATE);
-    EXPECT_EQ(t.predictor, PREDICTOR_FLOATINGPOINT);
+    EXPECT_EQ(t.predictor, PREDICTOR_NONE);
     EXPECT_EQ(t.sampleFormat, SAMPLEFORMAT_IEEEFP);
     EXPECT_EQ(t.bits, 32);
     EXPECT_EQ(t.nodata, "nan");
