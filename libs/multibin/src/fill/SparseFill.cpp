@@ -60,6 +60,7 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
                                FillResult::Stats& s) {
     const CellWindow& w = in.lattice.window;
     TiledCells<int> label(kUnvisited);
+    label.reserve(in.cells.tileCount());  // the floods stay in the data's tiles, mostly
     Cursor<const TiledCells<MeasuredCell>, const MeasuredCell*> data(in.cells);
     Cursor<TiledCells<int>, int*> labels(label);
     auto measured = [&](int ix, int iy) {
@@ -93,7 +94,10 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
             const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
             for (const auto& p : nb) {
                 if (!w.contains(p[0], p[1]) || measured(p[0], p[1])) continue;
-                if (inEmptyWholeTile(p[0], p[1])) large = true;
+                if (inEmptyWholeTile(p[0], p[1])) {  // no label: its tile is not allocated
+                    large = true;
+                    continue;
+                }
                 int& l = labelOf(p[0], p[1]);
                 if (l == kLarge) large = true;  // part of a region already found too large
                 if (l != kUnvisited) continue;

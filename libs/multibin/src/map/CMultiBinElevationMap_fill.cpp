@@ -47,6 +47,7 @@ multibin::fill::SparseHeights CMultiBinElevationMap::fillInput() const {
                      x++)
                     tiles.emplace(y, x);
         });
+    in.cells.reserve(tiles.size());               // at most one input tile per tile read
     const Eigen::Vector2d& o = m_impl->origin_m;  // surfaceQuery() takes pose-frame coordinates
     const multibin::CellWindow& w = in.lattice.window;
     for (const auto& [ty, tx] : tiles) {
