@@ -78,7 +78,7 @@ struct ReadTiff {
         TIFFGetField(t, TIFFTAG_TILEWIDTH, &tileWidth);
         TIFFGetField(t, TIFFTAG_TILELENGTH, &tileLength);
         TIFFGetField(t, TIFFTAG_COMPRESSION, &compression);
-        TIFFGetField(t, TIFFTAG_PREDICTOR, &predictor);
+        TIFFGetFieldDefaulted(t, TIFFTAG_PREDICTOR, &predictor);  // absent: none (1)
         TIFFGetField(t, TIFFTAG_SAMPLEFORMAT, &sampleFormat);
         TIFFGetField(t, TIFFTAG_BITSPERSAMPLE, &bits);
         const char* text = nullptr;
