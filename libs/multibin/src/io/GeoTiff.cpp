@@ -53,9 +53,10 @@ void setTags(TIFF* tif, const TiledRaster& raster, const CellWindow& bounds,
     need(TIFFSetField(tif, TIFFTAG_TILEWIDTH, uint32_t(kGeoTiffTile)), "TileWidth");
     need(TIFFSetField(tif, TIFFTAG_TILELENGTH, uint32_t(kGeoTiffTile)), "TileLength");
     need(TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_ADOBE_DEFLATE), "Compression");
-    need(TIFFSetField(tif, TIFFTAG_PREDICTOR, PREDICTOR_FLOATINGPOINT), "Predictor");
-    // Deflate's fastest level: the tiles are mostly NaN (a route's thin strip), which any level
-    // packs to almost nothing, while level 6 (libtiff's default) takes most of the writing.
+    // No predictor, DEFLATE's fastest level: the tiles are mostly NaN (a route's thin strip),
+    // which DEFLATE alone packs to almost nothing, while the floating-point predictor (a byte
+    // shuffle and differences over every pixel) and level 6 (libtiff's default) took most of the
+    // writing (doc/results/2026-11-27-route-scale-outputs.md).
     need(TIFFSetField(tif, TIFFTAG_ZIPQUALITY, 1), "ZipQuality");
     need(TIFFSetField(tif, TIFFTAG_GDAL_NODATA, "nan"), "GDAL_NODATA");
     if (!options.description.empty())

@@ -39,16 +39,21 @@ std::vector<TiledRaster> tiledLayers(const CMultiBinElevationMap& map,
     struct LastWindow {
         CellWindow window;
         std::vector<EsriAsciiGrid> rasters;  // empty until the first read
+        std::vector<bool> taken;             // rasters[k] moved out to its caller
     };
     const auto last = std::make_shared<LastWindow>();
     std::vector<TiledRaster> out(layers.size(), t);
     for (size_t k = 0; k < layers.size(); k++)
         out[k].samples = [m = &map, layers, last, k](const CellWindow& w) {
-            if (last->rasters.empty() || !(last->window == w)) {
+            // Each layer's raster is handed over, not copied (a 256 x 256 tile is 256 kB): the
+            // callers ask every layer once per window; a second ask reads the map again.
+            if (last->rasters.empty() || !(last->window == w) || last->taken[k]) {
                 last->rasters = m->toRasters(layers, w);
                 last->window = w;
+                last->taken.assign(layers.size(), false);
             }
-            return last->rasters[k];
+            last->taken[k] = true;
+            return std::move(last->rasters[k]);
         };
     return out;
 }

@@ -75,6 +75,31 @@ struct CMultiBinElevationMap::Impl {
                              [&](const multibin::Bin&) { any = true; });
         return any;
     }
+    /** holdsBins() over the cells of one 64 x 64 tile of `grid`'s store: the tile is found once
+     * (a directory lookup), not per cell; with the dual grid, holdsBins() itself. */
+    class TileBins {
+    public:
+        TileBins(const Impl& impl, int tx, int ty, bool dual)
+            : m_impl(impl),
+              m_dual(dual),
+              m_tile(impl.grid.store().tileNumber(tx, ty)),
+              m_base(multibin::BinStore::tileBase(m_tile)) {}
+        /** Whether the tile holds no bin (not allocated) and the dual grid is off. */
+        bool empty() const { return !m_dual && m_tile == 0; }
+        /** holdsBins(ix, iy, dual) for a cell of this tile. */
+        bool holds(int ix, int iy) const {
+            if (m_dual) return m_impl.holdsBins(ix, iy, true);
+            const multibin::BinStore& s = m_impl.grid.store();
+            return m_tile != 0 && s.window().contains(ix, iy) &&
+                   s.slotHoldsBins(m_base + multibin::BinStore::slotInTile(ix, iy));
+        }
+
+    private:
+        const Impl& m_impl;
+        bool m_dual;
+        uint32_t m_tile;
+        size_t m_base;
+    };
     /** The traversability layers (CMultiBinElevationMap_traversability.cpp). */
     multibin::TraversabilityCache traversability;
 };

@@ -4,13 +4,15 @@
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
-#include <mrpt/system/crc.h>
+#include <zlib.h>
+
 #include "CMultiBinElevationMap_impl.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <vector>
@@ -281,6 +283,15 @@ namespace {
  * body is version 1's with each bin's plane moments after its estimate; version 4's adds the
  * bin's two pose sigma codes (Bin.h) after the moments. */
 constexpr size_t kPayloadChunkBytes = size_t(1) << 20;
+
+/** The payload's checksum as MRPT's compute_CRC32 defines it (CRC-32's reflected polynomial
+ * 0xEDB88320, the register starting at 0, no final inversion), so every file written before reads
+ * back, computed by zlib's table-driven crc32_z instead of MRPT's bit by bit: zlib inverts the
+ * register on entry and on exit, so it starts from ~0 and its result is inverted back. */
+uint32_t payloadCrc32(const uint8_t* data, uint64_t n) {
+    if (n == 0) return 0;
+    return ~uint32_t(crc32_z(0xFFFFFFFFUL, data, size_t(n)));
+}
 }  // namespace
 
 void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) const {
@@ -311,7 +322,7 @@ void CMultiBinElevationMap::serializeTo(mrpt::serialization::CArchive& out) cons
     const uint64_t n = mem.getTotalBytesCount();
     out << n;
     out.WriteBuffer(payload, n);
-    out << mrpt::system::compute_CRC32(payload, n);
+    out << payloadCrc32(payload, n);
 }
 
 void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version) {
@@ -349,7 +360,7 @@ void CMultiBinElevationMap::serializeFrom(mrpt::serialization::CArchive& in, uin
             }
             uint32_t storedCrc = 0;
             in >> storedCrc;
-            const uint32_t actual = mrpt::system::compute_CRC32(payload.data(), payload.size());
+            const uint32_t actual = payloadCrc32(payload.data(), payload.size());
             if (storedCrc != actual)
                 corrupt("checksum mismatch: the " + std::to_string(n) +
                         "-byte payload has CRC-32 " + std::to_string(actual) + ", stored " +
@@ -393,10 +404,11 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     const multibin::fill::FilledCells& f = m_impl->filled;
     const multibin::CellWindow& fw = m_impl->fillWindow;
     const bool withFill = insertionOptions.query.dem_return_filled;
-    // The filled cells' tile of the store tile being read, found once per tile (not per cell).
+    // The store tile being read and its filled cells' tile, found once per tile (not per cell).
     const multibin::fill::FilledCell* filledTile = nullptr;
+    std::optional<Impl::TileBins> bins;
     const auto mayBeKnown = [&](int ix, int iy) {
-        return m_impl->holdsBins(ix, iy, isDualGrid()) ||
+        return bins->holds(ix, iy) ||
                (filledTile && fw.contains(ix, iy) &&
                 filledTile[multibin::fill::TiledCells<int>::inTile(ix, iy)].source !=
                     multibin::HeightSource::Unknown);
@@ -406,7 +418,8 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
                   "the filled cells' tiles are the store's");
     const auto tileMayHoldKnown = [&](int tx, int ty) {
         filledTile = withFill ? f.cells.findTile(tx, ty) : nullptr;
-        return isDualGrid() || grid.store().tileNumber(tx, ty) != 0 || filledTile;
+        bins.emplace(*m_impl, tx, ty, isDualGrid());
+        return !bins->empty() || filledTile;
     };
     const auto readCell = [&](int ix, int iy) {
         if (!mayBeKnown(ix, iy)) return;

@@ -40,6 +40,13 @@ public:
         }
         return m_cells.data() + size_t(it->second) * kTileCells;
     }
+    /** Room for `tiles` tiles in all: adding them then copies no tile (the tiles' array grows by
+     * reallocation otherwise, each copy touching fresh pages). */
+    void reserve(size_t tiles) {
+        m_cells.reserve(tiles * kTileCells);
+        m_xy.reserve(tiles);
+        m_index.reserve(tiles);
+    }
     /** The cells of tile (tx, ty), or nullptr if it was never written. */
     const T* findTile(int tx, int ty) const {
         const auto it = m_index.find(key(tx, ty));

@@ -192,6 +192,10 @@ public:
     }
     /** Appends a bin with this estimate to the chain of the cell at `slot` (a writable one). */
     BinId appendBin(size_t slot, const BinEstimate& estimate);
+    /** Whether the cell at `slot` holds a bin: one load, for loops over a tile's slots
+     * (tileBase(tileNumber(tx, ty)) + slotInTile(ix, iy)) that skip empty cells; the window is
+     * the caller's to check, as forEachBin does. */
+    bool slotHoldsBins(size_t slot) const { return m_heads[slot] != kNoBin; }
     /** Calls f(const Bin&) for every bin of the cell, in chain order; nothing outside the
      * window. */
     template <typename F>

@@ -26,7 +26,7 @@ constexpr int kGeoTiffTile = 256;
 void checkGeoTiffEpsg(int epsg, const std::string& what);
 
 /** Writes `raster` (tileCells must be kGeoTiffTile) as a single-band float32 GeoTIFF over its
- * tileBounds(): north up, 256 x 256 tiles, DEFLATE with the floating-point predictor, NaN as
+ * tileBounds(): north up, 256 x 256 tiles, DEFLATE (fastest level, no predictor), NaN as
  * nodata (GDAL_NODATA tag), placed by ModelPixelScale and ModelTiepoint (pixel-is-area) in the
  * raster's frame, ProjectedCSTypeGeoKey options.epsg (or user-defined, in metres). Only the tiles
  * of raster.tiles that hold a known sample are written; the others keep offset and byte count 0,
