@@ -45,9 +45,10 @@ std::vector<uint32_t> pointsPerCell(const BinGrid& grid, const PointsWithCov& ma
         for (size_t i = 0; i < n; i++) at(cell[i])++;
         for (size_t i = 0; i < n; i++) perPoint[i] = at(cell[i]);
     } else {
-        std::unordered_map<int64_t, uint32_t> sparse;
+        std::unordered_map<uint64_t, uint32_t> sparse;
+        // Both indices' 32 bits, unsigned: shifting a negative index is undefined.
         auto key = [](const Eigen::Vector2i& c) {
-            return (int64_t(c.x()) << 32) ^ uint32_t(c.y());
+            return (uint64_t(uint32_t(c.x())) << 32) | uint32_t(c.y());
         };
         for (size_t i = 0; i < n; i++) sparse[key(cell[i])]++;
         for (size_t i = 0; i < n; i++) perPoint[i] = sparse[key(cell[i])];
