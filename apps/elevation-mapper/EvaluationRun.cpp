@@ -248,8 +248,8 @@ EvaluationRun::EvaluationRun(const Options& options, CMultiBinElevationMap& eval
     laser.mixedPixelFilter = false;
     laser.continuity = false;
     auto& stereo = m_rawSensorOptions.stereo;
-    stereo.haloFilter = false;
-    stereo.nearClusterFilter = false;
+    stereo.halo.enabled = false;
+    stereo.nearCluster.enabled = false;
 }
 
 void EvaluationRun::insertRawPoints(const mrpt::obs::CObservation& obs,

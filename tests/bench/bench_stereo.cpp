@@ -122,7 +122,7 @@ static void BM_StereoPointsWithCovariance(benchmark::State& state) {
         } else {
             // The reference loop without its filters (already applied).
             StereoModelOptions noFilters = o;
-            noFilters.haloFilter = noFilters.nearClusterFilter = false;
+            noFilters.halo.enabled = noFilters.nearCluster.enabled = false;
             out = stereo_reference::framePoints(g, filtered, refTable, noFilters, 0, kInf).points;
         }
         benchmark::DoNotOptimize(out.data());

@@ -105,21 +105,21 @@ int main(int argc, char** argv) {
             argv[i],
             [](auto& o) {
                 auto& so = o.sensors.stereo;
-                if (auto e = std::getenv("HALO")) so.haloFilter = std::atoi(e);
-                if (auto e = std::getenv("NC")) so.nearClusterFilter = std::atoi(e);
+                if (auto e = std::getenv("HALO")) so.halo.enabled = std::atoi(e);
+                if (auto e = std::getenv("NC")) so.nearCluster.enabled = std::atoi(e);
                 if (auto e = std::getenv("SUB")) so.subsample = std::atoi(e);
                 if (auto e = std::getenv("SIG")) so.matchingSigma_px = std::atof(e);
-                if (auto e = std::getenv("HJ")) so.haloJump_px = std::atof(e);
-                if (auto e = std::getenv("TEX")) so.textureMinStd_grey = std::atof(e);
-                if (auto e = std::getenv("TEXR")) so.textureRadius_px = std::atoi(e);
+                if (auto e = std::getenv("HJ")) so.halo.jump_px = std::atof(e);
+                if (auto e = std::getenv("TEX")) so.texture.minStd_grey = std::atof(e);
+                if (auto e = std::getenv("TEXR")) so.texture.radius_px = std::atoi(e);
                 if (auto e = std::getenv("FULL")) so.sgbmFullWidth = std::atoi(e);
                 if (auto e = std::getenv("UNIQ")) so.sgbmUniquenessRatio = std::atoi(e);
                 if (auto e = std::getenv("D12")) so.sgbmDisp12MaxDiff = std::atoi(e);
                 if (auto e = std::getenv("BLOCK")) so.sgbmBlockSize = std::atoi(e);
                 if (auto e = std::getenv("SPW")) so.sgbmSpeckleWindowSize = std::atoi(e);
                 if (auto e = std::getenv("MODE")) so.sgbmMode = e;
-                if (auto e = std::getenv("NCA")) so.nearClusterMaxArea_px = std::atoi(e);
-                if (auto e = std::getenv("HR")) so.haloRadius_px = std::atoi(e);
+                if (auto e = std::getenv("NCA")) so.nearCluster.maxArea_px = std::atoi(e);
+                if (auto e = std::getenv("HR")) so.halo.radius_px = std::atoi(e);
                 if (auto e = std::getenv("MEU")) o.max_elevation_uncertainty_m = std::atof(e);
                 if (auto e = std::getenv("MAXR")) o.max_range_m = std::atof(e);
             },

@@ -2,6 +2,7 @@
  * comparisons, and synthetic observations. */
 #pragma once
 
+#include <gtest/gtest.h>
 #include <mrpt/core/bits_math.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CMemoryStream.h>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "multibin/grid/BinGrid.h"
+#include "multibin/io/ErrorMessage.h"
 #include "multibin/map/MapInternals.h"
 #include "multibin/sensors/StereoDisparity.h"
 #include "test_files.h"
@@ -158,6 +160,22 @@ inline mrpt::obs::CObservationStereoImages::Ptr stereoPair(int w, int h) {
     obs->hasImageDisparity = true;
     obs->hasImageRight = false;
     return obs;
+}
+
+/** f() throws a std::exception, and the one-line message a program shows
+ * (multibin::oneLineMessage, which takes MRPT's "Message:" out of its exception wrapper) holds
+ * every word of `words`. */
+template <typename F>
+void expectErrorMentioning(F&& f, const std::vector<std::string>& words) {
+    try {
+        f();
+        ADD_FAILURE() << "no exception; expected one mentioning '" << words.front() << "'";
+    } catch (const std::exception& e) {
+        const std::string msg = multibin::oneLineMessage(e);
+        for (const auto& w : words)
+            EXPECT_NE(msg.find(w), std::string::npos)
+                << "'" << w << "' not in: " << msg << "\nwhole: " << e.what();
+    }
 }
 
 }  // namespace reliability

@@ -226,7 +226,7 @@ TEST(FillGaps, LongShadowBesideAStepStaysWithinItsOwnRim) {
     // the fitted residual covariance collapses to the nugget): measured, not asserted.
     for (const bool shadows : {true, false}) {
         FillOptions o;
-        o.shadowOccluders = shadows;
+        o.shadowOccluders.enabled = shadows;
         const auto f = fillGaps(r, o);
         ASSERT_EQ(f.stats.gaussian, 80 * 12 + 26 * 28);
         EXPECT_EQ(f.stats.shadowGaps, shadows ? 1 : 0);
@@ -292,7 +292,7 @@ TEST(FillGaps, ShadowBehindAStepIsFilledFromItsHiddenSide) {
     double rmse[2] = {0, 0};
     for (const bool shadows : {true, false}) {
         FillOptions o;
-        o.shadowOccluders = shadows;
+        o.shadowOccluders.enabled = shadows;
         const auto f = fillGaps(r, o);
         double sum2 = 0;
         int n = 0, within3 = 0;
@@ -331,7 +331,7 @@ TEST(FillGaps, CompactGapOverAStepCornerIsNotAShadow) {
             r.setMeasured(ix, iy, float((ix < 15 && iy < 17 ? 0.06 : 0.0) + noise(rng)), 0.002f);
     hide(r, 10, 10, 10, 10);
     FillOptions off;
-    off.shadowOccluders = false;
+    off.shadowOccluders.enabled = false;
     const FillResult f = fillGaps(r, FillOptions{}), g = fillGaps(r, off);
     EXPECT_EQ(f.stats.shadowGaps, 0);
     EXPECT_EQ(f.height_m, g.height_m);

@@ -140,7 +140,7 @@ TEST(OptionKeys, ValuesSetInCodeAreCheckedByTheKeysRules) {
     o.fill.medianWindow_cells = 4;
     expectRefused(o, "fill_median_window_cells", "odd number from 3 to 15 (cells)");
     o = {};
-    o.sensors.stereo.haloJump_px = 0;
+    o.sensors.stereo.halo.jump_px = 0;
     expectRefused(o, "stereo_halo_jump_px", "positive and finite (px)");
     o = {};
     o.sensors.depth.axialOffset_m = std::numeric_limits<double>::infinity();

@@ -30,19 +30,6 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 /** Beams of floorScan() that hit the floor within 4 m (683 beams over 240 deg, 45 deg pitch). */
 constexpr size_t kFloorReturns = 481;
 
-/** Asserts that `f` throws a std::exception whose message contains every word of `words`. */
-template <typename F>
-void expectErrorMentioning(F&& f, const std::vector<std::string>& words) {
-    try {
-        f();
-        ADD_FAILURE() << "no exception; expected one mentioning '" << words.front() << "'";
-    } catch (const std::exception& e) {
-        const std::string msg = e.what();
-        for (const auto& w : words)
-            EXPECT_NE(msg.find(w), std::string::npos) << "'" << w << "' not in: " << msg;
-    }
-}
-
 /** A scan of `beams` beams, all with range `r`, marked valid. */
 mrpt::obs::CObservation2DRangeScan::Ptr scanOfRanges(float r, size_t beams = 50) {
     auto scan = floorScan(beams);

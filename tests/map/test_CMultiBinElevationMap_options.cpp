@@ -30,21 +30,6 @@ using namespace reliability;
 namespace {
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/** f() throws; the one-line message a program shows (multibin::oneLineMessage, which takes
- * MRPT's "Message:" out of its exception wrapper) holds every word. */
-template <typename F>
-void expectErrorMentioning(F&& f, const std::vector<std::string>& words) {
-    try {
-        f();
-        ADD_FAILURE() << "no exception; expected one mentioning '" << words.front() << "'";
-    } catch (const std::exception& e) {
-        const std::string msg = multibin::oneLineMessage(e);
-        for (const auto& w : words)
-            EXPECT_NE(msg.find(w), std::string::npos)
-                << "'" << w << "' not in: " << msg << "\nwhole: " << e.what();
-    }
-}
-
 /** Loads the maps of an ini file through MRPT's initializers, as observations2map does. */
 void mapsFromIniFile(const fs::path& path) {
     mrpt::config::CConfigFile ini(path.string());

@@ -57,7 +57,7 @@ TEST(TraversabilityOptions, ReadStrictlyFromTheMapsIniSection) {
     EXPECT_EQ(map->traversabilityOptions.max_step_m, 0.1);
     EXPECT_EQ(map->traversabilityOptions.max_slope_deg, 20);
     EXPECT_EQ(map->traversabilityOptions.max_roughness_m, 0.03);
-    EXPECT_EQ(map->traversabilityOptions.foot_radius_m, 0.03);
+    EXPECT_EQ(map->traversabilityOptions.foothold.radius_m, 0.03);
 
     const auto errorOf = [](const std::string& text) -> std::string {
         try {

@@ -74,7 +74,7 @@ TEST(DepthArtefacts, SyntheticFrameFlyingPixelsAndBorderAreRemovedAndCounted) {
     EXPECT_LE(wallOrBoxLost, 2u * 4u * 40u + 8u);
     EXPECT_GT(stats.flyingPixel, 40u);
     // Off: nothing removed, nothing counted.
-    opts.flyingPixelFilter = false;
+    opts.flyingPixel.enabled = false;
     opts.borderWidth_px = 0;
     DepthStats off;
     depthScanToPoints(scan, opts, 0.02, 10, pts, off);

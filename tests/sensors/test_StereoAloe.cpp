@@ -164,7 +164,7 @@ void expectFiltersAsReference(const DisparityImage& raw, const StereoModelOption
                               const std::string& what, size_t* nearRemoved = nullptr) {
     SCOPED_TRACE(what);
     DisparityImage lib = raw, ref = raw;
-    if (o.haloFilter) {
+    if (o.halo.enabled) {
         const size_t halo = removeHalos(lib, o);
         EXPECT_EQ(halo, stereo_reference::removeHalos(ref, o));
         EXPECT_TRUE(sameDisparity(lib, ref));
@@ -185,8 +185,8 @@ void expectPointsAsReference(const StereoGeometry& g, const DisparityImage& raw,
     const stereo_reference::Frame ref = stereo_reference::framePoints(
         g, raw, stereo_reference::Table(g, o), o, minRange_m, maxRange_m);
     DisparityImage d = raw;
-    const size_t halo = o.haloFilter ? removeHalos(d, o) : 0;
-    const size_t near = o.nearClusterFilter ? removeNearClusters(d, o) : 0;
+    const size_t halo = o.halo.enabled ? removeHalos(d, o) : 0;
+    const size_t near = o.nearCluster.enabled ? removeNearClusters(d, o) : 0;
     EXPECT_EQ(halo, ref.halo);
     EXPECT_EQ(near, ref.nearCluster);
     EXPECT_TRUE(sameDisparity(d, ref.filtered));
@@ -238,16 +238,16 @@ TEST(StereoAloe, OptimisedFiltersRemoveExactlyTheReferencePixels) {
     expectFiltersAsReference(raw, StereoModelOptions(), "shipped defaults", &near);
     EXPECT_GT(near, 1000u);  // the comparison covers many removed regions
     StereoModelOptions noHalo;
-    noHalo.haloFilter = false;  // the raw SGBM frame: more and ragged regions
+    noHalo.halo.enabled = false;  // the raw SGBM frame: more and ragged regions
     expectFiltersAsReference(raw, noHalo, "near clusters on the raw frame", &near);
     EXPECT_GT(near, 1000u);
     StereoModelOptions wide;  // larger regions, a finer step, a smaller jump
-    wide.nearClusterMaxArea_px = 5000;
-    wide.nearClusterStep_px = 0.5;
-    wide.nearClusterJump_px = 0.5;
+    wide.nearCluster.maxArea_px = 5000;
+    wide.nearCluster.step_px = 0.5;
+    wide.nearCluster.jump_px = 0.5;
     expectFiltersAsReference(raw, wide, "max area 5000, step 0.5, jump 0.5");
     StereoModelOptions none;
-    none.nearClusterMaxArea_px = 1;  // no region is smaller than one pixel
+    none.nearCluster.maxArea_px = 1;  // no region is smaller than one pixel
     expectFiltersAsReference(raw, none, "max area 1", &near);
     EXPECT_EQ(near, 0u);
 }

@@ -38,7 +38,7 @@ TEST(StereoArtefacts, HaloOnTheNearSideOfAnEdgeIsRemovedFarSideKept) {
         for (int u = 18; u < 42; u++)
             d.at(u, v) = 30.f;  // true square: 20..39, halo 18..19, 40..41
     StereoModelOptions o;
-    o.haloRadius_px = 2;
+    o.halo.radius_px = 2;
     const size_t removed = removeHalos(d, o);
     EXPECT_FALSE(d.valid(18, 30));  // halo pixel: reject
     EXPECT_FALSE(d.valid(41, 30));
@@ -68,26 +68,26 @@ TEST(StereoArtefacts, TexturelessPixelsRemovedTexturedKept) {
     for (float& x : d.disparity_px) x = 10.f;
     d.at(35, 10) = std::numeric_limits<float>::quiet_NaN();  // already invalid: not counted
     StereoModelOptions o;
-    o.textureMinStd_grey = 1.5;
+    o.texture.minStd_grey = 1.5;
     DisparityImage out = d;
     // Windows reaching a textured column (u <= W/2 - 1 + 2) keep their pixels.
     const size_t expected = size_t(H) * size_t(W / 2 - 2) - 1;
     EXPECT_EQ(removeTextureless(out, left, o), expected);
     for (int v = 0; v < H; v++)
         for (int u = 0; u < W; u++) EXPECT_EQ(out.valid(u, v), u < W / 2 + 2) << u << "," << v;
-    o.textureMinStd_grey = 0.9;  // below the checkerboard's std: nothing removed
+    o.texture.minStd_grey = 0.9;  // below the checkerboard's std: nothing removed
     out = d;
     EXPECT_EQ(removeTextureless(out, left, o), 0u);
-    o.textureMinStd_grey = 0;  // off
+    o.texture.minStd_grey = 0;  // off
     EXPECT_EQ(removeTextureless(out, left, o), 0u);
-    o.textureMinStd_grey = 1.5;
+    o.texture.minStd_grey = 1.5;
     DisparityImage small(W - 1, H);
     EXPECT_THROW(removeTextureless(small, left, o), std::invalid_argument);
 }
 
 TEST(StereoArtefacts, SmallNearClusterRemovedLargeOrFarKept) {
     StereoModelOptions o;
-    o.nearClusterMaxArea_px = 50;
+    o.nearCluster.maxArea_px = 50;
     DisparityImage d(80, 80);
     for (auto& x : d.disparity_px) x = 10.f;
     for (int v = 5; v < 10; v++)

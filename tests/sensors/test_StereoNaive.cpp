@@ -28,7 +28,7 @@ TEST(StereoNaive, MapBeatsTheNaivePipelineOnRenderedRockBoards) {
     const auto on = stereo_naive::compare(
         prefix, [](auto&) {}, boards);
     const auto noTexture = stereo_naive::compare(
-        prefix, [](auto& o) { o.sensors.stereo.textureMinStd_grey = 0; }, boards);
+        prefix, [](auto& o) { o.sensors.stereo.texture.minStd_grey = 0; }, boards);
     const auto narrow = stereo_naive::compare(
         prefix, [](auto& o) { o.sensors.stereo.sgbmFullWidth = false; }, boards);
     for (const auto* s : {&on, &noTexture, &narrow})

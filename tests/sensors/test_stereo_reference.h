@@ -107,12 +107,12 @@ inline size_t removeHalos(DisparityImage& d, const StereoModelOptions& o) {
     for (int v = 0; v < d.height; v++)
         for (int u = 0; u < d.width; u++) m.at<float>(v, u) = d.valid(u, v) ? d.at(u, v) : 1e9f;
     cv::Mat minWin;
-    const int k = 2 * o.haloRadius_px + 1;
+    const int k = 2 * o.halo.radius_px + 1;
     cv::erode(m, minWin, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
     size_t removed = 0;
     for (int v = 0; v < d.height; v++)
         for (int u = 0; u < d.width; u++)
-            if (d.valid(u, v) && d.at(u, v) - minWin.at<float>(v, u) > o.haloJump_px) {
+            if (d.valid(u, v) && d.at(u, v) - minWin.at<float>(v, u) > o.halo.jump_px) {
                 d.at(u, v) = std::numeric_limits<float>::quiet_NaN();
                 removed++;
             }
@@ -150,7 +150,7 @@ inline size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o)
                 const int q = vv * W + uu;
                 const float dq = d.disparity_px[size_t(q)];
                 if (!std::isfinite(dq)) continue;
-                if (std::abs(dq - dp) <= o.nearClusterStep_px) {
+                if (std::abs(dq - dp) <= o.nearCluster.step_px) {
                     if (label[size_t(q)] < 0) {
                         label[size_t(q)] = id;
                         stack.push_back(q);
@@ -160,7 +160,7 @@ inline size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o)
                     around.push_back(dq);
                 }
             }
-            if (small && int(members.size()) >= o.nearClusterMaxArea_px) small = false;
+            if (small && int(members.size()) >= o.nearCluster.maxArea_px) small = false;
         }
         if (!small) continue;
         bool remove = around.empty();
@@ -168,7 +168,7 @@ inline size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o)
             std::nth_element(around.begin(), around.begin() + long(around.size() / 2),
                              around.end());
             const double median = around[around.size() / 2];
-            remove = sum / double(members.size()) > median + o.nearClusterJump_px;
+            remove = sum / double(members.size()) > median + o.nearCluster.jump_px;
         }
         if (remove) {
             for (int p : members)
@@ -191,8 +191,8 @@ struct Frame {
 inline Frame framePoints(const StereoGeometry& g, DisparityImage disp, const Table& table,
                          const StereoModelOptions& opts, double minRange_m, double maxRange_m) {
     Frame f;
-    if (opts.haloFilter) f.halo = stereo_reference::removeHalos(disp, opts);
-    if (opts.nearClusterFilter) f.nearCluster = stereo_reference::removeNearClusters(disp, opts);
+    if (opts.halo.enabled) f.halo = stereo_reference::removeHalos(disp, opts);
+    if (opts.nearCluster.enabled) f.nearCluster = stereo_reference::removeNearClusters(disp, opts);
     const int step = opts.subsample;
     f.points.reserve(size_t(g.width / step + 1) * size_t(g.height / step + 1));
     for (int v = 0; v < g.height; v += step)

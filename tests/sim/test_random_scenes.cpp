@@ -177,9 +177,10 @@ TEST(RandomScenes, ClearanceLowersTheFilledCellsError) {
     for (const ScoredScene& s : ciScenes()) {
         SCOPED_TRACE(s.scene.describe());
         const RandomSceneScores& without = s.scores;  // the default: fill_clearance off
-        const RandomSceneScores with = scoreRandomScene(
-            s.scene,
-            [](mrpt::maps::CMultiBinElevationMap& m) { m.insertionOptions.fill.clearance = true; });
+        const RandomSceneScores with =
+            scoreRandomScene(s.scene, [](mrpt::maps::CMultiBinElevationMap& m) {
+                m.insertionOptions.fill.clearance.enabled = true;
+            });
         std::printf("seed %lu: filled %.1f mm with the clearance, %.1f mm without (%zu cells)\n",
                     (unsigned long)s.scene.seed, 1e3 * with.filledRmse_m,
                     1e3 * without.filledRmse_m, without.filledCells);

@@ -48,11 +48,11 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("fill_terms_outside_gap", o.termsOutsideGap);
     visit("fill_kriging_max_points", o.krigingMaxPoints, between(20, 5000));
     visit("fill_moving_rim_check", o.movingRimCheck);
-    visit("fill_shadow_occluders", o.shadowOccluders);
-    visit("fill_shadow_step_sigmas", o.shadowStepSigmas, atLeast(0));
-    visit("fill_shadow_reach_cells", o.shadowReach_cells, between(0, 100, "cells"));
-    visit("fill_clearance", o.clearance);
-    visit("fill_clearance_margin_m", o.clearanceMargin_m, atLeast(0, "m"));
+    visit("fill_shadow_occluders", o.shadowOccluders.enabled);
+    visit("fill_shadow_step_sigmas", o.shadowOccluders.stepSigmas, atLeast(0));
+    visit("fill_shadow_reach_cells", o.shadowOccluders.reach_cells, between(0, 100, "cells"));
+    visit("fill_clearance", o.clearance.enabled);
+    visit("fill_clearance_margin_m", o.clearance.margin_m, atLeast(0, "m"));
     visit("fill_kriging_neighbourhood", o.krigingNeighbourhood, kNeighbourhoods);
     visit("fill_model_averaging", o.modelAveraging);
     visit("fill_extrapolation_margin", o.extrapolationMargin, atLeast(0));

@@ -68,7 +68,7 @@ void fillGap(const HeightRaster& r, const FillOptions& o, const Gap& gap,
         for (int k : gap.cells) median.fillCell(k % r.nx(), k / r.nx(), out, measured);
         return;
     }
-    if (o.gaussianEnabled && o.shadowOccluders) {
+    if (o.gaussianEnabled && o.shadowOccluders.enabled) {
         // A shadow behind a step: the step's top is not data of the hidden surface.
         const ShadowOccluders occ = findShadowOccluders(r, gap.cells, o);
         if (!occ.cells.empty() && fillShadow(withoutOccluders(r, occ), o, gap.cells, out)) {

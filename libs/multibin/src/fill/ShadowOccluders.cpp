@@ -177,7 +177,8 @@ std::vector<Occluder> occluderRimCells(const Gap& g, const std::vector<int>& rim
                                       slopeAlong(r, far.x, far.y, nxv, nyv, island));
         const double explained =
             std::sqrt(so * so + sf * sf + (far.dist * slope) * (far.dist * slope));
-        if (drop > o.shadowStepSigmas * explained) occluders.push_back({k, ho - 0.5 * drop});
+        if (drop > o.shadowOccluders.stepSigmas * explained)
+            occluders.push_back({k, ho - 0.5 * drop});
     }
     return occluders;
 }
@@ -291,7 +292,7 @@ void markStrayRimCells(const Gap& g, const std::vector<int>& rim, const FillOpti
         const double spread = 1.4826 * median(nb);
         const double s = r.sigma_m[size_t(k)];
         if (std::abs(r.height_m[size_t(k)] - med) >
-            o.shadowStepSigmas * std::sqrt(s * s + medSigma * medSigma + spread * spread))
+            o.shadowOccluders.stepSigmas * std::sqrt(s * s + medSigma * medSigma + spread * spread))
             mark[size_t(k)] = 1;
     }
 }
@@ -311,7 +312,7 @@ ShadowOccluders findShadowOccluders(const HeightRaster& r, const std::vector<int
     if (stepRunsThrough(gap, rim, occluders)) return out;  // filled as any other gap
     out.rimCells = int(occluders.size());
     std::vector<char> mark(r.size(), 0);
-    markOccluderTops(gap, occluders, o.shadowReach_cells, mark);
+    markOccluderTops(gap, occluders, o.shadowOccluders.reach_cells, mark);
     markStrayIslands(gap, rim, mark);
     markStrayRimCells(gap, rim, o, mark);
     for (size_t k = 0; k < mark.size(); k++)

@@ -140,15 +140,16 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
  * (`surface` false): the median window's half side. Otherwise also the support square (side =
  * the box's longer side + 2 supportMargin_cells, centred, slid inside the raster: it stays within
  * side - (box width) of the box on either axis), the shadow test (the rim's 5 x 5 planes and the
- * occluders' tops within shadowReach_cells of the rim, ShadowOccluders.h) and the biharmonic
- * stencil (2 cells). */
+ * occluders' tops within shadowOccluders.reach_cells of the rim, ShadowOccluders.h) and the
+ * biharmonic stencil (2 cells). */
 CellWindow gapRaster(const GapCells& g, const CellWindow& w, const FillOptions& o, bool surface) {
     int x0 = INT_MAX, x1 = INT_MIN;
     const int y0 = g.front()[0], y1 = g.back()[0];
     for (const auto& c : g) x0 = std::min(x0, c[1]), x1 = std::max(x1, c[1]);
     const int bw = x1 - x0 + 1, bh = y1 - y0 + 1;
     const int side = std::max(bw, bh) + 2 * o.supportMargin_cells;
-    const int reach = std::max(o.medianWindow_cells / 2, surface ? o.shadowReach_cells + 4 : 0);
+    const int reach =
+        std::max(o.medianWindow_cells / 2, surface ? o.shadowOccluders.reach_cells + 4 : 0);
     const int mx = surface ? std::max(side - bw, reach) : reach;
     const int my = surface ? std::max(side - bh, reach) : reach;
     const int xa = std::max(x0 - mx, w.ix0), xb = std::min(x1 + mx + 1, w.ix0 + w.nx);

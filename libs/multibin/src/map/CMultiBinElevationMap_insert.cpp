@@ -386,7 +386,7 @@ multibin::InsertStats CMultiBinElevationMap::insertIntoGrid(
     if (sensorOrigin_m) {
         // The clearances bound the gap fill (fill::boundByClearance): kept only if it reads them.
         const multibin::fill::FillOptions& fill = insertionOptions.fill;
-        if (insertionOptions.visibility.enabled && fill.enabled && fill.clearance)
+        if (insertionOptions.visibility.enabled && fill.enabled && fill.clearance.enabled)
             multibin::noteClearances(grid, *sensorOrigin_m, multibin::kClearanceRise_m);
         m_impl->visibilityStats += multibin::applyVisibilityConstraint(
             grid, *sensorOrigin_m, insertionOptions.visibility, params,

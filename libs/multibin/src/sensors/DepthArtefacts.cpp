@@ -20,11 +20,11 @@ std::vector<DepthPixel> depthArtefacts(const std::vector<float>& depth_m, int ro
     auto at = [&](int r, int c) { return size_t(r) * size_t(cols) + size_t(c); };
     const int b = opts.borderWidth_px;
     auto inBorder = [&](int r, int c) { return r < b || c < b || r >= rows - b || c >= cols - b; };
-    if (opts.flyingPixelFilter) {
+    if (opts.flyingPixel.enabled) {
         // The border goes first: its depths do not make jumps with the pixels inside it.
         auto isJump = [&](int r0, int c0, int r1, int c1) {
             return !inBorder(r0, c0) && !inBorder(r1, c1) &&
-                   jumps(depth_m[at(r0, c0)], depth_m[at(r1, c1)], opts.flyingPixelJumpRelative);
+                   jumps(depth_m[at(r0, c0)], depth_m[at(r1, c1)], opts.flyingPixel.jumpRelative);
         };
         // Pixels on either side of a jump, then grown by the radius (a square window).
         std::vector<uint8_t> onJump(depth_m.size(), 0);
@@ -35,7 +35,7 @@ std::vector<DepthPixel> depthArtefacts(const std::vector<float>& depth_m, int ro
                 if (r + 1 < rows && isJump(r, c, r + 1, c))
                     onJump[at(r, c)] = onJump[at(r + 1, c)] = 1;
             }
-        const int k = std::max(0, opts.flyingPixelRadius_px - 1);
+        const int k = std::max(0, opts.flyingPixel.radius_px - 1);
         for (int r = 0; r < rows; r++)
             for (int c = 0; c < cols; c++) {
                 if (!onJump[at(r, c)]) continue;

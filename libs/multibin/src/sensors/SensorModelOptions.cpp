@@ -164,18 +164,18 @@ void visitStereoKeys(Stereo& stereo, Visit& visit) {
     visit("stereo_sgbm_speckle_window_size", stereo.sgbmSpeckleWindowSize, atLeast(0));
     visit("stereo_sgbm_speckle_range", stereo.sgbmSpeckleRange, atLeast(0));
     visit("stereo_sgbm_mode", stereo.sgbmMode, kSgbmModes);
-    visit("stereo_halo_filter", stereo.haloFilter);
-    visit({"stereo_halo_jump_px", "stereo_halo_jump"}, stereo.haloJump_px, positive("px"));
-    visit({"stereo_halo_radius_px", "stereo_halo_radius"}, stereo.haloRadius_px, atLeast(1, "px"));
-    visit("stereo_near_cluster_filter", stereo.nearClusterFilter);
+    visit("stereo_halo_filter", stereo.halo.enabled);
+    visit({"stereo_halo_jump_px", "stereo_halo_jump"}, stereo.halo.jump_px, positive("px"));
+    visit({"stereo_halo_radius_px", "stereo_halo_radius"}, stereo.halo.radius_px, atLeast(1, "px"));
+    visit("stereo_near_cluster_filter", stereo.nearCluster.enabled);
     visit({"stereo_near_cluster_max_area_px", "stereo_near_cluster_max_area"},
-          stereo.nearClusterMaxArea_px, atLeast(1, "px"));
-    visit({"stereo_near_cluster_step_px", "stereo_near_cluster_step"}, stereo.nearClusterStep_px,
+          stereo.nearCluster.maxArea_px, atLeast(1, "px"));
+    visit({"stereo_near_cluster_step_px", "stereo_near_cluster_step"}, stereo.nearCluster.step_px,
           positive("px"));
-    visit({"stereo_near_cluster_jump_px", "stereo_near_cluster_jump"}, stereo.nearClusterJump_px,
+    visit({"stereo_near_cluster_jump_px", "stereo_near_cluster_jump"}, stereo.nearCluster.jump_px,
           positive("px"));
-    visit("stereo_texture_min_std_grey", stereo.textureMinStd_grey, atLeast(0));
-    visit("stereo_texture_radius_px", stereo.textureRadius_px, atLeast(1, "px"));
+    visit("stereo_texture_min_std_grey", stereo.texture.minStd_grey, atLeast(0));
+    visit("stereo_texture_radius_px", stereo.texture.radius_px, atLeast(1, "px"));
     visit({"stereo_cloud_focal_length_px", "stereo_cloud_focal_length"}, stereo.cloudFocalLength_px,
           positive("px"));
     visit({"stereo_cloud_baseline_m", "stereo_cloud_baseline"}, stereo.cloudBaseline_m,
@@ -270,9 +270,9 @@ void visitKeys(Options& o, Visit&& visit) {
           positive("rad"));
     visit("depth_quantisation_step_per_m", depth.quantisationStep_per_m, atLeast(0, "1/m"));
     visit("depth_frame_sigma_relative", depth.frameSigmaRelative, atLeast(0));
-    visit("depth_flying_pixel_filter", depth.flyingPixelFilter);
-    visit("depth_flying_pixel_jump_relative", depth.flyingPixelJumpRelative, positive());
-    visit("depth_flying_pixel_radius_px", depth.flyingPixelRadius_px, atLeast(1, "px"));
+    visit("depth_flying_pixel_filter", depth.flyingPixel.enabled);
+    visit("depth_flying_pixel_jump_relative", depth.flyingPixel.jumpRelative, positive());
+    visit("depth_flying_pixel_radius_px", depth.flyingPixel.radius_px, atLeast(1, "px"));
     visit("depth_border_px", depth.borderWidth_px, atLeast(0, "px"));
     visit("depth_max_elevation_uncertainty_m", depth.maxElevationUncertainty_m, atLeast(0, "m"));
 }

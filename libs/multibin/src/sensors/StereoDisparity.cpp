@@ -101,7 +101,7 @@ DisparityImage computeDisparitySGBM(const mrpt::img::CImage& left, const mrpt::i
 
 size_t removeTextureless(DisparityImage& d, const mrpt::img::CImage& left,
                          const StereoModelOptions& o) {
-    if (o.textureMinStd_grey <= 0) return 0;
+    if (o.texture.minStd_grey <= 0) return 0;
     const cv::Mat& l = left.asCvMatRef();
     if (l.cols != d.width || l.rows != d.height)
         throw std::invalid_argument(
@@ -110,10 +110,10 @@ size_t removeTextureless(DisparityImage& d, const mrpt::img::CImage& left,
     if (l.channels() == 3) cv::cvtColor(l, grey, cv::COLOR_BGR2GRAY);
     grey.convertTo(g, CV_32F);
     g2 = g.mul(g);
-    const int k = 2 * o.textureRadius_px + 1;
+    const int k = 2 * o.texture.radius_px + 1;
     cv::boxFilter(g, mean, CV_32F, cv::Size(k, k));
     cv::boxFilter(g2, mean2, CV_32F, cv::Size(k, k));
-    const float minVar = float(o.textureMinStd_grey * o.textureMinStd_grey);
+    const float minVar = float(o.texture.minStd_grey * o.texture.minStd_grey);
     const float nan = std::numeric_limits<float>::quiet_NaN();
     size_t removed = 0;
     for (int v = 0; v < d.height; v++) {
@@ -138,10 +138,10 @@ size_t removeHalos(DisparityImage& d, const StereoModelOptions& o) {
         for (int u = 0; u < d.width; u++) row[u] = std::isfinite(in[u]) ? in[u] : 1e9f;
     }
     cv::Mat minWin;
-    const int k = 2 * o.haloRadius_px + 1;
+    const int k = 2 * o.halo.radius_px + 1;
     cv::erode(m, minWin, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
     const float nan = std::numeric_limits<float>::quiet_NaN();
-    const double jump = o.haloJump_px;
+    const double jump = o.halo.jump_px;
     size_t removed = 0;
     for (int v = 0; v < d.height; v++) {
         float* row = d.disparity_px.data() + size_t(v) * size_t(d.width);
@@ -192,7 +192,7 @@ size_t decideRegion(DisparityImage& d, const StereoModelOptions& o, int start, u
             const float dq = disp[q];
             if (!std::isfinite(dq)) continue;
             const uint32_t f = flags(q);
-            if (std::abs(dq - dp) <= o.nearClusterStep_px) {
+            if (std::abs(dq - dp) <= o.nearCluster.step_px) {
                 if (!(f & 1u)) {
                     mark[size_t(q)] = tag | f | 1u;
                     stack.push_back(q);
@@ -202,14 +202,14 @@ size_t decideRegion(DisparityImage& d, const StereoModelOptions& o, int start, u
                 around.push_back(dq);
             }
         }
-        if (small && int(members.size()) >= o.nearClusterMaxArea_px) small = false;
+        if (small && int(members.size()) >= o.nearCluster.maxArea_px) small = false;
     }
     if (!small) return 0;
     bool remove = around.empty();
     if (!remove) {
         std::nth_element(around.begin(), around.begin() + long(around.size() / 2), around.end());
         const double median = around[around.size() / 2];
-        remove = sum / double(members.size()) > median + o.nearClusterJump_px;
+        remove = sum / double(members.size()) > median + o.nearCluster.jump_px;
     }
     if (!remove) return 0;
     for (int p : members) disp[p] = std::numeric_limits<float>::quiet_NaN();
@@ -237,7 +237,7 @@ size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
     const int W = d.width, H = d.height;
     if (W <= 0 || H <= 0) return 0;
     const float* disp = d.disparity_px.data();
-    const double step = o.nearClusterStep_px;
+    const double step = o.nearCluster.step_px;
     std::vector<int32_t> parent, length, first;  // per run: union-find parent, pixels, 1st pixel
     parent.reserve(size_t(H) * 16);
     length.reserve(size_t(H) * 16);
@@ -291,7 +291,7 @@ size_t removeNearClusters(DisparityImage& d, const StereoModelOptions& o) {
     uint32_t id = 0;
     size_t removed = 0;
     for (int32_t r = 0; r < runs; r++) {
-        if (parent[size_t(r)] != r || length[size_t(r)] >= o.nearClusterMaxArea_px) continue;
+        if (parent[size_t(r)] != r || length[size_t(r)] >= o.nearCluster.maxArea_px) continue;
         if (mark.empty()) mark.assign(size_t(W) * size_t(H), 0);
         removed += decideRegion(d, o, first[size_t(r)], ++id, mark, stack, members, around);
     }

@@ -533,8 +533,8 @@ void stereoToPoints(const mrpt::obs::CObservationStereoImages& obs, const Stereo
     if (disp.width != g.width || disp.height != g.height)
         throw std::invalid_argument("CObservationStereoImages '" + obs.sensorLabel +
                                     "': image size differs from leftCamera's ncols x nrows");
-    if (opts.haloFilter) stats.halo += removeHalos(disp, opts);
-    if (opts.nearClusterFilter) stats.nearCluster += removeNearClusters(disp, opts);
+    if (opts.halo.enabled) stats.halo += removeHalos(disp, opts);
+    if (opts.nearCluster.enabled) stats.nearCluster += removeNearClusters(disp, opts);
 
     if (!table || !table->matches(g, opts)) {
         table = std::make_shared<const StereoCovarianceTable>(g, opts);

@@ -158,9 +158,9 @@ struct Stencil {
 };
 
 uint8_t discsAt(double d2_m2, const TraversabilityOptions& o) {
-    const double clear_m = o.foot_radius_m + o.foothold_clearance_m;
+    const double clear_m = o.foothold.radius_m + o.foothold.clearance_m;
     return uint8_t((d2_m2 <= o.radius_m * o.radius_m ? kDisc : 0) |
-                   (d2_m2 <= o.foot_radius_m * o.foot_radius_m ? kFoot : 0) |
+                   (d2_m2 <= o.foothold.radius_m * o.foothold.radius_m ? kFoot : 0) |
                    (d2_m2 <= clear_m * clear_m ? kClear : 0));
 }
 
@@ -234,7 +234,7 @@ struct Realisation {
                f.roughness_m > o.max_roughness_m;
     }
     bool goodFoothold(const TraversabilityOptions& o) const {
-        return footHi - footLo <= o.foothold_flatness_m && clearHi - clearLo <= o.max_step_m;
+        return footHi - footLo <= o.foothold.flatness_m && clearHi - clearLo <= o.max_step_m;
     }
 };
 
@@ -503,7 +503,7 @@ void computeCellLinear(const std::vector<Known>& known, int groups, const Traver
     }
     w.footD.assign(sources, 0.0), w.clearD.assign(sources, 0.0);
     foot.derivatives(w.footD, w.share), clear.derivatives(w.clearD, w.share);
-    out.foothold[k] = float(below(foot.range(), norm(w.footD), o.foothold_flatness_m) *
+    out.foothold[k] = float(below(foot.range(), norm(w.footD), o.foothold.flatness_m) *
                             below(clear.range(), norm(w.clearD), o.max_step_m));
 }
 

@@ -17,9 +17,9 @@ void visitKeys(Options& o, Visit&& visit) {
     visit("max_step_m", o.max_step_m, positive("m"));
     visit("max_slope_deg", o.max_slope_deg, between(0.1, 89.9, "deg"));
     visit("max_roughness_m", o.max_roughness_m, positive("m"));
-    visit("foot_radius_m", o.foot_radius_m, positive("m"));
-    visit("foothold_flatness_m", o.foothold_flatness_m, positive("m"));
-    visit("foothold_clearance_m", o.foothold_clearance_m, atLeast(0, "m"));
+    visit("foot_radius_m", o.foothold.radius_m, positive("m"));
+    visit("foothold_flatness_m", o.foothold.flatness_m, positive("m"));
+    visit("foothold_clearance_m", o.foothold.clearance_m, atLeast(0, "m"));
     visit("samples_per_cell", o.samples_per_cell, between(1, 8));
     visit("monte_carlo_draws", o.monte_carlo_draws, between(0, 4096));
     visit("linear_uncertainty", o.linear_uncertainty);
@@ -51,7 +51,7 @@ TraversabilityOptions TraversabilityOptions::uncalibrated() const {
 }
 
 double TraversabilityOptions::reach_m() const {
-    return std::max(radius_m, foot_radius_m + foothold_clearance_m);
+    return std::max(radius_m, foothold.radius_m + foothold.clearance_m);
 }
 
 void TraversabilityOptions::read(StrictConfigSection& s) { readOptionKeys(s, *this, kKeys); }

@@ -3,15 +3,9 @@
 
 #include <string>
 
-// Included by the public map header: no other header of the library here.
+#include "multibin/io/OptionsFwd.h"
 
-namespace mrpt::config {
-class CConfigFileBase;
-}
-
-namespace multibin {
-class StrictConfigSection;
-}
+// Included by the public map header: no other header of the library here but OptionsFwd.h.
 
 namespace multibin::fill {
 
@@ -120,26 +114,29 @@ struct FillOptions {
      * filled that way (the kriging sigma kept). A step hidden in a long shadow is what the
      * smooth kriging carries too far. */
     bool movingRimCheck = true;
-    /** [fill_shadow_occluders] a gap whose rim holds the top of a step that hides it (a shadow
-     * behind a raised edge, see ShadowOccluders.h) is filled without the step's top: from the
-     * hidden side only. */
-    bool shadowOccluders = true;
-    /** [fill_shadow_step_sigmas] a rim cell is an occluder when it stands above the cells across
-     * the gap by more than this many standard deviations of what their sigmas and the visible
-     * slopes explain [-]. */
-    double shadowStepSigmas = 3.0;
-    /** [fill_shadow_reach_cells] an occluder's top is hidden from the fill up to this many cells
-     * from its rim cell [cells]. */
-    int shadowReach_cells = 4;
-    /** [fill_clearance] a filled cell lies no higher than its clearance (the lowest line of
-     * sight that passed over it without a return there, kept by the map's visibility stage)
-     * plus fill_clearance_margin_m: a cell the laser never hit lies below the rays over it
-     * (BoundedByClearance.h). Off by default: the lines walked for it cost about 17 % of a
-     * laser scan's insertion (doc/gap-filling.md). */
-    bool clearance = false;
-    /** [fill_clearance_margin_m] what a filled cell may lie above its clearance [m]: the ray's
-     * own error near its end point and the cell's relief under a line crossing it. */
-    double clearanceMargin_m = 0.0;
+    /** A filled cell lies no higher than its clearance (the lowest line of sight that passed
+     * over it without a return there, kept by the map's visibility stage) plus margin_m: a cell
+     * the laser never hit lies below the rays over it (BoundedByClearance.h). */
+    struct Clearance {
+        /** [fill_clearance] off by default: the lines walked for it cost about 17 % of a laser
+         * scan's insertion (doc/gap-filling.md). */
+        bool enabled = false;
+        /** [fill_clearance_margin_m] what a filled cell may lie above its clearance [m]: the
+         * ray's own error near its end point and the cell's relief under a line crossing it. */
+        double margin_m = 0.0;
+    } clearance;
+    /** A gap whose rim holds the top of a step that hides it (a shadow behind a raised edge,
+     * see ShadowOccluders.h) is filled without the step's top: from the hidden side only. */
+    struct ShadowOccluders {
+        bool enabled = true;  //!< [fill_shadow_occluders]
+        /** [fill_shadow_step_sigmas] a rim cell is an occluder when it stands above the cells
+         * across the gap by more than this many standard deviations of what their sigmas and the
+         * visible slopes explain [-]. */
+        double stepSigmas = 3.0;
+        /** [fill_shadow_reach_cells] an occluder's top is hidden from the fill up to this many
+         * cells from its rim cell [cells]. */
+        int reach_cells = 4;
+    } shadowOccluders;
     /** [fill_model_averaging] kriging only: average the fills of the m visited by the search
      * with Akaike weights exp(-dAIC/2) (and add their spread to the variance) instead of
      * keeping the single best m. */

@@ -20,17 +20,17 @@ namespace multibin::fill {
  * its inward normal (a fan of five directions within +-30 degrees; eight directions all round
  * for a cell with the gap all round it), the first measured cells beyond the gap (the median of
  * at least three) lie lower than o by a step that neither the sigmas nor the visible surfaces'
- * slopes explain: drop > shadowStepSigmas * sqrt(sigma_o^2 + sigma_f^2 + (d s)^2), d the
+ * slopes explain: drop > shadowOccluders.stepSigmas * sqrt(sigma_o^2 + sigma_f^2 + (d s)^2), d the
  * distance across [cells] and s the larger slope along the crossing of the planes fitted to the
  * 5 x 5 windows of o and of the far cell. The gap is a shadow only if there are at least
  * sqrt(gap cells) such rim cells (a strip behind its edge is at least as long as it is wide).
  * Then the fill ignores:
  *  - each occluder's top: measured cells joined to an occluder rim cell through cells above
- *    halfway down its step, within shadowReach_cells of it;
+ *    halfway down its step, within shadowOccluders.reach_cells of it;
  *  - stray returns inside the shadow: measured islands of one or two cells with nothing but the
  *    gap around them (mixed pixels between the edge and the far ground, outliers);
  *  - stray returns on the rim: rim cells off the median of their measured 8-neighbours by more
- *    than shadowStepSigmas times what the sigmas and the neighbours' spread explain. */
+ *    than shadowOccluders.stepSigmas times what the sigmas and the neighbours' spread explain. */
 struct ShadowOccluders {
     /** Raster indices of the measured cells the hidden surface's fill ignores (above); empty when
      * the gap is not a shadow behind a step. They stay measured in the map. */
@@ -39,7 +39,7 @@ struct ShadowOccluders {
 };
 
 /** Finds the occluders of gap `cells` (raster indices of one 4-connected gap of `raster`), with
- * options.shadowStepSigmas and options.shadowReach_cells. */
+ * options.shadowOccluders.stepSigmas and options.shadowOccluders.reach_cells. */
 ShadowOccluders findShadowOccluders(const HeightRaster& raster, const std::vector<int>& cells,
                                     const FillOptions& options);
 

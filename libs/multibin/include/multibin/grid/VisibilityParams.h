@@ -4,13 +4,9 @@
 #include <cstddef>
 #include <string>
 
-namespace mrpt::config {
-class CConfigFileBase;
-}
+#include "multibin/io/OptionsFwd.h"
 
 namespace multibin {
-
-class StrictConfigSection;
 
 /** Parameters of the visibility constraint. */
 struct VisibilityParams {

@@ -18,8 +18,8 @@ enum class DepthPixel : uint8_t {
 
 /** The artefacts of one depth frame, `depth_m` row-major (rows x cols), 0 where there is no
  * return (as the laser's mixed pixels and stereo's halos, removed before the points are made):
- * - flying pixels: every pixel within flyingPixelRadius_px of a jump between two 4-neighbours
- *   larger than flyingPixelJumpRelative x the nearer depth (a structured-light or time-of-flight
+ * - flying pixels: every pixel within flyingPixel.radius_px of a jump between two 4-neighbours
+ *   larger than flyingPixel.jumpRelative x the nearer depth (a structured-light or time-of-flight
  *   camera returns depths between the two surfaces there);
  * - the frame's border: pixels within borderWidth_px of the image's edge (lens distortion and
  *   the projector's pattern are least reliable there).

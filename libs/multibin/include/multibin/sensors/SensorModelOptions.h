@@ -6,14 +6,8 @@
 #include <map>
 #include <string>
 
+#include "multibin/io/OptionsFwd.h"
 #include "multibin/sensors/RangeSigmaCurve.h"
-
-namespace mrpt::config {
-class CConfigFileBase;
-}
-namespace multibin {
-class StrictConfigSection;
-}
 
 namespace multibin::sensors {
 
@@ -113,27 +107,32 @@ struct StereoModelOptions {
     std::string sgbmMode = "sgbm_3way";  //!< sgbm, hh, sgbm_3way or hh4
     /** @} */
 
-    /** Halo filter: pixels on the near side of a disparity jump larger than haloJump_px, within
-     * haloRadius_px of it (keys `stereo_halo_filter`, `stereo_halo_jump_px`,
+    /** Halo filter: pixels on the near side of a disparity jump larger than jump_px, within
+     * radius_px of it (keys `stereo_halo_filter`, `stereo_halo_jump_px`,
      * `stereo_halo_radius_px`). */
-    bool haloFilter = true;
-    double haloJump_px = 3.0;
-    int haloRadius_px = 4;
-    /** Near-cluster filter: connected regions (neighbours within nearClusterStep_px of disparity)
-     * of fewer than nearClusterMaxArea_px pixels that are nearer than their surroundings by more
-     * than nearClusterJump_px (keys `stereo_near_cluster_filter`,
-     * `stereo_near_cluster_max_area_px`, `stereo_near_cluster_step_px`,
-     * `stereo_near_cluster_jump_px`). */
-    bool nearClusterFilter = true;
-    int nearClusterMaxArea_px = 400;
-    double nearClusterStep_px = 2.0;
-    double nearClusterJump_px = 2.0;
-    /** SGBM only: pixels whose left-image grey standard deviation over a textureRadius_px window
-     * is below textureMinStd_grey have no match of their own (SGBM's smoothing carries a
-     * neighbour's disparity into them) and are removed; 0 turns it off (keys
+    struct HaloFilter {
+        bool enabled = true;
+        double jump_px = 3.0;
+        int radius_px = 4;
+    } halo;
+    /** Near-cluster filter: connected regions (neighbours within step_px of disparity) of fewer
+     * than maxArea_px pixels that are nearer than their surroundings by more than jump_px (keys
+     * `stereo_near_cluster_filter`, `stereo_near_cluster_max_area_px`,
+     * `stereo_near_cluster_step_px`, `stereo_near_cluster_jump_px`). */
+    struct NearClusterFilter {
+        bool enabled = true;
+        int maxArea_px = 400;
+        double step_px = 2.0;
+        double jump_px = 2.0;
+    } nearCluster;
+    /** SGBM only: pixels whose left-image grey standard deviation over a radius_px window is
+     * below minStd_grey have no match of their own (SGBM's smoothing carries a neighbour's
+     * disparity into them) and are removed; minStd_grey 0 turns it off (keys
      * `stereo_texture_min_std_grey`, `stereo_texture_radius_px`; doc/sensor-models.md). */
-    double textureMinStd_grey = 1.5;
-    int textureRadius_px = 2;
+    struct TextureFilter {
+        double minStd_grey = 1.5;
+        int radius_px = 2;
+    } texture;
     /** Eq 13's Delta_max for this model's points [m] (key `stereo_max_elevation_uncertainty_m`): a
      * point counts if 3 sigma_z <= it. 0: the map's max_elevation_uncertainty_m
      * (doc/sensor-reach.md). */
@@ -157,13 +156,15 @@ struct DepthModelOptions {
     double quantisationStep_per_m = 0.003;
     double frameSigmaRelative = 0.005;
     /** Depth-frame artefacts (DepthArtefacts.h; frames with a pixel grid only, not point
-     * clouds): flying pixels within flyingPixelRadius_px of a jump between neighbouring pixels
-     * larger than flyingPixelJumpRelative x the nearer depth, and the frame's border of
-     * borderWidth_px (keys `depth_flying_pixel_filter`, `depth_flying_pixel_jump_relative`,
-     * `depth_flying_pixel_radius_px`, `depth_border_px`). */
-    bool flyingPixelFilter = true;
-    double flyingPixelJumpRelative = 0.05;
-    int flyingPixelRadius_px = 1;
+     * clouds): flying pixels within radius_px of a jump between neighbouring pixels larger than
+     * jumpRelative x the nearer depth (keys `depth_flying_pixel_filter`,
+     * `depth_flying_pixel_jump_relative`, `depth_flying_pixel_radius_px`), and the frame's
+     * border of borderWidth_px (key `depth_border_px`). */
+    struct FlyingPixelFilter {
+        bool enabled = true;
+        double jumpRelative = 0.05;
+        int radius_px = 1;
+    } flyingPixel;
     int borderWidth_px = 0;
     /** Eq 13's Delta_max for this model's points [m] (key `depth_max_elevation_uncertainty_m`): a
      * point counts if 3 sigma_z <= it. 0: the map's max_elevation_uncertainty_m

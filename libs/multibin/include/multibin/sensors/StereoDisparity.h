@@ -39,24 +39,24 @@ DisparityImage computeDisparitySGBM(const mrpt::img::CImage& left, const mrpt::i
                                     const StereoModelOptions& opts);
 
 /** Halo filter: invalidates every pixel whose disparity exceeds the smallest valid disparity within
- * opts.haloRadius_px (square window) by more than opts.haloJump_px, i.e. the near side of a depth
+ * opts.halo.radius_px (square window) by more than opts.halo.jump_px, i.e. the near side of a depth
  * boundary, where block matching stretches the foreground over the background. Returns the number
  * of pixels removed. */
 size_t removeHalos(DisparityImage& disparity, const StereoModelOptions& opts);
 
 /** Near-cluster filter: 4-connected regions whose neighbouring disparities differ by at most
- * opts.nearClusterStep_px, smaller than opts.nearClusterMaxArea_px, are invalidated when their
+ * opts.nearCluster.step_px, smaller than opts.nearCluster.maxArea_px, are invalidated when their
  * mean disparity exceeds the median disparity of the valid pixels around them by more than
- * opts.nearClusterJump_px (a group of points floating in front of the scene: textureless areas,
+ * opts.nearCluster.jump_px (a group of points floating in front of the scene: textureless areas,
  * out-of-horopter matches), or when no valid pixel surrounds them. Returns the number of pixels
  * removed. */
 size_t removeNearClusters(DisparityImage& disparity, const StereoModelOptions& opts);
 
 /** Texture filter for disparities computed by SGBM from `left` (8-bit grey or colour): invalidates
- * every pixel whose grey standard deviation over the (2 opts.textureRadius_px + 1)^2 window of
- * the left image is below opts.textureMinStd_grey. Such a pixel has no match of its own; SGBM's
+ * every pixel whose grey standard deviation over the (2 opts.texture.radius_px + 1)^2 window of
+ * the left image is below opts.texture.minStd_grey. Such a pixel has no match of its own; SGBM's
  * smoothness term carries a neighbour's disparity into it. Returns the number of pixels removed
- * (none if opts.textureMinStd_grey is 0). Throws std::invalid_argument if the sizes differ. */
+ * (none if opts.texture.minStd_grey is 0). Throws std::invalid_argument if the sizes differ. */
 size_t removeTextureless(DisparityImage& disparity, const mrpt::img::CImage& left,
                          const StereoModelOptions& opts);
 

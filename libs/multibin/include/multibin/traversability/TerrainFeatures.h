@@ -14,9 +14,7 @@ namespace multibin::traversability {
  * the highest minus the lowest height, `slope` the inclination of the least-squares plane z = a
  * + b x + c y, `roughness` the RMS residual about that plane. */
 struct DiscFeatures {
-    double step_m = 0;
-    double slope_deg = 0;
-    double roughness_m = 0;
+    double step_m = 0, slope_deg = 0, roughness_m = 0;
 };
 
 /** The least-squares plane z = mh + g . ((x, y) - (mx, my)) of a disc's points, and their
@@ -99,8 +97,8 @@ struct TraversabilityLayers {
     std::vector<float> roughness_m, roughnessSigma_m;  //!< [m]
     /** P(step > max_step_m or slope > max_slope_deg or roughness > max_roughness_m) [-] */
     std::vector<float> untraversable;
-    /** P(a foot of foot_radius_m here rests on ground flat within foothold_flatness_m, with no
-     * step above max_step_m within foothold_clearance_m of it) [-] */
+    /** P(a foot of foothold.radius_m here rests on ground flat within foothold.flatness_m, with no
+     * step above max_step_m within foothold.clearance_m of it) [-] */
     std::vector<float> foothold;
 
     TraversabilityLayers() = default;

@@ -3,13 +3,7 @@
 
 #include <string>
 
-namespace mrpt::config {
-class CConfigFileBase;
-}
-
-namespace multibin {
-class StrictConfigSection;
-}
+#include "multibin/io/OptionsFwd.h"
 
 namespace multibin::traversability {
 
@@ -26,13 +20,16 @@ struct TraversabilityOptions {
     /** [max_roughness_m] a disc whose RMS residual about that plane is larger is untraversable
      * [m] */
     double max_roughness_m = 0.02;
-    /** [foot_radius_m] radius of a foot: the disc that must be flat for a foothold [m] */
-    double foot_radius_m = 0.02;
-    /** [foothold_flatness_m] largest height range under the foot of a good foothold [m] */
-    double foothold_flatness_m = 0.01;
-    /** [foothold_clearance_m] margin around the foot that must hold no step above max_step_m [m]
-     */
-    double foothold_clearance_m = 0.02;
+    /** Where a foot can rest (the foothold layer). */
+    struct Foothold {
+        /** [foot_radius_m] radius of a foot: the disc that must be flat for a foothold [m] */
+        double radius_m = 0.02;
+        /** [foothold_flatness_m] largest height range under the foot of a good foothold [m] */
+        double flatness_m = 0.01;
+        /** [foothold_clearance_m] margin around the foot that must hold no step above max_step_m
+         * [m] */
+        double clearance_m = 0.02;
+    } foothold;
     /** [samples_per_cell] surface samples per cell side (the sub-cell surface at k x k points of
      * each cell) [-] */
     int samples_per_cell = 2;
