@@ -323,6 +323,17 @@ RandomScene makeRandomScene(const RandomSceneOptions& opts) {
     sc.darkPatches = uniformInt(rng, 0, 8);
     sc.laser = cfg.laser;
     sc.laser.pose = mrpt::poses::CPose3D(0, 0, mountHeight, 0, pitchDeg * M_PI / 180, 0);
+    // The camera's mount from a stream of its own, so that the laser scenes stay as they were.
+    Rng camRng(hash64(opts.seed ^ 0x53544552u));
+    sc.stereo = cfg.stereo;
+    sc.stereo.disparity = false;  // both pipelines match the rendered pair
+    sc.stereo.height_m = uniform(camRng, 0.4, 0.55);
+    sc.stereo.pitch_rad = uniform(camRng, 30, 45) * M_PI / 180;
+    if (opts.noise == "independent") {
+        // Errors of the images that no disparity model describes (doc/random-scenes.md).
+        sc.stereo.rightRowError_px = 0.3;
+        sc.stereo.rightGain = 1.05;
+    }
     return sc;
 }
 

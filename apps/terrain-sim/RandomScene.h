@@ -4,6 +4,7 @@
 #pragma once
 
 #include "LaserSim.h"
+#include "StereoSim.h"
 #include "Terrain.h"
 #include "Trajectory.h"
 
@@ -51,6 +52,9 @@ struct RandomScene {
     std::vector<ScenePass> passes;
     LaserConfig laser;    //!< mounting height and pitch drawn; noise matched or independent
     int darkPatches = 0;  //!< black discs on the boards (texture is drawn from the seed)
+    /** The stereo camera (`--sensor stereo`): terrain-sim's rig, mounted 0.4-0.55 m high and
+     * pitched 30-45 deg down, pairs only (SGBM matches them); noise matched or independent. */
+    StereoConfig stereo;
 
     /** The terrain the sensors see in pass p: the ground with the pass's object drawn in. */
     Terrain seenIn(size_t pass) const;

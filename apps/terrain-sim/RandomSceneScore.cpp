@@ -1,9 +1,11 @@
 /* Part of the multibin elevation-mapping library: terrain-sim. */
 #include "RandomSceneScore.h"
 
+#include "NaiveStereo.h"
 #include "Scenario.h"
 #include "SurfaceTexture.h"
 
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/maps/CHeightGridMap2D.h>
 #include <mrpt/maps/CMultiBinElevationMap.h>
 #include <mrpt/maps/CSimplePointsMap.h>
@@ -249,7 +251,95 @@ void scoreQueries(const RandomScene& sc, const Regions& reg, Maps& m, RandomScen
     s.queryFloorRmse_m = floor.value();
 }
 
+/** Adds cell (x, y) of truth `truth` to `a`: what the map and the naive grid hold there. */
+void scoreStereoCell(const CMultiBinElevationMap& map, const CHeightGridMap2D& naive, double x,
+                     double y, double truth, StereoSceneScores::Area& a,
+                     std::vector<std::array<double, 6>>* cells) {
+    a.truthCells++;
+    double h, sigma;
+    const bool hasMap = map.getHeight(x, y, h, sigma);
+    const auto* c = naive.cellByPos(x, y);
+    const bool hasNaive = c && c->w > 0;
+    a.mapCells += hasMap;
+    a.naiveCells += hasNaive;
+    if (cells && (hasMap || hasNaive))
+        cells->push_back({x, y, truth, hasMap ? h : RandomSceneScores::kNaN,
+                          hasMap ? sigma : RandomSceneScores::kNaN,
+                          hasNaive ? double(c->h) : RandomSceneScores::kNaN});
+    const double kFar_m = StereoSceneScores::Area::kFar_m;
+    a.mapGood += hasMap && std::abs(h - truth) <= kFar_m;
+    a.naiveGood += hasNaive && std::abs(c->h - truth) <= kFar_m;
+    if (hasNaive && !hasMap) {
+        a.naiveOnlyCells++;
+        a.naiveOnlySumSq_m2 += (c->h - truth) * (c->h - truth);
+    }
+    if (!hasMap || !hasNaive) return;
+    a.commonCells++;
+    const double e = h - truth, en = c->h - truth;
+    a.mapSumSq_m2 += e * e;
+    a.naiveSumSq_m2 += en * en;
+    if (std::abs(e) > kFar_m) {
+        a.mapFarCells++;
+        a.mapFarSumSq_m2 += e * e;
+        a.naiveOnMapFarSumSq_m2 += en * en;
+    }
+}
+
 }  // namespace
+
+double StereoSceneScores::Area::mapRmse_m() const {
+    return commonCells ? std::sqrt(mapSumSq_m2 / commonCells) : RandomSceneScores::kNaN;
+}
+double StereoSceneScores::Area::naiveRmse_m() const {
+    return commonCells ? std::sqrt(naiveSumSq_m2 / commonCells) : RandomSceneScores::kNaN;
+}
+
+StereoSceneScores scoreRandomSceneStereo(
+    const RandomScene& sc, const std::function<void(CMultiBinElevationMap&)>& configure,
+    bool keepCells) {
+    CMultiBinElevationMap map;
+    {  // the rig's calibration sigmas, as terrain-sim writes them for its scenarios
+        ScenarioConfig rig;
+        rig.stereo = sc.stereo;
+        const mrpt::config::CConfigFileMemory ini(mapperIni(rig));
+        map.insertionOptions.loadFromConfigFile(
+            ini, "MappingApplication_multiBinElevationMap_00_insertOpts");
+    }
+    if (configure) configure(map);
+    const Terrain& g = sc.ground;
+    const double cell = map.dem_get_resolution();
+    CHeightGridMap2D naive(CHeightGridMap2D::mrSimpleAverage, g.x0_m() - 2.0, g.xMax_m() + 2.0,
+                           g.y0_m() - 2.0, g.yMax_m() + 2.0, cell);
+    StereoSceneScores s;
+    for (size_t p = 0; p < sc.passes.size(); ++p) {
+        const Terrain seen = sc.seenIn(p);
+        const SurfaceTexture texture(seen, sc.seed, sc.darkPatches);
+        const StereoSim camera(sc.stereo, seen, texture);
+        std::mt19937_64 rng(hash64((sc.seed * 1000003 + p) ^ 0x53544552u));
+        for (const Frame& f : sc.passes[p].frames) {
+            if (!f.stereo) continue;
+            const auto obs =
+                camera.observation(camera.render(f.truth, rng), syntheticStamp(f.t_s + 100.0 * p));
+            map.insertObservation(*obs, f.estimate);
+            insertNaiveStereo(naive, *obs, f.estimate.mean);
+            s.stereoFrames++;
+        }
+    }
+    const multibin::EsriAsciiGrid gt = g.groundTruth(cell);
+    const Regions reg(gt, sc.placements);
+    const double xTiles_m = g.tilesX() * g.tileSide_m(),
+                 yTiles_m = 0.5 * g.tilesY() * g.tileSide_m();
+    for (int r = 0; r < gt.rows(); ++r)
+        for (int k = 0; k < gt.cols(); ++k) {
+            const double truth = gt.heights_m(r, k);
+            if (!std::isfinite(truth) || reg.inAny(r, k)) continue;
+            const double x = gt.xllcenter_m + k * cell, y = gt.yllcenter_m + r * cell;
+            scoreStereoCell(map, naive, x, y, truth, s.raster, nullptr);
+            if (x >= 0 && x <= xTiles_m && std::abs(y) <= yTiles_m)
+                scoreStereoCell(map, naive, x, y, truth, s.boards, keepCells ? &s.cells : nullptr);
+        }
+    return s;
+}
 
 RandomSceneScores scoreRandomScene(const RandomScene& sc,
                                    const std::function<void(CMultiBinElevationMap&)>& configure) {

@@ -5,9 +5,11 @@
 
 #include "RandomScene.h"
 
+#include <array>
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <vector>
 
 namespace mrpt::maps {
 class CMultiBinElevationMap;
@@ -52,6 +54,46 @@ struct RandomSceneScores {
     double queryFloorRmse_m = kNaN;
     size_t queryPoints = 0;
 };
+
+/** Stereo only (`random-scenes --sensor stereo`): the library's map and the naive pipeline
+ * (NaiveStereo.h) fed the same rendered pairs, scored against the truth raster. */
+struct StereoSceneScores {
+    /** One scored area: cells with a truth, held by each (the map: measured cells, getHeight();
+     * the naive grid: cells with a point), and the squared errors on the cells both hold. */
+    struct Area {
+        size_t truthCells = 0, mapCells = 0, naiveCells = 0, commonCells = 0;
+        double mapSumSq_m2 = 0, naiveSumSq_m2 = 0;
+        /** Where the error sits: common cells the map has more than kFar_m off, and their part
+         * of the map's (and of the naive grid's) squared error. */
+        static constexpr double kFar_m = 0.03;
+        size_t mapFarCells = 0;
+        double mapFarSumSq_m2 = 0, naiveOnMapFarSumSq_m2 = 0;
+        /** Cells only the naive grid holds, and its squared error there: what its extra
+         * coverage is worth. Cells each holds within kFar_m of the truth (all it holds). */
+        size_t naiveOnlyCells = 0;
+        double naiveOnlySumSq_m2 = 0;
+        size_t mapGood = 0, naiveGood = 0;
+        double mapRmse_m() const;
+        double naiveRmse_m() const;
+        double mapCoverage() const { return truthCells ? double(mapCells) / truthCells : 0; }
+        double naiveCoverage() const { return truthCells ? double(naiveCells) / truthCells : 0; }
+    };
+    Area boards;  //!< the tiles (rough, textured ground), away from every placement + 1 cell
+    Area raster;  //!< the whole truth raster (flat textureless margin too), same exclusion
+    size_t stereoFrames = 0;
+    /** Per cell of `boards` either holds, when asked for: x, y, truth, map, map sigma, naive [m]
+     * (NaN where one holds nothing). */
+    std::vector<std::array<double, 6>> cells;
+};
+
+/** Renders every pass's stereo pairs (1 Hz, the scene's texture and camera, the object where it
+ * stands in that pass) and feeds them (a) to a CMultiBinElevationMap with default options and the
+ * rig's calibration sigmas (mapperIni), then `configure` if given, each pair with its frame's pose
+ * PDF, and (b) to the naive pipeline at the estimated pose, at the map's cell size. */
+StereoSceneScores scoreRandomSceneStereo(
+    const RandomScene& scene,
+    const std::function<void(mrpt::maps::CMultiBinElevationMap&)>& configure = {},
+    bool keepCells = false);
 
 /** Maps every pass of the scene (laser, 10 Hz, the pass's pose PDFs) into a
  * CMultiBinElevationMap (default options, then `configure` if given, e.g. options from an ini)

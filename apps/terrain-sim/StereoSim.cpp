@@ -29,11 +29,12 @@ double StereoSim::shade(const Eigen::Vector3d& p, const Eigen::Vector3d& n) cons
     return 255.0 * texture_->albedo(p.x(), p.y()) * (0.35 + 0.65 * std::max(0.0, n.dot(light)));
 }
 
-void StereoSim::renderView(const mrpt::poses::CPose3D& cam, cv::Mat& grey, cv::Mat& zcam) const {
+void StereoSim::renderView(const mrpt::poses::CPose3D& cam, double rowError_px, cv::Mat& grey,
+                           cv::Mat& zcam) const {
     const int W = cfg_.width_px, H = cfg_.height_px;
     // The true principal point (the observation keeps the nominal one).
     const double f = cfg_.fx_px(), cx = cfg_.cx_px() + cfg_.cxError_px,
-                 cy = cfg_.cy_px() + cfg_.cyError_px;
+                 cy = cfg_.cy_px() + cfg_.cyError_px + rowError_px;
     grey.create(H, W, CV_64F);
     zcam.create(H, W, CV_64F);
     const Eigen::Matrix3d R = cam.getRotationMatrix().asEigen();
@@ -60,8 +61,8 @@ StereoRender StereoSim::render(const mrpt::poses::CPose3D& robot, std::mt19937_6
     const double trueBaseline_m = cfg_.baseline_m + cfg_.baselineError_m;
     const mrpt::poses::CPose3D right = left + mrpt::poses::CPose3D(trueBaseline_m, 0, 0, 0, 0, 0);
     cv::Mat gl, zl, gr, zr;
-    renderView(left, gl, zl);
-    renderView(right, gr, zr);
+    renderView(left, 0.0, gl, zl);
+    renderView(right, cfg_.rightRowError_px, gr, zr);
     const int W = cfg_.width_px, H = cfg_.height_px;
     std::normal_distribution<double> gauss(0.0, 1.0);
     std::uniform_real_distribution<double> uni(0.0, 1.0);
@@ -71,7 +72,8 @@ StereoRender StereoSim::render(const mrpt::poses::CPose3D& robot, std::mt19937_6
     for (int v = 0; v < H; ++v)
         for (int u = 0; u < W; ++u) {
             const double a = gl.at<double>(v, u) + cfg_.pixelNoise_grey * gauss(rng);
-            const double b = gr.at<double>(v, u) + cfg_.pixelNoise_grey * gauss(rng);
+            const double b =
+                cfg_.rightGain * gr.at<double>(v, u) + cfg_.pixelNoise_grey * gauss(rng);
             out.left.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(std::lround(a));
             out.right.at<uint8_t>(v, u) = cv::saturate_cast<uint8_t>(std::lround(b));
         }

@@ -44,6 +44,11 @@ struct StereoConfig {
      * observation and the ini keep the nominal ones, so the map is not told. */
     double baselineError_m = 0.0;
     double cxError_px = 0.0, cyError_px = 0.0;
+    /** Errors of the images themselves (for matching on the rendered pair): the right image's
+     * rows lie this far below the left's (a rectification error) [px], and its grey levels are
+     * the left camera's times this gain (an exposure mismatch). 0 and 1: none. */
+    double rightRowError_px = 0.0;
+    double rightGain = 1.0;
 
     double fx_px() const { return 0.5 * width_px / std::tan(0.5 * hfov_rad); }
     double cx_px() const { return 0.5 * (width_px - 1); }
@@ -77,7 +82,8 @@ public:
 
 private:
     /** Renders one camera (pose in the map frame): grey image (noise-free, CV_64F) and z_cam. */
-    void renderView(const mrpt::poses::CPose3D& cam, cv::Mat& grey, cv::Mat& zcam) const;
+    void renderView(const mrpt::poses::CPose3D& cam, double rowError_px, cv::Mat& grey,
+                    cv::Mat& zcam) const;
     StereoConfig cfg_;
     const Terrain* terrain_;
     const SurfaceTexture* texture_;

@@ -24,8 +24,12 @@ namespace {
 const char* kUsage =
     "usage: random-scenes [--boards tuning|scoring] [--seeds FIRST-LAST] "
     "[--noise matched|independent|exact] [--board-dir DIR] [--ini FILE]\n"
+    "                     [--sensor laser|stereo] [--cells FILE]\n"
     "  tuning boards B, X1, W; scoring boards AC, CC, CD (doc/independent-evaluation.md)\n"
-    "  --ini: map options from FILE's section " kInsertSection " over the defaults\n";
+    "  --ini: map options from FILE's section " kInsertSection
+    " over the defaults\n"
+    "  --sensor stereo: stereo only, the map against the naive pipeline; --cells: the cells\n"
+    "    on the boards either holds (seed x y truth map sigma naive [m], nan: none) into FILE\n";
 
 struct Quantity {
     const char* name;
@@ -47,10 +51,101 @@ void record(Quantity& q, double value, bool fails, uint64_t seed) {
     if (fails) q.failing.push_back(std::to_string(seed));
 }
 
+std::string joined(const std::vector<std::string>& v) {
+    std::string out;
+    for (const auto& f : v) out += (out.empty() ? "" : " ") + f;
+    return out;
+}
+
+void printTable(const std::vector<const Quantity*>& quantities) {
+    std::printf("\n| quantity | bound | scenes | median | 90th pct | worst | failing scenes |\n");
+    std::printf("| --- | --- | ---: | ---: | ---: | ---: | --- |\n");
+    for (const Quantity* q : quantities)
+        std::printf("| %s | %s | %zu | %.3g | %.3g | %.3g | %zu: %s |\n", q->name, q->bound,
+                    q->values.size(), percentile(q->values, 0.5), percentile(q->values, 0.9),
+                    percentile(q->values, 1.0), q->failing.size(), joined(q->failing).c_str());
+}
+
+/** `--sensor stereo`: per scene the map and the naive pipeline on the cells both hold, then the
+ * distributions of the RMSE ratio and the coverage ratio (issue 38: ratio <= 0.8 in 90 % of the
+ * scenes, coverage no lower). */
+int runStereo(RandomSceneOptions opts, uint64_t first, uint64_t last,
+              const std::function<void(mrpt::maps::CMultiBinElevationMap&)>& configure,
+              const std::string& cellsFile) {
+    FILE* cells = nullptr;
+    if (!cellsFile.empty() && !(cells = std::fopen(cellsFile.c_str(), "w"))) {
+        std::fprintf(stderr, "random-scenes: error: cannot write --cells '%s'\n",
+                     cellsFile.c_str());
+        return 1;
+    }
+    Quantity ratio{
+        "stereo, boards: map RMSE / naive RMSE, cells both hold", "<= 0.8 in 90 %", {}, {}};
+    Quantity coverage{"stereo, boards: map coverage / naive coverage", ">= 1", {}, {}};
+    Quantity mapMm{"  map RMSE on the cells both hold [mm]", "-", {}, {}};
+    Quantity naiveMm{"  naive RMSE on the cells both hold [mm]", "-", {}, {}};
+    Quantity far{"  share of the map's squared error in cells > 30 mm off", "-", {}, {}};
+    Quantity good{"stereo, boards: cells within 30 mm, map / naive", "-", {}, {}};
+    Quantity naiveOnly{"  naive-only cells: share of the truth cells", "-", {}, {}};
+    Quantity naiveOnlyMm{"  naive-only cells: naive RMSE there [mm]", "-", {}, {}};
+    Quantity rasterRatio{"stereo, whole raster (flat margin too): RMSE ratio", "-", {}, {}};
+    Quantity rasterCoverage{"stereo, whole raster: coverage ratio", "-", {}, {}};
+    std::vector<std::string> failingBoth;
+    std::printf(
+        "# seed map_mm naive_mm ratio common map_cov naive_cov cov_ratio far_cells far_share "
+        "good_ratio naive_only naive_only_mm raster_ratio raster_cov_ratio frames | camera | "
+        "scene\n");
+    for (uint64_t seed = first; seed <= last; ++seed) {
+        opts.seed = seed;
+        const RandomScene sc = makeRandomScene(opts);
+        const StereoSceneScores s = scoreRandomSceneStereo(sc, configure, cells != nullptr);
+        const auto& b = s.boards;
+        const double r = b.mapRmse_m() / b.naiveRmse_m();
+        const double c = b.mapCoverage() / b.naiveCoverage();
+        const double farShare = b.mapFarSumSq_m2 / b.mapSumSq_m2;
+        const double goodRatio = double(b.mapGood) / double(b.naiveGood);
+        const double naiveOnly_mm = 1e3 * std::sqrt(b.naiveOnlySumSq_m2 / b.naiveOnlyCells);
+        const double rr = s.raster.mapRmse_m() / s.raster.naiveRmse_m();
+        const double rc = s.raster.mapCoverage() / s.raster.naiveCoverage();
+        std::printf(
+            "%lu %.2f %.2f %.3f %zu %.3f %.3f %.3f %zu %.2f %.3f %zu %.1f %.3f %.3f %zu | %.2f m "
+            "%.0f deg | "
+            "%s\n",
+            (unsigned long)seed, 1e3 * b.mapRmse_m(), 1e3 * b.naiveRmse_m(), r, b.commonCells,
+            b.mapCoverage(), b.naiveCoverage(), c, b.mapFarCells, farShare, goodRatio,
+            b.naiveOnlyCells, naiveOnly_mm, rr, rc, s.stereoFrames, sc.stereo.height_m,
+            sc.stereo.pitch_rad * 180 / M_PI, sc.describe().c_str());
+        std::fflush(stdout);
+        for (const auto& cell : s.cells)
+            std::fprintf(cells, "%lu %.4f %.4f %.5f %.5f %.5f %.5f\n", (unsigned long)seed, cell[0],
+                         cell[1], cell[2], cell[3], cell[4], cell[5]);
+        record(ratio, r, !(r <= 0.8), seed);
+        record(coverage, c, !(c >= 1), seed);
+        if (!(r <= 0.8 && c >= 1)) failingBoth.push_back(std::to_string(seed));
+        record(mapMm, 1e3 * b.mapRmse_m(), false, seed);
+        record(naiveMm, 1e3 * b.naiveRmse_m(), false, seed);
+        record(far, farShare, false, seed);
+        record(good, goodRatio, false, seed);
+        record(naiveOnly, double(b.naiveOnlyCells) / double(b.truthCells), false, seed);
+        record(naiveOnlyMm, naiveOnly_mm, false, seed);
+        record(rasterRatio, rr, false, seed);
+        record(rasterCoverage, rc, false, seed);
+    }
+    if (cells) std::fclose(cells);
+    printTable({&ratio, &coverage, &mapMm, &naiveMm, &far, &good, &naiveOnly, &naiveOnlyMm,
+                &rasterRatio, &rasterCoverage});
+    const size_t n = last - first + 1, held = n - failingBoth.size();
+    std::printf(
+        "\nstereo: %zu of %zu scenes hold both (ratio <= 0.8 and coverage no lower; bound: 90 "
+        "%%): %s; failing: %s\n",
+        held, n, 10 * held >= 9 * n ? "met" : "NOT met", joined(failingBoth).c_str());
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     std::string boards = "scoring", noise = "matched", dir = "rawlogs/terrain/littledog", ini;
+    std::string sensor = "laser", cellsFile;
     uint64_t first = 1000, last = 1049;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -63,6 +158,10 @@ int main(int argc, char** argv) {
             dir = argv[++i];
         else if (a == "--ini" && v)
             ini = argv[++i];
+        else if (a == "--sensor" && v)
+            sensor = argv[++i];
+        else if (a == "--cells" && v)
+            cellsFile = argv[++i];
         else if (a == "--seeds" && v && std::sscanf(argv[++i], "%lu-%lu", &first, &last) == 2) {
         } else {
             std::fprintf(stderr, "random-scenes: error: bad argument '%s'\n%s", a.c_str(), kUsage);
@@ -70,8 +169,12 @@ int main(int argc, char** argv) {
         }
     }
     if ((boards != "tuning" && boards != "scoring") ||
-        (noise != "matched" && noise != "independent" && noise != "exact") || last < first) {
-        std::fprintf(stderr, "random-scenes: error: bad --boards, --noise or --seeds\n%s", kUsage);
+        (noise != "matched" && noise != "independent" && noise != "exact") || last < first ||
+        (sensor != "laser" && sensor != "stereo") || (!cellsFile.empty() && sensor != "stereo")) {
+        std::fprintf(stderr,
+                     "random-scenes: error: bad --boards, --noise, --seeds or --sensor (--cells "
+                     "needs --sensor stereo)\n%s",
+                     kUsage);
         return 1;
     }
     RandomSceneOptions opts;
@@ -96,6 +199,12 @@ int main(int argc, char** argv) {
             std::string section = kInsertSection;
             map.insertionOptions.loadFromConfigFile(file, section.substr(1, section.size() - 2));
         };
+    }
+    if (sensor == "stereo") {
+        std::printf("# random-scenes --sensor stereo --boards %s --noise %s --seeds %lu-%lu%s%s\n",
+                    boards.c_str(), noise.c_str(), (unsigned long)first, (unsigned long)last,
+                    ini.empty() ? "" : " --ini ", ini.c_str());
+        return runStereo(opts, first, last, configure, cellsFile);
     }
     Quantity object{"moved object RMSE, footprint + 1 cell [mm]", "<= 15 mm in 90 %", {}, {}};
     Quantity mrptObject{"  MRPT's mean there [mm]", "-", {}, {}};
@@ -149,16 +258,8 @@ int main(int argc, char** argv) {
         record(query, q, q > 0.55, seed);
         record(queryFloor, s.queryRmse_m / s.queryFloorRmse_m, false, seed);
     }
-    std::printf("\n| quantity | bound | scenes | median | 90th pct | worst | failing scenes |\n");
-    std::printf("| --- | --- | ---: | ---: | ---: | ---: | --- |\n");
-    for (const Quantity* q : {&object, &mrptObject, &noObject, &seenAgain, &staticRatio,
-                              &staticMrpt, &filled, &query, &queryFloor}) {
-        std::string fails;
-        for (const auto& f : q->failing) fails += (fails.empty() ? "" : " ") + f;
-        std::printf("| %s | %s | %zu | %.3g | %.3g | %.3g | %zu: %s |\n", q->name, q->bound,
-                    q->values.size(), percentile(q->values, 0.5), percentile(q->values, 0.9),
-                    percentile(q->values, 1.0), q->failing.size(), fails.c_str());
-    }
+    printTable({&object, &mrptObject, &noObject, &seenAgain, &staticRatio, &staticMrpt, &filled,
+                &query, &queryFloor});
     double total = 0;
     for (const auto& kind : failingSq) total += kind[0] + kind[1];
     const char* kinds[] = {"an object bin winning beside a ground bin", "only object bins",

@@ -19,9 +19,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "NaiveStereo.h"
 #include "multibin/io/EsriAsciiGrid.h"
-#include "multibin/sensors/StereoDisparity.h"
-#include "multibin/sensors/StereoModel.h"
 
 namespace stereo_naive {
 
@@ -79,18 +78,7 @@ Score compare(const std::string& prefix, EditOptions edit, const Area& area = {}
             auto st = std::dynamic_pointer_cast<mrpt::obs::CObservationStereoImages>(obs);
             if (!st) continue;
             st->hasImageDisparity = false;
-            const auto g = multibin::sensors::StereoGeometry::fromObservation(*st);
-            const auto disp =
-                multibin::sensors::computeDisparitySGBM(st->imageLeft, st->imageRight, defaults);
-            const mrpt::poses::CPose3D cam = robot + mrpt::poses::CPose3D(st->cameraPose);
-            for (int v = 0; v < disp.height; v++)
-                for (int u = 0; u < disp.width; u++) {
-                    if (!disp.valid(u, v)) continue;
-                    const Eigen::Vector3d p = g.triangulate(u, v, disp.at(u, v));
-                    double x, y, z;
-                    cam.composePoint(p.x(), p.y(), p.z(), x, y, z);
-                    naive.insertIndividualPoint(x, y, z);
-                }
+            terrain_sim::insertNaiveStereo(naive, *st, robot, defaults);
         }
     }
 
