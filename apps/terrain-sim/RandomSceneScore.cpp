@@ -11,6 +11,7 @@
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <multibin/grid/BinGrid.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include "multibin/map/MapInternals.h"
@@ -252,12 +253,25 @@ void scoreQueries(const RandomScene& sc, const Regions& reg, Maps& m, RandomScen
 }
 
 /** Adds cell (x, y) of truth `truth` to `a`: what the map and the naive grid hold there. */
-void scoreStereoCell(const CMultiBinElevationMap& map, const CHeightGridMap2D& naive, double x,
-                     double y, double truth, StereoSceneScores::Area& a,
+/** The map's measured height at (x, y), or (the control) a second naive grid's mean. */
+struct StereoMapSide {
+    const CMultiBinElevationMap& map;
+    const CHeightGridMap2D* naiveAsMap;
+    bool height(double x, double y, double& h, double& sigma) const {
+        if (!naiveAsMap) return map.getHeight(x, y, h, sigma);
+        const auto* c = naiveAsMap->cellByPos(x, y);
+        h = c ? c->h : 0;
+        sigma = RandomSceneScores::kNaN;
+        return c && c->w > 0;
+    }
+};
+
+void scoreStereoCell(const StereoMapSide& map, const CHeightGridMap2D& naive, double x, double y,
+                     double truth, bool besideStep, StereoSceneScores::Area& a,
                      std::vector<std::array<double, 6>>* cells) {
     a.truthCells++;
     double h, sigma;
-    const bool hasMap = map.getHeight(x, y, h, sigma);
+    const bool hasMap = map.height(x, y, h, sigma);
     const auto* c = naive.cellByPos(x, y);
     const bool hasNaive = c && c->w > 0;
     a.mapCells += hasMap;
@@ -278,6 +292,11 @@ void scoreStereoCell(const CMultiBinElevationMap& map, const CHeightGridMap2D& n
     const double e = h - truth, en = c->h - truth;
     a.mapSumSq_m2 += e * e;
     a.naiveSumSq_m2 += en * en;
+    if (besideStep) {
+        a.stepCells++;
+        a.mapStepSumSq_m2 += e * e;
+        a.naiveStepSumSq_m2 += en * en;
+    }
     if (std::abs(e) > kFar_m) {
         a.mapFarCells++;
         a.mapFarSumSq_m2 += e * e;
@@ -285,7 +304,27 @@ void scoreStereoCell(const CMultiBinElevationMap& map, const CHeightGridMap2D& n
     }
 }
 
+/** Whether two cells within 2 of cell (r, k) (5 x 5) have truths more than `step_m` apart: a
+ * step of the truth, or its 2 cells beyond, where a drop's occluded side lies. */
+bool besideStep(const multibin::EsriAsciiGrid& gt, int r, int k, double step_m) {
+    float lo = gt.heights_m(r, k), hi = lo;
+    for (int dr = -2; dr <= 2; ++dr)
+        for (int dk = -2; dk <= 2; ++dk) {
+            const int rr = r + dr, kk = k + dk;
+            if (rr < 0 || kk < 0 || rr >= gt.rows() || kk >= gt.cols()) continue;
+            lo = std::min(lo, gt.heights_m(rr, kk));
+            hi = std::max(hi, gt.heights_m(rr, kk));
+        }
+    return hi - lo > step_m;
+}
+
 }  // namespace
+
+double StereoSceneScores::Area::ratioOffSteps() const {
+    const double n = double(commonCells - stepCells);
+    return std::sqrt((mapSumSq_m2 - mapStepSumSq_m2) / n) /
+           std::sqrt((naiveSumSq_m2 - naiveStepSumSq_m2) / n);
+}
 
 double StereoSceneScores::Area::mapRmse_m() const {
     return commonCells ? std::sqrt(mapSumSq_m2 / commonCells) : RandomSceneScores::kNaN;
@@ -296,7 +335,7 @@ double StereoSceneScores::Area::naiveRmse_m() const {
 
 StereoSceneScores scoreRandomSceneStereo(
     const RandomScene& sc, const std::function<void(CMultiBinElevationMap&)>& configure,
-    bool keepCells) {
+    bool keepCells, bool naiveAsMap) {
     CMultiBinElevationMap map;
     {  // the rig's calibration sigmas, as terrain-sim writes them for its scenarios
         ScenarioConfig rig;
@@ -308,8 +347,11 @@ StereoSceneScores scoreRandomSceneStereo(
     if (configure) configure(map);
     const Terrain& g = sc.ground;
     const double cell = map.dem_get_resolution();
-    CHeightGridMap2D naive(CHeightGridMap2D::mrSimpleAverage, g.x0_m() - 2.0, g.xMax_m() + 2.0,
-                           g.y0_m() - 2.0, g.yMax_m() + 2.0, cell);
+    auto meanGrid = [&] {
+        return CHeightGridMap2D(CHeightGridMap2D::mrSimpleAverage, g.x0_m() - 2.0, g.xMax_m() + 2.0,
+                                g.y0_m() - 2.0, g.yMax_m() + 2.0, cell);
+    };
+    CHeightGridMap2D naive = meanGrid(), naiveCopy = meanGrid();  // the copy: the control's map
     StereoSceneScores s;
     for (size_t p = 0; p < sc.passes.size(); ++p) {
         const Terrain seen = sc.seenIn(p);
@@ -320,13 +362,17 @@ StereoSceneScores scoreRandomSceneStereo(
             if (!f.stereo) continue;
             const auto obs =
                 camera.observation(camera.render(f.truth, rng), syntheticStamp(f.t_s + 100.0 * p));
-            map.insertObservation(*obs, f.estimate);
+            if (naiveAsMap)
+                insertNaiveStereo(naiveCopy, *obs, f.estimate.mean);
+            else
+                map.insertObservation(*obs, f.estimate);
             insertNaiveStereo(naive, *obs, f.estimate.mean);
             s.stereoFrames++;
         }
     }
     const multibin::EsriAsciiGrid gt = g.groundTruth(cell);
     const Regions reg(gt, sc.placements);
+    const StereoMapSide side{map, naiveAsMap ? &naiveCopy : nullptr};
     const double xTiles_m = g.tilesX() * g.tileSide_m(),
                  yTiles_m = 0.5 * g.tilesY() * g.tileSide_m();
     for (int r = 0; r < gt.rows(); ++r)
@@ -334,9 +380,11 @@ StereoSceneScores scoreRandomSceneStereo(
             const double truth = gt.heights_m(r, k);
             if (!std::isfinite(truth) || reg.inAny(r, k)) continue;
             const double x = gt.xllcenter_m + k * cell, y = gt.yllcenter_m + r * cell;
-            scoreStereoCell(map, naive, x, y, truth, s.raster, nullptr);
+            const bool step = besideStep(gt, r, k, StereoSceneScores::Area::kStep_m);
+            scoreStereoCell(side, naive, x, y, truth, step, s.raster, nullptr);
             if (x >= 0 && x <= xTiles_m && std::abs(y) <= yTiles_m)
-                scoreStereoCell(map, naive, x, y, truth, s.boards, keepCells ? &s.cells : nullptr);
+                scoreStereoCell(side, naive, x, y, truth, step, s.boards,
+                                keepCells ? &s.cells : nullptr);
         }
     return s;
 }

@@ -73,6 +73,14 @@ struct StereoSceneScores {
         size_t naiveOnlyCells = 0;
         double naiveOnlySumSq_m2 = 0;
         size_t mapGood = 0, naiveGood = 0;
+        /** Common cells within 2 cells of a step of the truth (truths more than kStep_m apart
+         * within 5 x 5 cells: the boards' edges, drops between tiles, steep rock), and both
+         * squared errors there. */
+        static constexpr double kStep_m = 0.1;
+        size_t stepCells = 0;
+        double mapStepSumSq_m2 = 0, naiveStepSumSq_m2 = 0;
+        /** The RMSE ratio on the common cells away from such steps. */
+        double ratioOffSteps() const;
         double mapRmse_m() const;
         double naiveRmse_m() const;
         double mapCoverage() const { return truthCells ? double(mapCells) / truthCells : 0; }
@@ -89,11 +97,13 @@ struct StereoSceneScores {
 /** Renders every pass's stereo pairs (1 Hz, the scene's texture and camera, the object where it
  * stands in that pass) and feeds them (a) to a CMultiBinElevationMap with default options and the
  * rig's calibration sigmas (mapperIni), then `configure` if given, each pair with its frame's pose
- * PDF, and (b) to the naive pipeline at the estimated pose, at the map's cell size. */
+ * PDF, and (b) to the naive pipeline at the estimated pose, at the map's cell size. `keepCells`
+ * fills StereoSceneScores::cells; `naiveAsMap` is a control: the naive pipeline stands in for
+ * the map too, so that a check of the bound can be seen to fail. */
 StereoSceneScores scoreRandomSceneStereo(
     const RandomScene& scene,
     const std::function<void(mrpt::maps::CMultiBinElevationMap&)>& configure = {},
-    bool keepCells = false);
+    bool keepCells = false, bool naiveAsMap = false);
 
 /** Maps every pass of the scene (laser, 10 Hz, the pass's pose PDFs) into a
  * CMultiBinElevationMap (default options, then `configure` if given, e.g. options from an ini)
