@@ -6,6 +6,7 @@
 #include "RandomScene.h"
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <limits>
@@ -79,8 +80,9 @@ struct StereoSceneScores {
         static constexpr double kStep_m = 0.1;
         size_t stepCells = 0;
         double mapStepSumSq_m2 = 0, naiveStepSumSq_m2 = 0;
-        /** The RMSE ratio on the common cells away from such steps. */
+        /** The RMSE ratio on the common cells away from such steps, and on them. */
         double ratioOffSteps() const;
+        double ratioOnSteps() const { return std::sqrt(mapStepSumSq_m2 / naiveStepSumSq_m2); }
         double mapRmse_m() const;
         double naiveRmse_m() const;
         double mapCoverage() const { return truthCells ? double(mapCells) / truthCells : 0; }
