@@ -68,7 +68,7 @@ TEST(RandomScenesStereo, TheBoundFailsForTheNaivePipelineAndWithoutTheTextureFil
     const StereoSceneScores naive = scoreRandomSceneStereo(sc, {}, false, /*naiveAsMap=*/true);
     EXPECT_NEAR(rmseRatio(naive), 1.0, 1e-12);
     const StereoSceneScores noTexture = scoreRandomSceneStereo(
-        sc, [](auto& map) { map.insertionOptions.sensors.stereo.textureMinStd_grey = 0; });
+        sc, [](auto& map) { map.insertionOptions.sensors.stereo.texture.minStd_grey = 0; });
     std::printf("texture filter off: ratio %.3f\n", rmseRatio(noTexture));
     EXPECT_GT(rmseRatio(noTexture), 0.8);
 }
