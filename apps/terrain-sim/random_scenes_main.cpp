@@ -182,12 +182,18 @@ int main(int argc, char** argv) {
         }
     }
     if ((boards != "tuning" && boards != "scoring") ||
-        (noise != "matched" && noise != "independent" && noise != "exact") || last < first ||
-        (sensor != "laser" && sensor != "stereo") || (!cellsFile.empty() && sensor != "stereo")) {
+        (noise != "matched" && noise != "independent" && noise != "exact") || last < first) {
+        std::fprintf(stderr, "random-scenes: error: bad --boards, --noise or --seeds\n%s", kUsage);
+        return 1;
+    }
+    if (sensor != "laser" && sensor != "stereo") {
         std::fprintf(stderr,
-                     "random-scenes: error: bad --boards, --noise, --seeds or --sensor (--cells "
-                     "needs --sensor stereo)\n%s",
-                     kUsage);
+                     "random-scenes: error: --sensor must be laser or stereo (got '%s')\n%s",
+                     sensor.c_str(), kUsage);
+        return 1;
+    }
+    if (!cellsFile.empty() && sensor != "stereo") {
+        std::fprintf(stderr, "random-scenes: error: --cells needs --sensor stereo\n%s", kUsage);
         return 1;
     }
     RandomSceneOptions opts;
