@@ -245,9 +245,12 @@ void OutputFolder::moveIn(const std::string& name, const std::string& file) cons
 MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
     MapLayers m;
     m.m_map = &map;
-    m.tiled[0] = multibin::tiledLayer(map, Layer::Height);
-    for (int i = 1; i < 4; i++)
-        m.tiled[i] = multibin::tiledLayer(map, kLayers[i], &m.tiled[0].tiles);
+    // Height, sigma and source read once (one query per known cell) for every output that
+    // scales with the route; the certainty (a surface per cell more) only if an output asks.
+    const std::vector<multibin::TiledRaster> read =
+        multibin::knownLayers(map, {Layer::Height, Layer::Sigma, Layer::Source});
+    m.tiled[0] = read[0], m.tiled[1] = read[1], m.tiled[3] = read[2];
+    m.tiled[2] = multibin::tiledLayer(map, Layer::Certainty, &m.tiled[0].tiles);
     m.cells = multibin::knownWindow(m.tiled[0], kMargin_cells);
     return m;
 }
@@ -352,8 +355,10 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
                     options.back().epsg = sel.epsg;
                     options.back().description = multibin::layerPreviewStyle(kLayers[i]).title;
                 }
+            std::vector<multibin::TiledRaster> rasters;
+            for (const Layer l : chosen) rasters.push_back(layers.tiled[int(l)]);
             multibin::writeSparseGeoTiffs(
-                multibin::tiledLayers(map, chosen, &layers.tiled[0].tiles), names, options,
+                rasters, names, options,
                 [&](size_t k, const std::function<bool(const std::string&)>& write) {
                     folder.writeWith(names[k], write);
                 });
@@ -365,7 +370,9 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
         steps.emplace_back("elevation.3Dscene", [&] {
             mrpt::opengl::COpenGLScene scene;
             auto obj = mrpt::opengl::CSetOfObjects::Create();
-            multibin::buildTerrainView(map, sel.sceneColouring, *obj);
+            multibin::buildTerrainView(
+                layers.tiled[0], layers.tiled[int(multibin::layerShownBy(sel.sceneColouring))],
+                map.mapOrigin(), sel.sceneColouring, *obj);
             scene.insert(obj);
             multibin::frameTerrainScene(scene);  // opens framed in SceneViewer3D
             folder.write("elevation.3Dscene", gzSerialized(scene));
@@ -373,8 +380,9 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
     if (sel.png)
         steps.emplace_back("elevation_{height,sigma,source}.png", [&] {
             const std::vector<Layer> shown{Layer::Height, Layer::Sigma, Layer::Source};
-            const auto png = multibin::layerPreviewPngs(
-                multibin::tiledLayers(map, shown, &layers.tiled[0].tiles), shown, layers.cells);
+            std::vector<multibin::TiledRaster> rasters;
+            for (const Layer l : shown) rasters.push_back(layers.tiled[int(l)]);
+            const auto png = multibin::layerPreviewPngs(rasters, shown, layers.cells);
             for (size_t i = 0; i < shown.size(); i++)
                 folder.write(std::string("elevation_") + multibin::mapLayerName(shown[i]) + ".png",
                              png[i]);

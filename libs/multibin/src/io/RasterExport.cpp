@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <iomanip>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -16,10 +18,17 @@
 #include <stdexcept>
 
 #include "multibin/io/OutputFile.h"
+#include "multibin/io/RunDeflate.h"
 
 namespace multibin {
 
 ColourLut colourLut(int colormap) {
+    // OpenCV builds a colour map's table by interpolation on each call (0.6 M instructions):
+    // each map's table is made once.
+    static std::mutex mutex;
+    static std::map<int, ColourLut> made;
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (const auto it = made.find(colormap); it != made.end()) return it->second;
     cv::Mat ramp(1, 256, CV_8UC1), bgr;
     for (int i = 0; i < 256; i++) ramp.at<uint8_t>(0, i) = uint8_t(i);
     cv::applyColorMap(ramp, bgr, colormap);
@@ -28,7 +37,7 @@ ColourLut colourLut(int colormap) {
         const cv::Vec3b c = bgr.at<cv::Vec3b>(0, i);
         lut[size_t(i)] = {c[2], c[1], c[0]};
     }
-    return lut;
+    return made[colormap] = lut;
 }
 
 RasterBox knownBox(const EsriAsciiGrid& raster, int margin_cells) {
@@ -168,18 +177,25 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
                const ColourOf& colourOf) {
     const int rows = raster.rows(), cols = raster.cols();
     // Each sample's colour once, row by row (the raster is column-major), then copied to its
-    // pixels: the panel is the preview's largest part.
+    // pixels through the column of each pixel, found once: the panel is the preview's largest
+    // part, and a row of samples drawn again (scale > 1) is a copy of the row above.
+    std::vector<int> columnOf(static_cast<size_t>(panel.width));
+    for (int px = 0; px < panel.width; px++)
+        columnOf[size_t(px)] = std::min(cols - 1, int(px / scale));
     std::vector<cv::Vec3b> rowColours(static_cast<size_t>(cols));
     int colouredRow = -1;
     for (int py = 0; py < panel.height; py++) {
         const int r = rows - 1 - std::min(rows - 1, int(py / scale));  // north up
-        if (r != colouredRow) {
-            for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
-            colouredRow = r;
-        }
         cv::Vec3b* pixel = img.ptr<cv::Vec3b>(panel.y + py) + panel.x;
+        if (r == colouredRow) {
+            const cv::Vec3b* above = img.ptr<cv::Vec3b>(panel.y + py - 1) + panel.x;
+            std::copy(above, above + panel.width, pixel);
+            continue;
+        }
+        for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
+        colouredRow = r;
         for (int px = 0; px < panel.width; px++)
-            pixel[px] = rowColours[size_t(std::min(cols - 1, int(px / scale)))];
+            pixel[px] = rowColours[size_t(columnOf[size_t(px)])];
     }
 }
 
@@ -290,9 +306,11 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     cv::rectangle(img, {bx, legendBottom}, {bx + 16, legendBottom + 16}, kBlack);
     text(img, "unknown", {bx + 24, legendBottom + 13});
 
-    std::vector<uint8_t> bytes;
-    if (!cv::imencode(".png", img, bytes)) throw std::runtime_error("PNG encoding failed");
-    return bytes;
+    // The same pixels as cv::imencode's PNG, coded by their runs (RunDeflate.h): the previews
+    // are mostly runs of one colour, which zlib scans byte by byte.
+    cv::Mat rgb;
+    cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
+    return rgbPng(rgb.ptr<uint8_t>(0), rgb.cols, rgb.rows);
 }
 
 void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {

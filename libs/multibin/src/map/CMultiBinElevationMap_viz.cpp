@@ -32,7 +32,9 @@ namespace {
 using Layer = CMultiBinElevationMap::RasterLayer;
 using HS = CMultiBinElevationMap::HeightSource;
 
-Layer layerOf(SceneColouring c) {
+}  // namespace
+
+MapLayer layerShownBy(SceneColouring c) {
     switch (c) {
         case SceneColouring::Sigma:
             return Layer::Sigma;
@@ -44,8 +46,6 @@ Layer layerOf(SceneColouring c) {
             return Layer::Height;
     }
 }
-
-}  // namespace
 
 const std::vector<RasterCategory>& heightSourceCategories() {
     // tab10's blue, orange and green: distinct, and none is the grey of unknown cells.
@@ -64,15 +64,16 @@ SceneColouring sceneColouringFromName(const std::string& name) {
                                 "' (known: height, sigma, certainty, source)");
 }
 
-const char* sceneColouringName(SceneColouring c) { return mapLayerName(layerOf(c)); }
+const char* sceneColouringName(SceneColouring c) { return mapLayerName(layerShownBy(c)); }
 
 namespace {
 
 /** The rasters a view is drawn from: the heights and the colouring layer, block-reduced to at
  * most kPreviewMaxSide_px a side, relative to the map origin. */
-std::vector<EsriAsciiGrid> viewRasters(const CMultiBinElevationMap& map, Layer shown) {
+std::vector<EsriAsciiGrid> viewRasters(const TiledRaster& heights, const TiledRaster& values,
+                                       Layer shown) {
     // Read tile by tile, one vertex per cell up to kPreviewMaxSide_px a side, else per block.
-    std::vector<TiledRaster> layers = tiledLayers(map, {Layer::Height, shown});
+    std::vector<TiledRaster> layers{heights, values};
     for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
     const CellWindow box = knownWindow(layers[0], 1);
     return blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px),
@@ -135,7 +136,7 @@ std::vector<mrpt::opengl::CMesh::Ptr> terrainMeshes(const EsriAsciiGrid& heights
                                                     const EsriAsciiGrid& values,
                                                     SceneColouring colouring, const ViewRanges& r) {
     const int nx = heights.cols(), ny = heights.rows();
-    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    const ColourLut lut = colourLut(layerPreviewStyle(layerShownBy(colouring)).colormap);
     const auto known = [&](int ix, int iy) { return std::isfinite(heights.heights_m(iy, ix)); };
     std::vector<mrpt::opengl::CMesh::Ptr> meshes;
     for (int y0 = 0; y0 < ny - 1; y0 += kSceneTile_cells)
@@ -194,7 +195,7 @@ mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
                     return true;
         return false;
     };
-    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    const ColourLut lut = colourLut(layerPreviewStyle(layerShownBy(colouring)).colormap);
     auto points = mrpt::opengl::CPointCloudColoured::Create();
     points->setName("cells outside the mesh");
     points->setPointSize(2);
@@ -270,7 +271,7 @@ LegendFrame legendFrame(const EsriAsciiGrid& heights, const ViewRanges& r) {
 mrpt::opengl::CMesh::Ptr colourBar(const LegendFrame& f, SceneColouring colouring) {
     constexpr int kSteps = 64, kRows = kSteps + 2;
     const double step_m = f.height_m / (kSteps - 1);
-    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    const ColourLut lut = colourLut(layerPreviewStyle(layerShownBy(colouring)).colormap);
     mrpt::math::CMatrixDynamic<float> Z(2, kRows), mask(2, kRows);
     Z.setZero(), mask.fill(1.f);
     mrpt::img::CImage texture(kRows, 2, mrpt::img::CH_RGB);
@@ -349,12 +350,20 @@ mrpt::math::TVector3D TerrainViewDirection::up() const {
 
 void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring,
                       mrpt::opengl::CSetOfObjects& out) {
-    const std::vector<EsriAsciiGrid> rasters = viewRasters(map, layerOf(colouring));
+    const std::vector<TiledRaster> layers =
+        knownLayers(map, {Layer::Height, layerShownBy(colouring)});
+    buildTerrainView(layers[0], layers[1], map.mapOrigin(), colouring, out);
+}
+
+void buildTerrainView(const TiledRaster& heightLayer, const TiledRaster& shownLayer,
+                      const mrpt::math::TPoint2D& origin, SceneColouring colouring,
+                      mrpt::opengl::CSetOfObjects& out) {
+    const std::vector<EsriAsciiGrid> rasters =
+        viewRasters(heightLayer, shownLayer, layerShownBy(colouring));
     const EsriAsciiGrid &heights = rasters[0], &values = rasters[1];
     if (heights.cols() < 2 || heights.rows() < 2) return;
     // Built relative to the map origin and placed at it, so the view's floats stay small at
     // georeferenced coordinates.
-    const mrpt::math::TPoint2D origin = map.mapOrigin();
     auto placed = mrpt::opengl::CSetOfObjects::Create();
     placed->setName("map origin");
     placed->setLocation(origin.x, origin.y, 0);

@@ -1,0 +1,24 @@
+/* Part of the multibin elevation-mapping library. */
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace multibin {
+
+/** A zlib stream (RFC 1950) of `size` bytes that codes only runs: stretches where every byte
+ * equals the one `period` bytes before (a pixel or a float sample repeated) or, when rowBytes is
+ * given (at most 32768), the one a row before (a row repeated); other bytes are literals. One
+ * DEFLATE block (RFC 1951) with Huffman codes fitted to the symbols. For rasters that are mostly
+ * runs (previews of a sparse map, GeoTIFF tiles mostly NaN): the files are about the size zlib
+ * makes at its fastest level, for a cost that follows the runs, not the bytes (a general
+ * compressor hashes or scans every byte for matches these rasters do not have). period 1 to 8. */
+std::vector<uint8_t> runDeflateZlib(const uint8_t* data, size_t size, int period,
+                                    size_t rowBytes = 0);
+
+/** A PNG file (8-bit RGB, scanlines unfiltered) of `rows` x `cols` pixels given as contiguous
+ * R, G, B bytes, compressed by runDeflateZlib(): decoders read back exactly these pixels. */
+std::vector<uint8_t> rgbPng(const uint8_t* rgb, int cols, int rows);
+
+}  // namespace multibin
