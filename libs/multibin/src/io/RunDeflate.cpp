@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <memory>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -29,8 +30,15 @@ constexpr int kDistBase[30] = {1,    2,    3,    4,    5,    7,    9,    13,    
 constexpr int kDistExtra[30] = {0, 0, 0, 0, 1, 1, 2, 2,  3,  3,  4,  4,  5,  5,  6,
                                 6, 7, 7, 8, 8, 9, 9, 10, 10, 11, 11, 12, 12, 13, 13};
 
-int lengthCode(int len) {  // index into kLengthBase
-    return int(std::upper_bound(kLengthBase, kLengthBase + 29, len) - kLengthBase) - 1;
+int lengthCode(int len) {  // index into kLengthBase, by a table made once
+    static const std::array<uint8_t, kMaxMatch + 1> table = [] {
+        std::array<uint8_t, kMaxMatch + 1> t{};
+        for (int l = kMinMatch; l <= kMaxMatch; l++)
+            t[size_t(l)] =
+                uint8_t(std::upper_bound(kLengthBase, kLengthBase + 29, l) - kLengthBase - 1);
+        return t;
+    }();
+    return table[size_t(len)];
 }
 int distCode(int dist) {
     return int(std::upper_bound(kDistBase, kDistBase + 30, dist) - kDistBase) - 1;
@@ -39,6 +47,11 @@ int distCode(int dist) {
 /** Adler-32 kept as its two sums, updated by bytes or, in O(period), by a periodic run. */
 struct Adler {
     uint64_t a = 1, b = 0;
+    void byte(uint8_t v) {
+        a += v, b += a;
+        if (a >= kAdlerMod) a -= kAdlerMod;
+        b %= kAdlerMod;
+    }
     void bytes(const uint8_t* p, size_t n) {
         const uLong v = adler32_z(uLong((b << 16) | a), p, n);
         a = v & 0xffff, b = v >> 16;
@@ -232,16 +245,15 @@ void put32be(std::vector<uint8_t>& out, uint32_t v) {
     for (int shift = 24; shift >= 0; shift -= 8) out.push_back(uint8_t(v >> shift));
 }
 
-}  // namespace
-
-std::vector<uint8_t> runDeflateZlib(const uint8_t* data, size_t size, int period, size_t rowBytes) {
+/** The DEFLATE block of `data` into `out`, its Adler-32 into `adler` when given. */
+void deflateRuns(const uint8_t* data, size_t size, int period, size_t rowBytes, Adler* adler,
+                 std::vector<uint8_t>& out) {
     if (period < 1 || period > 8)
-        throw std::invalid_argument("runDeflateZlib: period " + std::to_string(period) +
+        throw std::invalid_argument("runDeflate: period " + std::to_string(period) +
                                     " outside 1..8");
     if (rowBytes > size_t(kMaxDistance) || rowBytes <= size_t(period)) rowBytes = 0;
     Tokens t;
     t.list.reserve(size / 64 + 16);
-    Adler adler;
     const size_t d = size_t(period);
     size_t i = 0;
     while (i < size) {
@@ -252,21 +264,38 @@ std::vector<uint8_t> runDeflateZlib(const uint8_t* data, size_t size, int period
                 : 0;
         if (std::max(byPeriod, byRow) < size_t(kMinMatch)) {
             t.literal(data[i]);
-            adler.bytes(data + i, 1);
+            if (adler) adler->byte(data[i]);
             i++;
         } else if (byPeriod >= byRow) {  // the whole run at once, its checksum in O(period)
             t.run(byPeriod, period);
-            adler.periodic(data + i - d, period, byPeriod);
+            if (adler) adler->periodic(data + i - d, period, byPeriod);
             i += byPeriod;
         } else {
             t.run(byRow, int(rowBytes));
-            adler.bytes(data + i, byRow);
+            if (adler) adler->bytes(data + i, byRow);
             i += byRow;
         }
     }
-    std::vector<uint8_t> out{0x78, 0x01};  // deflate, 32 kB window, "fastest" (RFC 1950)
     writeBlock(t, out);
+}
+
+}  // namespace
+
+std::vector<uint8_t> runDeflateZlib(const uint8_t* data, size_t size, int period, size_t rowBytes) {
+    std::vector<uint8_t> out{0x78, 0x01};  // deflate, 32 kB window, "fastest" (RFC 1950)
+    Adler adler;
+    deflateRuns(data, size, period, rowBytes, &adler, out);
     put32be(out, adler.value());
+    return out;
+}
+
+std::vector<uint8_t> runDeflateGzip(const uint8_t* data, size_t size, int period) {
+    // RFC 1952: magic, deflate, no flags, no time, fastest, unknown OS.
+    std::vector<uint8_t> out{0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 4, 0xff};
+    deflateRuns(data, size, period, 0, nullptr, out);
+    const uint32_t crc = uint32_t(crc32_z(0, data, size)), n = uint32_t(size);
+    for (const uint32_t v : {crc, n})
+        for (int shift = 0; shift < 32; shift += 8) out.push_back(uint8_t(v >> shift));
     return out;
 }
 
@@ -276,12 +305,13 @@ std::vector<uint8_t> rgbPng(const uint8_t* rgb, int cols, int rows) {
                                     std::to_string(rows) + " pixels: empty");
     // Each scanline: filter type 0 (none), then its pixels.
     const size_t rowBytes = size_t(cols) * 3 + 1;
-    std::vector<uint8_t> raw(rowBytes * size_t(rows));
+    const size_t size = rowBytes * size_t(rows);
+    const std::unique_ptr<uint8_t[]> raw(new uint8_t[size]);  // written whole below
     for (size_t r = 0; r < size_t(rows); r++) {
         raw[r * rowBytes] = 0;
         std::memcpy(&raw[r * rowBytes + 1], rgb + r * (rowBytes - 1), rowBytes - 1);
     }
-    const std::vector<uint8_t> z = runDeflateZlib(raw.data(), raw.size(), 3, rowBytes);
+    const std::vector<uint8_t> z = runDeflateZlib(raw.get(), size, 3, rowBytes);
     std::vector<uint8_t> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     const auto chunk = [&](const char* type, const uint8_t* body, size_t n) {
         put32be(png, uint32_t(n));

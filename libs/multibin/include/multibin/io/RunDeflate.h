@@ -17,6 +17,10 @@ namespace multibin {
 std::vector<uint8_t> runDeflateZlib(const uint8_t* data, size_t size, int period,
                                     size_t rowBytes = 0);
 
+/** The same coding as a gzip file (RFC 1952; what zlib's gzread and MRPT's CFileGZInputStream
+ * read), without row matches. */
+std::vector<uint8_t> runDeflateGzip(const uint8_t* data, size_t size, int period);
+
 /** A PNG file (8-bit RGB, scanlines unfiltered) of `rows` x `cols` pixels given as contiguous
  * R, G, B bytes, compressed by runDeflateZlib(): decoders read back exactly these pixels. */
 std::vector<uint8_t> rgbPng(const uint8_t* rgb, int cols, int rows);
