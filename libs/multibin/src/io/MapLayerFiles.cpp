@@ -31,16 +31,26 @@ const char* mapLayerName(MapLayer layer) {
     }
 }
 
-std::vector<TiledRaster> tiledLayers(const CMultiBinElevationMap& map,
-                                     const std::vector<MapLayer>& layers,
-                                     const std::vector<CellWindow>* tiles) {
+namespace {
+
+/** A raster of the map's lattice in the frame of the robot poses, over `tiles`, without samples. */
+TiledRaster rasterFrame(const CMultiBinElevationMap& map, std::vector<CellWindow> tiles) {
     TiledRaster t;
     t.cellSize_m = map.dem_get_resolution();
     const mrpt::math::TPoint2D origin = map.mapOrigin();
     t.originX_m = origin.x;
     t.originY_m = origin.y;
     t.tileCells = kGeoTiffTile;
-    t.tiles = tiles ? *tiles : map.occupiedTiles(kGeoTiffTile);
+    t.tiles = std::move(tiles);
+    return t;
+}
+
+}  // namespace
+
+std::vector<TiledRaster> tiledLayers(const CMultiBinElevationMap& map,
+                                     const std::vector<MapLayer>& layers,
+                                     const std::vector<CellWindow>* tiles) {
+    const TiledRaster t = rasterFrame(map, tiles ? *tiles : map.occupiedTiles(kGeoTiffTile));
     struct LastWindow {
         CellWindow window;
         std::vector<EsriAsciiGrid> rasters;  // empty until the first read
@@ -86,6 +96,7 @@ struct SparseCells {
  * (BinStore::kTileCells a side) at a time, grouped by the rasters' tiles of `tileCells`. */
 std::shared_ptr<const SparseCells> readSparseCells(const CMultiBinElevationMap& map,
                                                    const std::vector<MapLayer>& layers,
+                                                   const std::vector<CellWindow>& storeTiles,
                                                    int tileCells) {
     auto cells = std::make_shared<SparseCells>();
     cells->layers = layers.size();
@@ -96,16 +107,21 @@ std::shared_ptr<const SparseCells> readSparseCells(const CMultiBinElevationMap& 
     };
     std::vector<Cell> found;
     std::vector<float> values;
-    for (const CellWindow& w : map.occupiedTiles(BinStore::kTileCells)) {
+    std::vector<const float*> layer(layers.size());
+    for (const CellWindow& w : storeTiles) {
         const std::vector<EsriAsciiGrid> g = map.toRasters(layers, w);
-        for (int r = 0; r < w.ny; r++)
-            for (int c = 0; c < w.nx; c++) {
-                bool any = false;
-                for (const EsriAsciiGrid& l : g) any = any || std::isfinite(l.heights_m(r, c));
+        for (size_t k = 0; k < g.size(); k++) layer[k] = g[k].heights_m.data();
+        // Column-major: sample (r, c) at r + c ny. toRasters() writes every layer of a known
+        // cell, so a cell whose first layer is unknown is mostly skipped at once.
+        for (int c = 0; c < w.nx; c++)
+            for (int r = 0; r < w.ny; r++) {
+                const size_t at = size_t(r) + size_t(c) * size_t(w.ny);
+                bool any = std::isfinite(layer[0][at]);
+                for (size_t k = 1; k < layer.size() && !any; k++) any = std::isfinite(layer[k][at]);
                 if (!any) continue;
                 found.push_back({tileOfCell(w.ix0 + c, w.iy0 + r, tileCells), w.ix0 + c, w.iy0 + r,
                                  values.size()});
-                for (const EsriAsciiGrid& l : g) values.push_back(l.heights_m(r, c));
+                for (const float* l : layer) values.push_back(l[at]);
             }
     }
     // By raster tile (south to north, west to east, as occupiedTiles() lists them), then row by
@@ -132,8 +148,23 @@ std::shared_ptr<const SparseCells> readSparseCells(const CMultiBinElevationMap& 
 std::vector<TiledRaster> knownLayers(const CMultiBinElevationMap& map,
                                      const std::vector<MapLayer>& layers,
                                      const std::vector<CellWindow>* tiles) {
-    std::vector<TiledRaster> out = tiledLayers(map, layers, tiles);  // the frame and the tiles
-    const auto cells = readSparseCells(map, layers, kGeoTiffTile);
+    // The store's tiles holding data, read; the rasters' tiles (those that hold one, as
+    // occupiedTiles(kGeoTiffTile) lists them, south to north) found from them.
+    const std::vector<CellWindow> store = map.occupiedTiles(BinStore::kTileCells);
+    std::vector<CellWindow> rasterTiles;
+    if (tiles) {
+        rasterTiles = *tiles;
+    } else {
+        for (const CellWindow& w : store)
+            rasterTiles.push_back(tileOfCell(w.ix0, w.iy0, kGeoTiffTile));
+        std::sort(rasterTiles.begin(), rasterTiles.end(),
+                  [](const CellWindow& a, const CellWindow& b) {
+                      return std::tie(a.iy0, a.ix0) < std::tie(b.iy0, b.ix0);
+                  });
+        rasterTiles.erase(std::unique(rasterTiles.begin(), rasterTiles.end()), rasterTiles.end());
+    }
+    std::vector<TiledRaster> out(layers.size(), rasterFrame(map, rasterTiles));
+    const auto cells = readSparseCells(map, layers, store, kGeoTiffTile);
     for (size_t k = 0; k < out.size(); k++) {
         TiledRaster& t = out[k];
         const double cs = t.cellSize_m, x0 = t.originX_m, y0 = t.originY_m;

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <limits>
@@ -192,8 +193,12 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
             std::copy(above, above + panel.width, pixel);
             continue;
         }
-        for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
         colouredRow = r;
+        if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place
+            for (int c = 0; c < cols; c++) pixel[c] = colourOf(raster.heights_m(r, c));
+            continue;
+        }
+        for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
         for (int px = 0; px < panel.width; px++)
             pixel[px] = rowColours[size_t(columnOf[size_t(px)])];
     }
@@ -218,14 +223,14 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     const int H = std::max(1, int(std::lround(rows * scale)));
     const int L = 70, T = 34, R = 170, B = 70;
     const int panelH = std::max(H, 280);
-    cv::Mat img(panelH + T + B, W + L + R, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::Mat img(panelH + T + B, W + L + R, CV_8UC3);
+    std::memset(img.data, 255, img.total() * img.elemSize());  // white (Mat's fill goes per pixel)
 
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (int r = 0; r < rows; r++)
-        for (int c = 0; c < cols; c++) {
-            const float v = raster.heights_m(r, c);
-            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-        }
+    for (Eigen::Index i = 0; i < raster.heights_m.size(); i++) {
+        const float v = raster.heights_m.data()[i];
+        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
     if (!(lo <= hi)) lo = hi = 0;
     const float span = hi > lo ? hi - lo : 1.f;
     const ColourLut lut = colourLut(style.colormap);
