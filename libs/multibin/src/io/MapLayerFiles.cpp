@@ -112,13 +112,11 @@ std::shared_ptr<const SparseCells> readSparseCells(const CMultiBinElevationMap& 
         const std::vector<EsriAsciiGrid> g = map.toRasters(layers, w);
         for (size_t k = 0; k < g.size(); k++) layer[k] = g[k].heights_m.data();
         // Column-major: sample (r, c) at r + c ny. toRasters() writes every layer of a known
-        // cell, so a cell whose first layer is unknown is mostly skipped at once.
+        // cell or none, so the first layer tells which cells are known.
         for (int c = 0; c < w.nx; c++)
             for (int r = 0; r < w.ny; r++) {
                 const size_t at = size_t(r) + size_t(c) * size_t(w.ny);
-                bool any = std::isfinite(layer[0][at]);
-                for (size_t k = 1; k < layer.size() && !any; k++) any = std::isfinite(layer[k][at]);
-                if (!any) continue;
+                if (!std::isfinite(layer[0][at])) continue;
                 found.push_back({tileOfCell(w.ix0 + c, w.iy0 + r, tileCells), w.ix0 + c, w.iy0 + r,
                                  values.size()});
                 for (const float* l : layer) values.push_back(l[at]);

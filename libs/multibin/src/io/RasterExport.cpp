@@ -194,8 +194,12 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
             continue;
         }
         colouredRow = r;
-        if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place
-            for (int c = 0; c < cols; c++) pixel[c] = colourOf(raster.heights_m(r, c));
+        if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place,
+            // the unknown grey first (most of a sparse map's panel), then the known samples
+            std::fill(pixel, pixel + cols, colourOf(std::numeric_limits<float>::quiet_NaN()));
+            const float* sample = raster.heights_m.data() + r;  // column-major: stride `rows`
+            for (int c = 0; c < cols; c++, sample += rows)
+                if (std::isfinite(*sample)) pixel[c] = colourOf(*sample);
             continue;
         }
         for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
