@@ -243,14 +243,20 @@ void OutputFolder::moveIn(const std::string& name, const std::string& file) cons
     multibin::moveIntoPlace(file, (m_dir / name).string());
 }
 
-MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
+MapLayers MapLayers::of(const CMultiBinElevationMap& map, bool sparse) {
     MapLayers m;
     m.m_map = &map;
-    // Height, sigma and source read once (one query per known cell) for every output that
-    // scales with the route; the certainty (a surface per cell more) only if an output asks.
-    const std::vector<multibin::TiledRaster> read =
-        multibin::knownLayers(map, {Layer::Height, Layer::Sigma, Layer::Source});
-    m.tiled[0] = read[0], m.tiled[1] = read[1], m.tiled[3] = read[2];
+    if (sparse) {
+        // Height, sigma and source read once (one query per known cell) for every output that
+        // scales with the route; the certainty (a surface per cell more) only if one asks.
+        const std::vector<multibin::TiledRaster> read =
+            multibin::knownLayers(map, {Layer::Height, Layer::Sigma, Layer::Source});
+        m.tiled[0] = read[0], m.tiled[1] = read[1], m.tiled[3] = read[2];
+    } else {  // read when asked (the box below, the dense outputs)
+        m.tiled[0] = multibin::tiledLayer(map, Layer::Height);
+        m.tiled[1] = multibin::tiledLayer(map, Layer::Sigma, &m.tiled[0].tiles);
+        m.tiled[3] = multibin::tiledLayer(map, Layer::Source, &m.tiled[0].tiles);
+    }
     m.tiled[2] = multibin::tiledLayer(map, Layer::Certainty, &m.tiled[0].tiles);
     m.cells = multibin::knownWindow(m.tiled[0], kMargin_cells);
     return m;
