@@ -160,7 +160,8 @@ std::string metreFormat(double step) {
 }
 
 const cv::Scalar kBlack(0, 0, 0);
-const cv::Scalar kUnknown(kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]);  // BGR
+// The preview is drawn in R, G, B order (the PNG's), straight into its scanlines.
+const cv::Scalar kUnknown(kUnknownGrey[0], kUnknownGrey[1], kUnknownGrey[2]);
 
 void text(cv::Mat& img, const std::string& s, cv::Point at, double size = 0.4) {
     cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, size, kBlack, 1, cv::LINE_AA);
@@ -227,8 +228,9 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     const int H = std::max(1, int(std::lround(rows * scale)));
     const int L = 70, T = 34, R = 170, B = 70;
     const int panelH = std::max(H, 280);
-    cv::Mat img(panelH + T + B, W + L + R, CV_8UC3);
-    std::memset(img.data, 255, img.total() * img.elemSize());  // white (Mat's fill goes per pixel)
+    // Drawn in place in the PNG's scanlines (a filter byte, then R, G, B per pixel): no copy.
+    PngScanlines png(W + L + R, panelH + T + B);
+    cv::Mat img = png.image();  // white
 
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
     for (Eigen::Index i = 0; i < raster.heights_m.size(); i++) {
@@ -239,15 +241,15 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     const float span = hi > lo ? hi - lo : 1.f;
     const ColourLut lut = colourLut(style.colormap);
 
-    auto colourOf = [&](float v) -> cv::Vec3b {
-        if (!std::isfinite(v)) return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
+    auto colourOf = [&](float v) -> cv::Vec3b {  // R, G, B
+        if (!std::isfinite(v)) return {kUnknownGrey[0], kUnknownGrey[1], kUnknownGrey[2]};
         if (categorical) {
             for (const RasterCategory& k : style.categories)
-                if (int(std::lround(v)) == k.value) return {k.rgb[2], k.rgb[1], k.rgb[0]};
-            return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
+                if (int(std::lround(v)) == k.value) return {k.rgb[0], k.rgb[1], k.rgb[2]};
+            return {kUnknownGrey[0], kUnknownGrey[1], kUnknownGrey[2]};
         }
         const auto& rgb = colourAt(lut, (v - lo) / span);
-        return {rgb[2], rgb[1], rgb[0]};
+        return {rgb[0], rgb[1], rgb[2]};
     };
     drawPanel(img, raster, scale, {L, T, W, H}, colourOf);
     cv::rectangle(img, {L - 1, T - 1}, {L + W, T + H}, kBlack);
@@ -290,7 +292,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         for (size_t i = 0; i < style.categories.size(); i++) {
             const int y = T + int(i) * 24;
             const RasterCategory& k = style.categories[i];
-            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, cv::Scalar(k.rgb[2], k.rgb[1], k.rgb[0]),
+            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, cv::Scalar(k.rgb[0], k.rgb[1], k.rgb[2]),
                           cv::FILLED);
             cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, kBlack);
             text(img, k.name, {bx + 24, y + 13});
@@ -300,7 +302,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         const int barH = 200;
         for (int i = 0; i < barH; i++) {
             const auto& c = lut[size_t(std::clamp(255 - i * 255 / (barH - 1), 0, 255))];
-            cv::line(img, {bx, T + i}, {bx + 18, T + i}, cv::Scalar(c[2], c[1], c[0]));
+            cv::line(img, {bx, T + i}, {bx + 18, T + i}, cv::Scalar(c[0], c[1], c[2]));
         }
         cv::rectangle(img, {bx, T}, {bx + 18, T + barH - 1}, kBlack);
         for (int k = 0; k <= 4; k++) {
@@ -317,9 +319,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
 
     // The same pixels as cv::imencode's PNG, coded by their runs (RunDeflate.h): the previews
     // are mostly runs of one colour, which zlib scans byte by byte.
-    cv::Mat rgb;
-    cv::cvtColor(img, rgb, cv::COLOR_BGR2RGB);
-    return rgbPng(rgb.ptr<uint8_t>(0), rgb.cols, rgb.rows);
+    return png.encode();
 }
 
 void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {

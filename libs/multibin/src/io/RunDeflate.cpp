@@ -4,6 +4,8 @@
 
 #include <zlib.h>
 
+#include <opencv2/core.hpp>
+
 #include <algorithm>
 #include <array>
 #include <cstring>
@@ -299,19 +301,22 @@ std::vector<uint8_t> runDeflateGzip(const uint8_t* data, size_t size, int period
     return out;
 }
 
-std::vector<uint8_t> rgbPng(const uint8_t* rgb, int cols, int rows) {
+PngScanlines::PngScanlines(int cols, int rows) : m_cols(cols), m_rows(rows) {
     if (cols < 1 || rows < 1)
         throw std::invalid_argument("PNG of " + std::to_string(cols) + " x " +
                                     std::to_string(rows) + " pixels: empty");
-    // Each scanline: filter type 0 (none), then its pixels.
     const size_t rowBytes = size_t(cols) * 3 + 1;
-    const size_t size = rowBytes * size_t(rows);
-    const std::unique_ptr<uint8_t[]> raw(new uint8_t[size]);  // written whole below
-    for (size_t r = 0; r < size_t(rows); r++) {
-        raw[r * rowBytes] = 0;
-        std::memcpy(&raw[r * rowBytes + 1], rgb + r * (rowBytes - 1), rowBytes - 1);
-    }
-    const std::vector<uint8_t> z = runDeflateZlib(raw.get(), size, 3, rowBytes);
+    m_bytes.assign(rowBytes * size_t(rows), 255);
+    for (size_t r = 0; r < size_t(rows); r++) m_bytes[r * rowBytes] = 0;  // filter: none
+}
+
+cv::Mat PngScanlines::image() {
+    return cv::Mat(m_rows, m_cols, CV_8UC3, m_bytes.data() + 1, size_t(m_cols) * 3 + 1);
+}
+
+std::vector<uint8_t> PngScanlines::encode() const {
+    const std::vector<uint8_t> z =
+        runDeflateZlib(m_bytes.data(), m_bytes.size(), 3, size_t(m_cols) * 3 + 1);
     std::vector<uint8_t> png{0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
     const auto chunk = [&](const char* type, const uint8_t* body, size_t n) {
         put32be(png, uint32_t(n));
@@ -321,13 +326,21 @@ std::vector<uint8_t> rgbPng(const uint8_t* rgb, int cols, int rows) {
         put32be(png, uint32_t(crc32_z(0, png.data() + start, n + 4)));
     };
     std::vector<uint8_t> header;
-    put32be(header, uint32_t(cols));
-    put32be(header, uint32_t(rows));
+    put32be(header, uint32_t(m_cols));
+    put32be(header, uint32_t(m_rows));
     header.insert(header.end(), {8, 2, 0, 0, 0});  // 8 bits, RGB, deflate, filters, no interlace
     chunk("IHDR", header.data(), header.size());
     chunk("IDAT", z.data(), z.size());
     chunk("IEND", nullptr, 0);
     return png;
+}
+
+std::vector<uint8_t> rgbPng(const uint8_t* rgb, int cols, int rows) {
+    PngScanlines png(cols, rows);
+    const cv::Mat from(rows, cols, CV_8UC3, const_cast<uint8_t*>(rgb));
+    cv::Mat to = png.image();
+    from.copyTo(to);
+    return png.encode();
 }
 
 }  // namespace multibin

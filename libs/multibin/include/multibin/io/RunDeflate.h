@@ -5,6 +5,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace cv {
+class Mat;  // image() needs <opencv2/core.hpp>
+}
+
 namespace multibin {
 
 /** A zlib stream (RFC 1950) of `size` bytes that codes only runs: stretches where every byte
@@ -21,8 +25,22 @@ std::vector<uint8_t> runDeflateZlib(const uint8_t* data, size_t size, int period
  * read), without row matches. */
 std::vector<uint8_t> runDeflateGzip(const uint8_t* data, size_t size, int period);
 
-/** A PNG file (8-bit RGB, scanlines unfiltered) of `rows` x `cols` pixels given as contiguous
- * R, G, B bytes, compressed by runDeflateZlib(): decoders read back exactly these pixels. */
+/** The scanlines of an 8-bit RGB PNG image (each a filter byte 0, "none", then R, G, B per
+ * pixel), white, to draw into through image(); encode() makes the PNG file, compressed by
+ * runDeflateZlib(): decoders read back exactly the pixels drawn. */
+class PngScanlines {
+public:
+    PngScanlines(int cols, int rows);  //!< throws std::invalid_argument unless both >= 1
+    /** An OpenCV image over the pixels (CV_8UC3, channels R, G, B, row step 3 cols + 1). */
+    cv::Mat image();
+    std::vector<uint8_t> encode() const;
+
+private:
+    int m_cols, m_rows;
+    std::vector<uint8_t> m_bytes;
+};
+
+/** A PNG file of `rows` x `cols` pixels given as contiguous R, G, B bytes (PngScanlines). */
 std::vector<uint8_t> rgbPng(const uint8_t* rgb, int cols, int rows);
 
 }  // namespace multibin
