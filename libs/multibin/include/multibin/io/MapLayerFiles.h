@@ -31,7 +31,7 @@ std::vector<TiledRaster> tiledLayers(const mrpt::maps::CMultiBinElevationMap& ma
                                      const std::vector<MapLayer>& layers,
                                      const std::vector<CellWindow>* tiles = nullptr);
 /** The same layers read from the map once, over its tiles holding data (one query per cell), and
- * kept sparse (about 8 B per known cell and layer): their samples() and knownSamples() read
+ * kept sparse (8 B per known cell and 4 B per layer): their samples() and knownSamples() read
  * these cells, not the map, so the known box, the GeoTIFFs, the previews and the 3D view of one
  * run query each cell once, and readers of known samples cost the known cells, not the tiles'.
  * The rasters hold what the map held when read; `tiles` as in tiledLayers(). */
