@@ -25,6 +25,7 @@
 #include "multibin/io/NumberText.h"
 #include "multibin/io/OutputFile.h"
 #include "multibin/io/RasterExport.h"
+#include "multibin/io/RunDeflate.h"
 
 namespace fs = std::filesystem;
 using mrpt::maps::CMultiBinElevationMap;
@@ -242,12 +243,21 @@ void OutputFolder::moveIn(const std::string& name, const std::string& file) cons
     multibin::moveIntoPlace(file, (m_dir / name).string());
 }
 
-MapLayers MapLayers::of(const CMultiBinElevationMap& map) {
+MapLayers MapLayers::of(const CMultiBinElevationMap& map, bool sparse) {
     MapLayers m;
     m.m_map = &map;
-    m.tiled[0] = multibin::tiledLayer(map, Layer::Height);
-    for (int i = 1; i < 4; i++)
-        m.tiled[i] = multibin::tiledLayer(map, kLayers[i], &m.tiled[0].tiles);
+    if (sparse) {
+        // Height, sigma and source read once (one query per known cell) for every output that
+        // scales with the route; the certainty (a surface per cell more) only if one asks.
+        const std::vector<multibin::TiledRaster> read =
+            multibin::knownLayers(map, {Layer::Height, Layer::Sigma, Layer::Source});
+        m.tiled[0] = read[0], m.tiled[1] = read[1], m.tiled[3] = read[2];
+    } else {  // read when asked (the box below, the dense outputs)
+        m.tiled[0] = multibin::tiledLayer(map, Layer::Height);
+        m.tiled[1] = multibin::tiledLayer(map, Layer::Sigma, &m.tiled[0].tiles);
+        m.tiled[3] = multibin::tiledLayer(map, Layer::Source, &m.tiled[0].tiles);
+    }
+    m.tiled[2] = multibin::tiledLayer(map, Layer::Certainty, &m.tiled[0].tiles);
     m.cells = multibin::knownWindow(m.tiled[0], kMargin_cells);
     return m;
 }
@@ -352,8 +362,10 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
                     options.back().epsg = sel.epsg;
                     options.back().description = multibin::layerPreviewStyle(kLayers[i]).title;
                 }
+            std::vector<multibin::TiledRaster> rasters;
+            for (const Layer l : chosen) rasters.push_back(layers.tiled[int(l)]);
             multibin::writeSparseGeoTiffs(
-                multibin::tiledLayers(map, chosen, &layers.tiled[0].tiles), names, options,
+                rasters, names, options,
                 [&](size_t k, const std::function<bool(const std::string&)>& write) {
                     folder.writeWith(names[k], write);
                 });
@@ -365,16 +377,28 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
         steps.emplace_back("elevation.3Dscene", [&] {
             mrpt::opengl::COpenGLScene scene;
             auto obj = mrpt::opengl::CSetOfObjects::Create();
-            multibin::buildTerrainView(map, sel.sceneColouring, *obj);
+            multibin::buildTerrainView(
+                layers.tiled[0], layers.tiled[int(multibin::layerShownBy(sel.sceneColouring))],
+                map.mapOrigin(), sel.sceneColouring, *obj);
             scene.insert(obj);
             multibin::frameTerrainScene(scene);  // opens framed in SceneViewer3D
-            folder.write("elevation.3Dscene", gzSerialized(scene));
+            // Serialized, then gzip-coded by its runs (RunDeflate.h): the meshes' masked
+            // vertices and unknown texels are runs of one float or byte, which zlib scans
+            // byte by byte (3.3 MB on Malaga); CFileGZInputStream reads it as any gzip file.
+            mrpt::io::CMemoryStream mem;
+            auto arch = mrpt::serialization::archiveFrom(mem);
+            arch << scene;
+            folder.write(
+                "elevation.3Dscene",
+                multibin::runDeflateGzip(static_cast<const uint8_t*>(mem.getRawBufferData()),
+                                         size_t(mem.getTotalBytesCount()), sizeof(float)));
         });
     if (sel.png)
         steps.emplace_back("elevation_{height,sigma,source}.png", [&] {
             const std::vector<Layer> shown{Layer::Height, Layer::Sigma, Layer::Source};
-            const auto png = multibin::layerPreviewPngs(
-                multibin::tiledLayers(map, shown, &layers.tiled[0].tiles), shown, layers.cells);
+            std::vector<multibin::TiledRaster> rasters;
+            for (const Layer l : shown) rasters.push_back(layers.tiled[int(l)]);
+            const auto png = multibin::layerPreviewPngs(rasters, shown, layers.cells);
             for (size_t i = 0; i < shown.size(); i++)
                 folder.write(std::string("elevation_") + multibin::mapLayerName(shown[i]) + ".png",
                              png[i]);

@@ -83,7 +83,9 @@ struct MapLayers {
     multibin::TiledRaster tiled[4];  //!< height, sigma, certainty, source (RasterLayer order)
     multibin::CellWindow cells;      //!< known cells plus kMargin_cells; empty if none known
     static constexpr int kMargin_cells = 5;
-    static MapLayers of(const mrpt::maps::CMultiBinElevationMap& map);
+    /** sparse: read height, sigma and source once and keep their known cells (knownLayers()),
+     * for outputs that read them all (GeoTIFF, previews, scene); else read when asked. */
+    static MapLayers of(const mrpt::maps::CMultiBinElevationMap& map, bool sparse = true);
     /** Throws std::invalid_argument naming `output` unless the box fits a dense raster. */
     void requireDense(const std::string& output) const;
     /** Layer i (RasterLayer order) over `cells`, NaN where unknown; requireDense() first. */

@@ -397,7 +397,10 @@ int run(const Arguments& args, std::string& stage) {
         scoring.addSince(e0);
     }
     MapLayers layers;
-    ProgressBar::runWithProgress("layers", [&] { layers = MapLayers::of(*elevation); });
+    ProgressBar::runWithProgress("layers", [&] {
+        layers = MapLayers::of(
+            *elevation, selection.tif || selection.tifLayers || selection.scene || selection.png);
+    });
     // Everything that can fail on the request is computed before the first output is written.
     SupersampledLayers fine;
     if (exportCell_m > 0)

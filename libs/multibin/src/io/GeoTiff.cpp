@@ -17,6 +17,7 @@
 
 #include "multibin/io/OutputFile.h"
 #include "multibin/io/RasterExport.h"
+#include "multibin/io/RunDeflate.h"
 
 namespace multibin {
 
@@ -53,10 +54,11 @@ void setTags(TIFF* tif, const TiledRaster& raster, const CellWindow& bounds,
     need(TIFFSetField(tif, TIFFTAG_TILEWIDTH, uint32_t(kGeoTiffTile)), "TileWidth");
     need(TIFFSetField(tif, TIFFTAG_TILELENGTH, uint32_t(kGeoTiffTile)), "TileLength");
     need(TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_ADOBE_DEFLATE), "Compression");
-    // No predictor, DEFLATE's fastest level: the tiles are mostly NaN (a route's thin strip),
-    // which DEFLATE alone packs to almost nothing, while the floating-point predictor (a byte
-    // shuffle and differences over every pixel) and level 6 (libtiff's default) took most of the
-    // writing (doc/results/2026-11-27-route-scale-outputs.md).
+    // No predictor: the tiles are mostly NaN (a route's thin strip), which DEFLATE alone packs
+    // to almost nothing, while the floating-point predictor (a byte shuffle and differences over
+    // every pixel) took most of the writing (doc/results/2026-11-27-route-scale-outputs.md).
+    // The tiles are coded by runDeflateZlib() (writeTiles()); the level is libtiff's if it
+    // codes them (a byte-swapped file).
     need(TIFFSetField(tif, TIFFTAG_ZIPQUALITY, 1), "ZipQuality");
     need(TIFFSetField(tif, TIFFTAG_GDAL_NODATA, "nan"), "GDAL_NODATA");
     if (!options.description.empty())
@@ -123,8 +125,19 @@ size_t writeTiles(const std::vector<TiledRaster>& rasters, const std::vector<std
             const TilePlace p = placeOf(t, bounds);
             TIFF* tif = tifs[k].get();
             const uint32_t i = TIFFComputeTile(tif, p.x_px, p.y_px, 0, 0);
-            if (TIFFWriteEncodedTile(tif, i, buffer.data(), tmsize_t(buffer.size() * 4)) < 0)
-                fail(paths[k], "writing tile " + std::to_string(i) + " failed");
+            // The tile's DEFLATE stream made here from its runs (a tile is mostly NaN: the
+            // samples' runs, not its bytes, set the cost), written as is; the file's byte
+            // order is the machine's unless libtiff swaps, then libtiff encodes it.
+            const auto* bytes = reinterpret_cast<const uint8_t*>(buffer.data());
+            const tmsize_t n = tmsize_t(buffer.size() * sizeof(float));
+            const bool ok =
+                TIFFIsByteSwapped(tif) ? TIFFWriteEncodedTile(tif, i, buffer.data(), n) >= 0 : [&] {
+                    const std::vector<uint8_t> z = runDeflateZlib(bytes, size_t(n), sizeof(float),
+                                                                  kGeoTiffTile * sizeof(float));
+                    return TIFFWriteRawTile(tif, i, const_cast<uint8_t*>(z.data()),
+                                            tmsize_t(z.size())) >= 0;
+                }();
+            if (!ok) fail(paths[k], "writing tile " + std::to_string(i) + " failed");
             written += k == 0;
         }
     for (size_t k = 0; k < rasters.size(); k++)

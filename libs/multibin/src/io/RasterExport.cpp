@@ -6,9 +6,12 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -16,10 +19,17 @@
 #include <stdexcept>
 
 #include "multibin/io/OutputFile.h"
+#include "multibin/io/RunDeflate.h"
 
 namespace multibin {
 
 ColourLut colourLut(int colormap) {
+    // OpenCV builds a colour map's table by interpolation on each call (0.6 M instructions):
+    // each map's table is made once.
+    static std::mutex mutex;
+    static std::map<int, ColourLut> made;
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (const auto it = made.find(colormap); it != made.end()) return it->second;
     cv::Mat ramp(1, 256, CV_8UC1), bgr;
     for (int i = 0; i < 256; i++) ramp.at<uint8_t>(0, i) = uint8_t(i);
     cv::applyColorMap(ramp, bgr, colormap);
@@ -28,7 +38,7 @@ ColourLut colourLut(int colormap) {
         const cv::Vec3b c = bgr.at<cv::Vec3b>(0, i);
         lut[size_t(i)] = {c[2], c[1], c[0]};
     }
-    return lut;
+    return made[colormap] = lut;
 }
 
 RasterBox knownBox(const EsriAsciiGrid& raster, int margin_cells) {
@@ -150,7 +160,8 @@ std::string metreFormat(double step) {
 }
 
 const cv::Scalar kBlack(0, 0, 0);
-const cv::Scalar kUnknown(kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]);  // BGR
+// The preview is drawn in R, G, B order (the PNG's), straight into its scanlines.
+const cv::Scalar kUnknown(kUnknownGrey[0], kUnknownGrey[1], kUnknownGrey[2]);
 
 void text(cv::Mat& img, const std::string& s, cv::Point at, double size = 0.4) {
     cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, size, kBlack, 1, cv::LINE_AA);
@@ -168,18 +179,33 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
                const ColourOf& colourOf) {
     const int rows = raster.rows(), cols = raster.cols();
     // Each sample's colour once, row by row (the raster is column-major), then copied to its
-    // pixels: the panel is the preview's largest part.
+    // pixels through the column of each pixel, found once: the panel is the preview's largest
+    // part, and a row of samples drawn again (scale > 1) is a copy of the row above.
+    std::vector<int> columnOf(static_cast<size_t>(panel.width));
+    for (int px = 0; px < panel.width; px++)
+        columnOf[size_t(px)] = std::min(cols - 1, int(px / scale));
     std::vector<cv::Vec3b> rowColours(static_cast<size_t>(cols));
     int colouredRow = -1;
     for (int py = 0; py < panel.height; py++) {
         const int r = rows - 1 - std::min(rows - 1, int(py / scale));  // north up
-        if (r != colouredRow) {
-            for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
-            colouredRow = r;
-        }
         cv::Vec3b* pixel = img.ptr<cv::Vec3b>(panel.y + py) + panel.x;
+        if (r == colouredRow) {
+            const cv::Vec3b* above = img.ptr<cv::Vec3b>(panel.y + py - 1) + panel.x;
+            std::copy(above, above + panel.width, pixel);
+            continue;
+        }
+        colouredRow = r;
+        if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place,
+            // the unknown grey first (most of a sparse map's panel), then the known samples
+            std::fill(pixel, pixel + cols, colourOf(std::numeric_limits<float>::quiet_NaN()));
+            const float* sample = raster.heights_m.data() + r;  // column-major: stride `rows`
+            for (int c = 0; c < cols; c++, sample += rows)
+                if (std::isfinite(*sample)) pixel[c] = colourOf(*sample);
+            continue;
+        }
+        for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
         for (int px = 0; px < panel.width; px++)
-            pixel[px] = rowColours[size_t(std::min(cols - 1, int(px / scale)))];
+            pixel[px] = rowColours[size_t(columnOf[size_t(px)])];
     }
 }
 
@@ -202,27 +228,28 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     const int H = std::max(1, int(std::lround(rows * scale)));
     const int L = 70, T = 34, R = 170, B = 70;
     const int panelH = std::max(H, 280);
-    cv::Mat img(panelH + T + B, W + L + R, CV_8UC3, cv::Scalar(255, 255, 255));
+    // Drawn in place in the PNG's scanlines (a filter byte, then R, G, B per pixel): no copy.
+    PngScanlines png(W + L + R, panelH + T + B);
+    cv::Mat img = png.image();  // white
 
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (int r = 0; r < rows; r++)
-        for (int c = 0; c < cols; c++) {
-            const float v = raster.heights_m(r, c);
-            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-        }
+    for (Eigen::Index i = 0; i < raster.heights_m.size(); i++) {
+        const float v = raster.heights_m.data()[i];
+        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
     if (!(lo <= hi)) lo = hi = 0;
     const float span = hi > lo ? hi - lo : 1.f;
     const ColourLut lut = colourLut(style.colormap);
 
-    auto colourOf = [&](float v) -> cv::Vec3b {
-        if (!std::isfinite(v)) return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
+    auto colourOf = [&](float v) -> cv::Vec3b {  // R, G, B
+        if (!std::isfinite(v)) return {kUnknownGrey[0], kUnknownGrey[1], kUnknownGrey[2]};
         if (categorical) {
             for (const RasterCategory& k : style.categories)
-                if (int(std::lround(v)) == k.value) return {k.rgb[2], k.rgb[1], k.rgb[0]};
-            return {kUnknownGrey[2], kUnknownGrey[1], kUnknownGrey[0]};
+                if (int(std::lround(v)) == k.value) return {k.rgb[0], k.rgb[1], k.rgb[2]};
+            return {kUnknownGrey[0], kUnknownGrey[1], kUnknownGrey[2]};
         }
         const auto& rgb = colourAt(lut, (v - lo) / span);
-        return {rgb[2], rgb[1], rgb[0]};
+        return {rgb[0], rgb[1], rgb[2]};
     };
     drawPanel(img, raster, scale, {L, T, W, H}, colourOf);
     cv::rectangle(img, {L - 1, T - 1}, {L + W, T + H}, kBlack);
@@ -265,7 +292,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         for (size_t i = 0; i < style.categories.size(); i++) {
             const int y = T + int(i) * 24;
             const RasterCategory& k = style.categories[i];
-            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, cv::Scalar(k.rgb[2], k.rgb[1], k.rgb[0]),
+            cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, cv::Scalar(k.rgb[0], k.rgb[1], k.rgb[2]),
                           cv::FILLED);
             cv::rectangle(img, {bx, y}, {bx + 16, y + 16}, kBlack);
             text(img, k.name, {bx + 24, y + 13});
@@ -275,7 +302,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         const int barH = 200;
         for (int i = 0; i < barH; i++) {
             const auto& c = lut[size_t(std::clamp(255 - i * 255 / (barH - 1), 0, 255))];
-            cv::line(img, {bx, T + i}, {bx + 18, T + i}, cv::Scalar(c[2], c[1], c[0]));
+            cv::line(img, {bx, T + i}, {bx + 18, T + i}, cv::Scalar(c[0], c[1], c[2]));
         }
         cv::rectangle(img, {bx, T}, {bx + 18, T + barH - 1}, kBlack);
         for (int k = 0; k <= 4; k++) {
@@ -290,9 +317,9 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     cv::rectangle(img, {bx, legendBottom}, {bx + 16, legendBottom + 16}, kBlack);
     text(img, "unknown", {bx + 24, legendBottom + 13});
 
-    std::vector<uint8_t> bytes;
-    if (!cv::imencode(".png", img, bytes)) throw std::runtime_error("PNG encoding failed");
-    return bytes;
+    // The same pixels as cv::imencode's PNG, coded by their runs (RunDeflate.h): the previews
+    // are mostly runs of one colour, which zlib scans byte by byte.
+    return png.encode();
 }
 
 void saveMeshPly(const EsriAsciiGrid& raster, const std::string& path) {

@@ -43,6 +43,18 @@ CellWindow TiledRaster::tileBounds() const {
 }
 
 CellWindow TiledRaster::knownCells() const {
+    if (knownSamples) {  // sparse: every known sample once
+        int x0 = std::numeric_limits<int>::max(), y0 = x0, x1 = std::numeric_limits<int>::min(),
+            y1 = x1;
+        for (const CellWindow& t : tiles)
+            knownSamples(t, t, [&](int ix, int iy, float v) {
+                if (!std::isfinite(v)) return;
+                x0 = std::min(x0, ix), x1 = std::max(x1, ix);
+                y0 = std::min(y0, iy), y1 = std::max(y1, iy);
+            });
+        if (x1 < x0) return {};
+        return CellWindow{x0, y0, x1 - x0 + 1, y1 - y0 + 1};
+    }
     // Per tile, read once: the box of its known samples {x0, y0, x1, y1}, or none.
     struct Box {
         bool read = false, any = false;
@@ -119,22 +131,26 @@ std::vector<EsriAsciiGrid> blockReduced(const std::vector<TiledRaster>& rasters,
         const CellWindow part = intersection(t, window);
         if (part.nx == 0 || part.ny == 0) continue;
         for (size_t k = 0; k < rasters.size(); k++) {
-            const EsriAsciiGrid g = rasters[k].samples(part);
             EsriAsciiGrid& o = out[k];
-            for (int r = 0; r < part.ny; r++)
-                for (int c = 0; c < part.nx; c++) {
-                    const float v = g.heights_m(r, c);
-                    if (!std::isfinite(v)) continue;
-                    const int br = (part.iy0 + r - window.iy0) / factor;
-                    const int bc = (part.ix0 + c - window.ix0) / factor;
-                    float& b = o.heights_m(br, bc);
-                    if (how[k] == BlockReduce::Max) {
-                        b = std::isfinite(b) ? std::max(b, v) : v;
-                    } else {
-                        const float n = ++counts[k](br, bc);  // running mean: one pass
-                        b = n == 1 ? v : b + (v - b) / n;
-                    }
+            const auto add = [&](int ix, int iy, float v) {
+                if (!std::isfinite(v)) return;
+                const int br = (iy - window.iy0) / factor, bc = (ix - window.ix0) / factor;
+                float& b = o.heights_m(br, bc);
+                if (how[k] == BlockReduce::Max) {
+                    b = std::isfinite(b) ? std::max(b, v) : v;
+                } else {
+                    const float n = ++counts[k](br, bc);  // running mean: one pass
+                    b = n == 1 ? v : b + (v - b) / n;
                 }
+            };
+            if (rasters[k].knownSamples) {  // the same samples in the same order, sparse
+                rasters[k].knownSamples(t, part, add);
+                continue;
+            }
+            const EsriAsciiGrid g = rasters[k].samples(part);
+            for (int r = 0; r < part.ny; r++)
+                for (int c = 0; c < part.nx; c++)
+                    add(part.ix0 + c, part.iy0 + r, g.heights_m(r, c));
         }
     }
     return out;

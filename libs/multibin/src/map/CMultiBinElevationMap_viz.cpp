@@ -32,7 +32,9 @@ namespace {
 using Layer = CMultiBinElevationMap::RasterLayer;
 using HS = CMultiBinElevationMap::HeightSource;
 
-Layer layerOf(SceneColouring c) {
+}  // namespace
+
+MapLayer layerShownBy(SceneColouring c) {
     switch (c) {
         case SceneColouring::Sigma:
             return Layer::Sigma;
@@ -44,8 +46,6 @@ Layer layerOf(SceneColouring c) {
             return Layer::Height;
     }
 }
-
-}  // namespace
 
 const std::vector<RasterCategory>& heightSourceCategories() {
     // tab10's blue, orange and green: distinct, and none is the grey of unknown cells.
@@ -64,15 +64,16 @@ SceneColouring sceneColouringFromName(const std::string& name) {
                                 "' (known: height, sigma, certainty, source)");
 }
 
-const char* sceneColouringName(SceneColouring c) { return mapLayerName(layerOf(c)); }
+const char* sceneColouringName(SceneColouring c) { return mapLayerName(layerShownBy(c)); }
 
 namespace {
 
 /** The rasters a view is drawn from: the heights and the colouring layer, block-reduced to at
  * most kPreviewMaxSide_px a side, relative to the map origin. */
-std::vector<EsriAsciiGrid> viewRasters(const CMultiBinElevationMap& map, Layer shown) {
+std::vector<EsriAsciiGrid> viewRasters(const TiledRaster& heights, const TiledRaster& values,
+                                       Layer shown) {
     // Read tile by tile, one vertex per cell up to kPreviewMaxSide_px a side, else per block.
-    std::vector<TiledRaster> layers = tiledLayers(map, {Layer::Height, shown});
+    std::vector<TiledRaster> layers{heights, values};
     for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
     const CellWindow box = knownWindow(layers[0], 1);
     return blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px),
@@ -122,6 +123,31 @@ mrpt::img::TColor cellColour(float v, SceneColouring colouring, const ColourLut&
     return mrpt::img::TColor(128, 128, 128);
 }
 
+/** Vertices [x0, x1] x [y0, y1] (inclusive). */
+struct Box {
+    int x0, y0, x1, y1;
+};
+
+/** The known vertices' box within [x0, x1] x [y0, y1] (empty: x1 < x0), at least two vertices
+ * a side within it (a CMesh's grid spacing divides by the side minus one). Every quad of four
+ * known vertices of the range lies inside: a mesh over the box draws what one over the range
+ * draws, with fewer masked vertices to build, serialize and compress. */
+Box knownBox(const EsriAsciiGrid& heights, int x0, int y0, int x1, int y1) {
+    Box b{x1 + 1, y1 + 1, x0 - 1, y0 - 1};
+    for (int ix = x0; ix <= x1; ix++) {
+        const float* h = heights.heights_m.data() + size_t(ix) * size_t(heights.rows());
+        for (int iy = y0; iy <= y1; iy++)
+            if (std::isfinite(h[iy]))
+                b = {std::min(b.x0, ix), std::min(b.y0, iy), std::max(b.x1, ix),
+                     std::max(b.y1, iy)};
+    }
+    if (b.x1 < b.x0) return b;
+    // A side of one vertex grows by one within the range (which has two at least).
+    if (b.x1 == b.x0) (b.x1 < x1 ? b.x1 : b.x0) += b.x1 < x1 ? 1 : -1;
+    if (b.y1 == b.y0) (b.y1 < y1 ? b.y1 : b.y0) += b.y1 < y1 ? 1 : -1;
+    return b;
+}
+
 /** The side of the terrain's meshes [raster cells]: one per tile holding a known cell, so the
  * scene's size (and the cost of building and saving it) follows the data, not its bounding box. */
 constexpr int kSceneTile_cells = 64;
@@ -135,17 +161,16 @@ std::vector<mrpt::opengl::CMesh::Ptr> terrainMeshes(const EsriAsciiGrid& heights
                                                     const EsriAsciiGrid& values,
                                                     SceneColouring colouring, const ViewRanges& r) {
     const int nx = heights.cols(), ny = heights.rows();
-    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    const ColourLut lut = colourLut(layerPreviewStyle(layerShownBy(colouring)).colormap);
     const auto known = [&](int ix, int iy) { return std::isfinite(heights.heights_m(iy, ix)); };
     std::vector<mrpt::opengl::CMesh::Ptr> meshes;
     for (int y0 = 0; y0 < ny - 1; y0 += kSceneTile_cells)
         for (int x0 = 0; x0 < nx - 1; x0 += kSceneTile_cells) {
-            const int mx = std::min(kSceneTile_cells, nx - 1 - x0) + 1;
-            const int my = std::min(kSceneTile_cells, ny - 1 - y0) + 1;
-            bool any = false;
-            for (int iy = y0; iy < y0 + my && !any; iy++)
-                for (int ix = x0; ix < x0 + mx && !any; ix++) any = known(ix, iy);
-            if (!any) continue;
+            const int tx1 = x0 + std::min(kSceneTile_cells, nx - 1 - x0);
+            const int ty1 = y0 + std::min(kSceneTile_cells, ny - 1 - y0);
+            const Box b = knownBox(heights, x0, y0, tx1, ty1);
+            if (b.x1 < b.x0) continue;
+            const int mx = b.x1 - b.x0 + 1, my = b.y1 - b.y0 + 1;
             mrpt::math::CMatrixDynamic<float> Z(mx, my), mask(mx, my);
             mrpt::img::CImage texture(my, mx, mrpt::img::CH_RGB);
             for (int i = 0; i < mx; i++) {
@@ -153,7 +178,7 @@ std::vector<mrpt::opengl::CMesh::Ptr> terrainMeshes(const EsriAsciiGrid& heights
                 // setPixel checks and converts per texel.
                 uint8_t* texel = texture.ptrLine<uint8_t>(unsigned(i));
                 for (int j = 0; j < my; j++, texel += 3) {
-                    const int ix = x0 + i, iy = y0 + j;
+                    const int ix = b.x0 + i, iy = b.y0 + j;
                     const float h = heights.heights_m(iy, ix), v = values.heights_m(iy, ix);
                     Z(i, j) = known(ix, iy) ? h : r.zLo_m;
                     mask(i, j) = known(ix, iy) ? 1.f : 0.f;
@@ -167,8 +192,8 @@ std::vector<mrpt::opengl::CMesh::Ptr> terrainMeshes(const EsriAsciiGrid& heights
             mesh->setName("CMultiBinElevationMap");
             const double cs = heights.cellsize_m;
             mesh->setGridLimits(
-                heights.xllcenter_m + x0 * cs, heights.xllcenter_m + (x0 + mx - 1) * cs,
-                heights.yllcenter_m + y0 * cs, heights.yllcenter_m + (y0 + my - 1) * cs);
+                heights.xllcenter_m + b.x0 * cs, heights.xllcenter_m + (b.x0 + mx - 1) * cs,
+                heights.yllcenter_m + b.y0 * cs, heights.yllcenter_m + (b.y0 + my - 1) * cs);
             mesh->assignImageAndZ(texture, Z);
             mesh->setMask(mask);
             meshes.push_back(mesh);
@@ -194,13 +219,14 @@ mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
                     return true;
         return false;
     };
-    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    const ColourLut lut = colourLut(layerPreviewStyle(layerShownBy(colouring)).colormap);
     auto points = mrpt::opengl::CPointCloudColoured::Create();
     points->setName("cells outside the mesh");
     points->setPointSize(2);
-    for (int iy = 0; iy < ny; iy++)
-        for (int ix = 0; ix < nx; ix++) {
-            if (!known(ix, iy) || inAQuad(ix, iy)) continue;
+    for (int iy = 0; iy < ny; iy++) {
+        const float* h = heights.heights_m.data() + iy;  // column-major: stride ny
+        for (int ix = 0; ix < nx; ix++, h += ny) {
+            if (!std::isfinite(*h) || inAQuad(ix, iy)) continue;  // most cells: unknown
             const float v = values.heights_m(iy, ix);
             const mrpt::img::TColor c = std::isfinite(v) ? cellColour(v, colouring, lut, r)
                                                          : mrpt::img::TColor(128, 128, 128);
@@ -208,6 +234,7 @@ mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
                               float(heights.yllcenter_m + iy * heights.cellsize_m),
                               heights.heights_m(iy, ix), c.R / 255.f, c.G / 255.f, c.B / 255.f);
         }
+    }
     return points;
 }
 
@@ -270,7 +297,7 @@ LegendFrame legendFrame(const EsriAsciiGrid& heights, const ViewRanges& r) {
 mrpt::opengl::CMesh::Ptr colourBar(const LegendFrame& f, SceneColouring colouring) {
     constexpr int kSteps = 64, kRows = kSteps + 2;
     const double step_m = f.height_m / (kSteps - 1);
-    const ColourLut lut = colourLut(layerPreviewStyle(layerOf(colouring)).colormap);
+    const ColourLut lut = colourLut(layerPreviewStyle(layerShownBy(colouring)).colormap);
     mrpt::math::CMatrixDynamic<float> Z(2, kRows), mask(2, kRows);
     Z.setZero(), mask.fill(1.f);
     mrpt::img::CImage texture(kRows, 2, mrpt::img::CH_RGB);
@@ -349,12 +376,20 @@ mrpt::math::TVector3D TerrainViewDirection::up() const {
 
 void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring,
                       mrpt::opengl::CSetOfObjects& out) {
-    const std::vector<EsriAsciiGrid> rasters = viewRasters(map, layerOf(colouring));
+    const std::vector<TiledRaster> layers =
+        knownLayers(map, {Layer::Height, layerShownBy(colouring)});
+    buildTerrainView(layers[0], layers[1], map.mapOrigin(), colouring, out);
+}
+
+void buildTerrainView(const TiledRaster& heightLayer, const TiledRaster& shownLayer,
+                      const mrpt::math::TPoint2D& origin, SceneColouring colouring,
+                      mrpt::opengl::CSetOfObjects& out) {
+    const std::vector<EsriAsciiGrid> rasters =
+        viewRasters(heightLayer, shownLayer, layerShownBy(colouring));
     const EsriAsciiGrid &heights = rasters[0], &values = rasters[1];
     if (heights.cols() < 2 || heights.rows() < 2) return;
     // Built relative to the map origin and placed at it, so the view's floats stay small at
     // georeferenced coordinates.
-    const mrpt::math::TPoint2D origin = map.mapOrigin();
     auto placed = mrpt::opengl::CSetOfObjects::Create();
     placed->setName("map origin");
     placed->setLocation(origin.x, origin.y, 0);

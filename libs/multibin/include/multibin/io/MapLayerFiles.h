@@ -10,10 +10,14 @@
 #include "multibin/io/GeoTiff.h"
 #include "multibin/io/RasterExport.h"
 #include "multibin/io/TiledRaster.h"
+#include "multibin/map/TerrainView.h"
 
 namespace multibin {
 
 using MapLayer = mrpt::maps::CMultiBinElevationMap::RasterLayer;
+
+/** The layer a 3D view coloured so shows (TerrainView.h). */
+MapLayer layerShownBy(SceneColouring colouring);
 
 /** "height", "sigma", "certainty" or "source". */
 const char* mapLayerName(MapLayer layer);
@@ -24,6 +28,14 @@ const char* mapLayerName(MapLayer layer);
  * the same window one after the other (a loop over tiles that reads every layer of a tile), the
  * map answers all of them from one query per cell. Not for use from several threads. */
 std::vector<TiledRaster> tiledLayers(const mrpt::maps::CMultiBinElevationMap& map,
+                                     const std::vector<MapLayer>& layers,
+                                     const std::vector<CellWindow>* tiles = nullptr);
+/** The same layers read from the map once, over its tiles holding data (one query per cell), and
+ * kept sparse (8 B per known cell and 4 B per layer): their samples() and knownSamples() read
+ * these cells, not the map, so the known box, the GeoTIFFs, the previews and the 3D view of one
+ * run query each cell once, and readers of known samples cost the known cells, not the tiles'.
+ * The rasters hold what the map held when read; `tiles` as in tiledLayers(). */
+std::vector<TiledRaster> knownLayers(const mrpt::maps::CMultiBinElevationMap& map,
                                      const std::vector<MapLayer>& layers,
                                      const std::vector<CellWindow>* tiles = nullptr);
 /** One layer: tiledLayers(map, {layer}, tiles)[0]. */

@@ -26,6 +26,14 @@ struct TiledRaster {
     std::vector<CellWindow> tiles;  //!< aligned, tileCells x tileCells each, no duplicates
     /** The samples over a window of cells (any window), NaN where unknown. */
     std::function<EsriAsciiGrid(const CellWindow&)> samples;
+    /** A visitor of a sample: cell (ix, iy), its value. */
+    using SampleVisit = std::function<void(int ix, int iy, float value)>;
+    /** Optional (rasters kept sparse, knownLayers() in MapLayerFiles.h): visits the known samples
+     * of tile `tile` (one of `tiles`) inside `window`, row by row from the south, west to east
+     * (the order of samples()); knownCells() and blockReduced() then cost the known samples, not
+     * the tiles' cells. */
+    std::function<void(const CellWindow& tile, const CellWindow& window, const SampleVisit&)>
+        knownSamples;
 
     /** The smallest window holding every tile (empty without tiles). */
     CellWindow tileBounds() const;

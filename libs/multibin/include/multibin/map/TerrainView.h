@@ -3,6 +3,7 @@
 
 #include <mrpt/math/CMatrixFixed.h>
 #include <mrpt/math/TBoundingBox.h>
+#include <mrpt/math/TPoint2D.h>
 #include <mrpt/math/TPoint3D.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CSetOfObjects.h>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "multibin/io/RasterExport.h"
+#include "multibin/io/TiledRaster.h"
 
 namespace mrpt::maps {
 class CMultiBinElevationMap;
@@ -75,6 +77,12 @@ void frameTerrainScene(mrpt::opengl::COpenGLScene& scene);
  * a colour bar facing that direction, as tall as half the map's diagonal, with upright text
  * labels (CText; or the source layer's categories). Nothing when the map knows no cell. */
 void buildTerrainView(const mrpt::maps::CMultiBinElevationMap& map, SceneColouring colouring,
+                      mrpt::opengl::CSetOfObjects& out);
+/** The same from layers read already (knownLayers(), MapLayerFiles.h, in the frame of the robot
+ * poses): the heights and the layer `colouring` shows (the heights again for Height), the map's
+ * mapOrigin() given; a caller that writes other outputs reads the map once for all. */
+void buildTerrainView(const TiledRaster& heights, const TiledRaster& shown,
+                      const mrpt::math::TPoint2D& mapOrigin, SceneColouring colouring,
                       mrpt::opengl::CSetOfObjects& out);
 
 }  // namespace multibin
