@@ -80,8 +80,10 @@ struct SparseCells {
     std::vector<int32_t> ix, iy;
     std::vector<float> values;  // layers per cell
     size_t layers = 0;
-    std::unordered_map<int64_t, std::pair<size_t, size_t>> ofTile;  // (iy0, ix0) -> [first, end)
-    static int64_t key(const CellWindow& t) { return (int64_t(t.iy0) << 32) ^ uint32_t(t.ix0); }
+    std::unordered_map<uint64_t, std::pair<size_t, size_t>> ofTile;  // (iy0, ix0) -> [first, end)
+    static uint64_t key(const CellWindow& t) {
+        return uint64_t(uint32_t(t.iy0)) << 32 | uint32_t(t.ix0);
+    }
     /** Calls visit(cell index) for the cells of `tile` inside `window`, in order. */
     template <typename Visit>
     void forEach(const CellWindow& tile, const CellWindow& window, const Visit& visit) const {
