@@ -83,15 +83,22 @@ struct CMultiBinElevationMap::Impl {
             : m_impl(impl),
               m_dual(dual),
               m_tile(impl.grid.store().tileNumber(tx, ty)),
-              m_base(multibin::BinStore::tileBase(m_tile)) {}
+              m_base(multibin::BinStore::tileBase(m_tile)),
+              m_inside(wholeInside(impl.grid.store().window(), tx, ty)) {}
         /** Whether the tile holds no bin (not allocated) and the dual grid is off. */
         bool empty() const { return !m_dual && m_tile == 0; }
-        /** holdsBins(ix, iy, dual) for a cell of this tile. */
+        /** holdsBins(ix, iy, dual) for a cell of this tile: without the dual grid, a look at
+         * the cell's slot (a tile inside the store's window needs no window test per cell). */
         bool holds(int ix, int iy) const {
             if (m_dual) return m_impl.holdsBins(ix, iy, true);
             const multibin::BinStore& s = m_impl.grid.store();
-            return m_tile != 0 && s.window().contains(ix, iy) &&
+            return m_tile != 0 && (m_inside || s.window().contains(ix, iy)) &&
                    s.slotHoldsBins(m_base + multibin::BinStore::slotInTile(ix, iy));
+        }
+        /** Whether tile (tx, ty)'s cells all lie in window w. */
+        static bool wholeInside(const multibin::CellWindow& w, int tx, int ty) {
+            constexpr int k = multibin::BinStore::kTileCells;
+            return w.contains(tx * k, ty * k) && w.contains(tx * k + k - 1, ty * k + k - 1);
         }
 
     private:
@@ -99,6 +106,7 @@ struct CMultiBinElevationMap::Impl {
         bool m_dual;
         uint32_t m_tile;
         size_t m_base;
+        bool m_inside;
     };
     /** The traversability layers (CMultiBinElevationMap_traversability.cpp). */
     multibin::TraversabilityCache traversability;
