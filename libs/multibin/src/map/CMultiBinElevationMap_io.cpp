@@ -459,9 +459,7 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
             const int ya = std::max(ty * Store::kTileCells, w.iy0),
                       yb = std::min((ty + 1) * Store::kTileCells, w.iy0 + w.ny);
             multibin::rasterReadCounters().cellsVisited += size_t(xb - xa) * size_t(yb - ya);
-            for (int iy = ya; iy < yb; iy++)
-                for (int ix = xa; ix < xb; ix++)
-                    if (bins.holds(ix, iy) || filledAt(ix, iy)) readCell(ix, iy);
+            bins.forEachHeld(xa, xb, ya, yb, filledAt, readCell);
         }
     return out;
 }
