@@ -54,7 +54,7 @@ multibin::fill::SparseHeights CMultiBinElevationMap::fillInput() const {
         const Impl::TileBins bins(*m_impl, tx, ty, isDualGrid());
         const bool inside = Impl::TileBins::wholeInside(w, tx, ty);  // no test per cell then
         bins.forEachHeld(
-            tx * kTile, (tx + 1) * kTile, ty * kTile, (ty + 1) * kTile,
+            tx * kTile, (tx + 1) * kTile, ty * kTile, (ty + 1) * kTile, false,
             [](int, int) { return false; },
             [&](int ix, int iy) {
                 double h, s;

@@ -98,32 +98,37 @@ struct CMultiBinElevationMap::Impl {
                    s.slotHoldsBins(m_base + multibin::BinStore::slotInTile(ix, iy));
         }
         /** Calls f(ix, iy), row by row, for the cells of [xa, xb) x [ya, yb) (within this tile)
-         * that hold bins (holds()) or for which also(ix, iy) is true. Without the dual grid the
-         * cells are first picked by a loop over their slots' chain heads with no call inside,
-         * a few instructions a cell: most cells of a sparse route's tiles are empty. */
+         * that hold bins (holds()) or for which also(ix, iy) is true; also() is asked only if
+         * `alsoAny` (it may hold somewhere in the tile). Without the dual grid a row whose slots'
+         * chain heads are all empty is passed by one loop with no branch, about an instruction a
+         * cell, and the others' cells are picked before f is called: most cells of a sparse
+         * route's tiles are empty. */
         template <typename Also, typename F>
-        void forEachHeld(int xa, int xb, int ya, int yb, Also&& also, F&& f) const {
+        void forEachHeld(int xa, int xb, int ya, int yb, bool alsoAny, Also&& also, F&& f) const {
             if (m_dual || !m_inside) {
                 for (int iy = ya; iy < yb; iy++)
                     for (int ix = xa; ix < xb; ix++)
-                        if (holds(ix, iy) || also(ix, iy)) f(ix, iy);
+                        if (holds(ix, iy) || (alsoAny && also(ix, iy))) f(ix, iy);
                 return;
             }
+            if (m_tile == 0 && !alsoAny) return;
             constexpr int kSide = multibin::BinStore::kTileCells;
             std::array<uint16_t, multibin::BinStore::kTileSlots> picked;  // (iy, ix) in the tile
             size_t n = 0;
             const multibin::BinStore& s = m_impl.grid.store();
-            const bool allocated = m_tile != 0;
+            const int x0 = xa & ~(kSide - 1), y0 = ya & ~(kSide - 1);  // the tile's first cell
             for (int iy = ya; iy < yb; iy++) {
                 const size_t row = m_base + multibin::BinStore::slotInTile(0, iy);
+                bool any = alsoAny;
+                if (m_tile != 0)
+                    for (int ix = xa; ix < xb; ix++) any |= s.slotHoldsBins(row + size_t(ix - x0));
+                if (!any) continue;
                 for (int ix = xa; ix < xb; ix++) {
-                    const size_t k = size_t(iy & (kSide - 1)) * kSide + size_t(ix & (kSide - 1));
-                    picked[n] = uint16_t(k);
-                    n += (allocated && s.slotHoldsBins(row + size_t(ix & (kSide - 1)))) ||
-                         also(ix, iy);
+                    picked[n] = uint16_t((iy - y0) * kSide + (ix - x0));
+                    n += (m_tile != 0 && s.slotHoldsBins(row + size_t(ix - x0))) ||
+                         (alsoAny && also(ix, iy));
                 }
             }
-            const int x0 = xa & ~(kSide - 1), y0 = ya & ~(kSide - 1);  // the tile's first cell
             for (size_t i = 0; i < n; i++) f(x0 + picked[i] % kSide, y0 + picked[i] / kSide);
         }
         /** Whether tile (tx, ty)'s cells all lie in window w. */

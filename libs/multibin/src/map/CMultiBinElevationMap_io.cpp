@@ -459,7 +459,7 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
             const int ya = std::max(ty * Store::kTileCells, w.iy0),
                       yb = std::min((ty + 1) * Store::kTileCells, w.iy0 + w.ny);
             multibin::rasterReadCounters().cellsVisited += size_t(xb - xa) * size_t(yb - ya);
-            bins.forEachHeld(xa, xb, ya, yb, filledAt, readCell);
+            bins.forEachHeld(xa, xb, ya, yb, filledTile != nullptr, filledAt, readCell);
         }
     return out;
 }
@@ -479,8 +479,21 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
             corners.emplace_back(t.iy0, t.ix0);
     };
     // The stored bins, tile by tile (BinStore): the cost follows the data, not the window.
-    m_impl->grid.store().forEachStoredBin(
-        [&](int ix, int iy, const multibin::Bin&) { add(ix, iy); });
+    using Store = multibin::BinStore;
+    const Store& store = m_impl->grid.store();
+    if (tileCells % Store::kTileCells == 0) {
+        // A store tile lies in one of these tiles: its first slot holding a bin adds it.
+        store.forEachTileNumber([&](uint32_t t, int tx, int ty) {
+            const size_t base = Store::tileBase(t);
+            for (size_t k = 0; k < Store::kTileSlots; k++)
+                if (store.slotHoldsBins(base + k)) {
+                    add(tx * Store::kTileCells, ty * Store::kTileCells);
+                    break;
+                }
+        });
+    } else {
+        store.forEachStoredBin([&](int ix, int iy, const multibin::Bin&) { add(ix, iy); });
+    }
     if (isDualGrid()) {  // local cells not yet written back, at the global cell of their centre
         const multibin::BinGrid& l = m_impl->local;
         l.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
