@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library's tests: what the cheaper outputs and fill must
  * keep (the map file's checksum is MRPT's CRC-32, the fill's gaps are those of the whole-window
- * path) and the cost they must not exceed (the cells a flood reads beside a wall). */
+ * path) and the cost they must not exceed (the cells a flood reads beside a wall); the occupied
+ * tiles found from the store's slots. */
 #include <gtest/gtest.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/serialization/CArchive.h>
@@ -8,11 +9,14 @@
 
 #include <cmath>
 #include <cstring>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/SparseFill.h"
 #include "multibin/grid/BinGrid.h"
+#include "multibin/io/TiledRaster.h"
 #include "multibin/map/MapInternals.h"
 #include "route_map.h"
 
@@ -103,4 +107,37 @@ TEST(SparseFillCost, AFloodIntoATileWithoutDataStopsAtOnce) {
     EXPECT_EQ(filled, 1u);
     // The cost: the wall's south side no longer floods maxGapCells cells.
     EXPECT_LT(sparse.stats.cellsVisited, 2 * size_t(o.maxGapCells)) << sparse.stats.cellsVisited;
+}
+
+// occupiedTiles() finds a store tile's corner from its first slot holding a bin when the tiles
+// asked for are whole store tiles (64, 256 cells a side), and from every stored bin otherwise
+// (100): each against the tiles of every stored bin, on patches west and south of the origin,
+// and one cell in a tile's last slot.
+TEST(OccupiedTiles, AreTheTilesOfTheStoredBinsAtEveryTileSide) {
+    mrpt::maps::CMultiBinElevationMap map;
+    map.creationOptions.resolution_m = 0.05;
+    map.creationOptions.origin_auto = false;
+    map.setCreationOptions(map.creationOptions);
+    for (const auto& [x_m, y_m] : std::vector<std::pair<double, double>>{
+             {-7.3, -0.2}, {0.02, 0.02}, {3.175, 3.175}, {12.9, -15.1}, {-0.01, 9.6}})
+        for (int k = 0; k < 5; k++) map.insertIndividualPoint(x_m + 0.05 * k, y_m, 0.1 * k);
+    // A bin in the last slot of the tile of cells [64, 128): cell (127, 127).
+    map.insertIndividualPoint(127.5 * 0.05, 127.5 * 0.05, 0.5);
+    const multibin::BinStore& store = multibin::MapInternals::grid(map).store();
+    for (const int side : {64, 256, 100}) {
+        std::set<std::pair<int, int>> expected;  // (iy0, ix0)
+        store.forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
+            const CellWindow t = multibin::tileOfCell(ix, iy, side);
+            expected.emplace(t.iy0, t.ix0);
+        });
+        std::vector<std::pair<int, int>> got;
+        for (const CellWindow& t : map.occupiedTiles(side)) {
+            EXPECT_EQ(t.nx, side);
+            EXPECT_EQ(t.ny, side);
+            got.emplace_back(t.iy0, t.ix0);
+        }
+        const std::vector<std::pair<int, int>> want(expected.begin(), expected.end());
+        EXPECT_EQ(got, want) << "tiles of " << side << " cells";
+        EXPECT_GE(got.size(), 4u);  // the patches lie in several tiles
+    }
 }

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <tuple>
@@ -75,6 +77,19 @@ std::vector<TiledRaster> tiledLayers(const CMultiBinElevationMap& map,
 
 namespace {
 
+/** Whether any of v[0, n) is finite: the bits of std::isfinite, in one loop without a branch
+ * (a column of a sparse route's tile is mostly unknown, NaN). */
+bool anyFinite(const float* v, size_t n) {
+    constexpr uint32_t kExponent = 0x7f800000u;  // all ones: infinite or NaN
+    bool any = false;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t bits;
+        std::memcpy(&bits, v + i, sizeof bits);
+        any |= (bits & kExponent) != kExponent;
+    }
+    return any;
+}
+
 /** Known cells grouped by raster tile (in the order of the tiles), each tile's row by row. */
 struct SparseCells {
     std::vector<int32_t> ix, iy;
@@ -115,7 +130,8 @@ std::shared_ptr<const SparseCells> readSparseCells(const CMultiBinElevationMap& 
         for (size_t k = 0; k < g.size(); k++) layer[k] = g[k].heights_m.data();
         // Column-major: sample (r, c) at r + c ny. toRasters() writes every layer of a known
         // cell or none, so the first layer tells which cells are known.
-        for (int c = 0; c < w.nx; c++)
+        for (int c = 0; c < w.nx; c++) {
+            if (!anyFinite(layer[0] + size_t(c) * size_t(w.ny), size_t(w.ny))) continue;
             for (int r = 0; r < w.ny; r++) {
                 const size_t at = size_t(r) + size_t(c) * size_t(w.ny);
                 if (!std::isfinite(layer[0][at])) continue;
@@ -123,6 +139,7 @@ std::shared_ptr<const SparseCells> readSparseCells(const CMultiBinElevationMap& 
                                  values.size()});
                 for (const float* l : layer) values.push_back(l[at]);
             }
+        }
     }
     // By raster tile (south to north, west to east, as occupiedTiles() lists them), then row by
     // row: the order of a dense read of each tile.

@@ -52,16 +52,19 @@ multibin::fill::SparseHeights CMultiBinElevationMap::fillInput() const {
     const multibin::CellWindow& w = in.lattice.window;
     for (const auto& [ty, tx] : tiles) {
         const Impl::TileBins bins(*m_impl, tx, ty, isDualGrid());
-        for (int iy = ty * kTile; iy < (ty + 1) * kTile; iy++)
-            for (int ix = tx * kTile; ix < (tx + 1) * kTile; ix++) {
+        const bool inside = Impl::TileBins::wholeInside(w, tx, ty);  // no test per cell then
+        bins.forEachHeld(
+            tx * kTile, (tx + 1) * kTile, ty * kTile, (ty + 1) * kTile, false,
+            [](int, int) { return false; },
+            [&](int ix, int iy) {
                 double h, s;
                 // Without the pose part the cells share (CellSurface::poseVariance_m2): it moves
                 // a gap's neighbours together, so it does not weigh one against another.
-                if (w.contains(ix, iy) && bins.holds(ix, iy) &&
+                if ((inside || w.contains(ix, iy)) &&
                     surfaceQuery(false, o.x() + grid.cellCenter_m(ix),
                                  o.y() + grid.cellCenter_m(iy), h, s, false))
                     in.setMeasured(ix, iy, float(h), float(s));
-            }
+            });
     }
     return in;
 }

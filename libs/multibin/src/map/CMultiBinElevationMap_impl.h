@@ -5,6 +5,8 @@
 
 #include <mrpt/maps/CMultiBinElevationMap.h>
 
+#include <array>
+#include <cstdint>
 #include <mutex>
 #include <optional>
 
@@ -83,15 +85,56 @@ struct CMultiBinElevationMap::Impl {
             : m_impl(impl),
               m_dual(dual),
               m_tile(impl.grid.store().tileNumber(tx, ty)),
-              m_base(multibin::BinStore::tileBase(m_tile)) {}
+              m_base(multibin::BinStore::tileBase(m_tile)),
+              m_inside(wholeInside(impl.grid.store().window(), tx, ty)) {}
         /** Whether the tile holds no bin (not allocated) and the dual grid is off. */
         bool empty() const { return !m_dual && m_tile == 0; }
-        /** holdsBins(ix, iy, dual) for a cell of this tile. */
+        /** holdsBins(ix, iy, dual) for a cell of this tile: without the dual grid, a look at
+         * the cell's slot (a tile inside the store's window needs no window test per cell). */
         bool holds(int ix, int iy) const {
             if (m_dual) return m_impl.holdsBins(ix, iy, true);
             const multibin::BinStore& s = m_impl.grid.store();
-            return m_tile != 0 && s.window().contains(ix, iy) &&
+            return m_tile != 0 && (m_inside || s.window().contains(ix, iy)) &&
                    s.slotHoldsBins(m_base + multibin::BinStore::slotInTile(ix, iy));
+        }
+        /** Calls f(ix, iy), row by row, for the cells of [xa, xb) x [ya, yb) (within this tile)
+         * that hold bins (holds()) or for which also(ix, iy) is true; also() is asked only if
+         * `alsoAny` (it may hold somewhere in the tile). Without the dual grid a row whose slots'
+         * chain heads are all empty is passed by one loop with no branch, about an instruction a
+         * cell, and the others' cells are picked before f is called: most cells of a sparse
+         * route's tiles are empty. */
+        template <typename Also, typename F>
+        void forEachHeld(int xa, int xb, int ya, int yb, bool alsoAny, Also&& also, F&& f) const {
+            if (m_dual || !m_inside) {
+                for (int iy = ya; iy < yb; iy++)
+                    for (int ix = xa; ix < xb; ix++)
+                        if (holds(ix, iy) || (alsoAny && also(ix, iy))) f(ix, iy);
+                return;
+            }
+            if (m_tile == 0 && !alsoAny) return;
+            constexpr int kSide = multibin::BinStore::kTileCells;
+            std::array<uint16_t, multibin::BinStore::kTileSlots> picked;  // (iy, ix) in the tile
+            size_t n = 0;
+            const multibin::BinStore& s = m_impl.grid.store();
+            const int x0 = xa & ~(kSide - 1), y0 = ya & ~(kSide - 1);  // the tile's first cell
+            for (int iy = ya; iy < yb; iy++) {
+                const size_t row = m_base + multibin::BinStore::slotInTile(0, iy);
+                bool any = alsoAny;
+                if (m_tile != 0)
+                    for (int ix = xa; ix < xb; ix++) any |= s.slotHoldsBins(row + size_t(ix - x0));
+                if (!any) continue;
+                for (int ix = xa; ix < xb; ix++) {
+                    picked[n] = uint16_t((iy - y0) * kSide + (ix - x0));
+                    n += (m_tile != 0 && s.slotHoldsBins(row + size_t(ix - x0))) ||
+                         (alsoAny && also(ix, iy));
+                }
+            }
+            for (size_t i = 0; i < n; i++) f(x0 + picked[i] % kSide, y0 + picked[i] / kSide);
+        }
+        /** Whether tile (tx, ty)'s cells all lie in window w. */
+        static bool wholeInside(const multibin::CellWindow& w, int tx, int ty) {
+            constexpr int k = multibin::BinStore::kTileCells;
+            return w.contains(tx * k, ty * k) && w.contains(tx * k + k - 1, ty * k + k - 1);
         }
 
     private:
@@ -99,6 +142,7 @@ struct CMultiBinElevationMap::Impl {
         bool m_dual;
         uint32_t m_tile;
         size_t m_base;
+        bool m_inside;
     };
     /** The traversability layers (CMultiBinElevationMap_traversability.cpp). */
     multibin::TraversabilityCache traversability;

@@ -12,9 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <optional>
-#include <set>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "multibin/grid/CellSurface.h"
@@ -404,29 +403,16 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     const multibin::fill::FilledCells& f = m_impl->filled;
     const multibin::CellWindow& fw = m_impl->fillWindow;
     const bool withFill = insertionOptions.query.dem_return_filled;
-    // The store tile being read and its filled cells' tile, found once per tile (not per cell).
-    const multibin::fill::FilledCell* filledTile = nullptr;
-    std::optional<Impl::TileBins> bins;
-    const auto mayBeKnown = [&](int ix, int iy) {
-        return bins->holds(ix, iy) ||
-               (filledTile && fw.contains(ix, iy) &&
-                filledTile[multibin::fill::TiledCells<int>::inTile(ix, iy)].source !=
-                    multibin::HeightSource::Unknown);
-    };
     using Store = multibin::BinStore;
     static_assert(Store::kTileCells == multibin::fill::TiledCells<int>::kSide,
                   "the filled cells' tiles are the store's");
-    const auto tileMayHoldKnown = [&](int tx, int ty) {
-        filledTile = withFill ? f.cells.findTile(tx, ty) : nullptr;
-        bins.emplace(*m_impl, tx, ty, isDualGrid());
-        return !bins->empty() || filledTile;
-    };
     const auto readCell = [&](int ix, int iy) {
-        if (!mayBeKnown(ix, iy)) return;
+        // cellElevation() without its per-cell preparation and lock, held here for the raster.
         double h, s;
-        const HeightSource src =
-            cellElevation(o.x() + grid.cellCenter_m(ix), o.y() + grid.cellCenter_m(iy), h, s,
-                          insertionOptions.query.dem_return_filled);
+        const double x_m = o.x() + grid.cellCenter_m(ix), y_m = o.y() + grid.cellCenter_m(iy);
+        HeightSource src = HeightSource::Measured;
+        if (!surfaceQuery(false, x_m, y_m, h, s))
+            src = withFill ? filledQuery(x_m, y_m, h, s) : HeightSource::Unknown;
         if (src == HeightSource::Unknown) return;
         for (size_t k = 0; k < layers.size(); k++) {
             float& v = out[k].heights_m(iy - w.iy0, ix - w.ix0);
@@ -456,15 +442,24 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     };
     for (int ty = Store::tileOf(w.iy0); w.nx > 0 && ty <= Store::tileOf(w.iy0 + w.ny - 1); ty++)
         for (int tx = Store::tileOf(w.ix0); tx <= Store::tileOf(w.ix0 + w.nx - 1); tx++) {
-            if (!tileMayHoldKnown(tx, ty)) continue;
+            // The store's tile and its filled cells' tile, found once per tile (not per cell).
+            const multibin::fill::FilledCell* filledTile =
+                withFill ? f.cells.findTile(tx, ty) : nullptr;
+            const Impl::TileBins bins(*m_impl, tx, ty, isDualGrid());
+            if (bins.empty() && !filledTile) continue;
+            const bool filledInside = filledTile && Impl::TileBins::wholeInside(fw, tx, ty);
+            const auto filledAt = [&](int ix, int iy) {
+                return filledTile && (filledInside || fw.contains(ix, iy)) &&
+                       filledTile[multibin::fill::TiledCells<int>::inTile(ix, iy)].source !=
+                           multibin::HeightSource::Unknown;
+            };
             // Multiplied, not shifted: tile indices are negative left of the origin.
             const int xa = std::max(tx * Store::kTileCells, w.ix0),
                       xb = std::min((tx + 1) * Store::kTileCells, w.ix0 + w.nx);
             const int ya = std::max(ty * Store::kTileCells, w.iy0),
                       yb = std::min((ty + 1) * Store::kTileCells, w.iy0 + w.ny);
             multibin::rasterReadCounters().cellsVisited += size_t(xb - xa) * size_t(yb - ya);
-            for (int iy = ya; iy < yb; iy++)
-                for (int ix = xa; ix < xb; ix++) readCell(ix, iy);
+            bins.forEachHeld(xa, xb, ya, yb, filledTile != nullptr, filledAt, readCell);
         }
     return out;
 }
@@ -475,14 +470,30 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
                                     " must be at least 1");
     prepareForReading();
     const multibin::MapLock::Shared lock(m_impl->lock);
-    std::set<std::pair<int, int>> corners;  // (iy0, ix0): ordered row by row from the south
+    // (iy0, ix0), sorted row by row from the south below. The cells come tile by tile: a
+    // corner equal to the last one added is skipped without a search.
+    std::vector<std::pair<int, int>> corners;
     const auto add = [&](int ix, int iy) {
         const multibin::CellWindow t = multibin::tileOfCell(ix, iy, tileCells);
-        corners.emplace(t.iy0, t.ix0);
+        if (corners.empty() || corners.back() != std::make_pair(t.iy0, t.ix0))
+            corners.emplace_back(t.iy0, t.ix0);
     };
     // The stored bins, tile by tile (BinStore): the cost follows the data, not the window.
-    m_impl->grid.store().forEachStoredBin(
-        [&](int ix, int iy, const multibin::Bin&) { add(ix, iy); });
+    using Store = multibin::BinStore;
+    const Store& store = m_impl->grid.store();
+    if (tileCells % Store::kTileCells == 0) {
+        // A store tile lies in one of these tiles: its first slot holding a bin adds it.
+        store.forEachTileNumber([&](uint32_t t, int tx, int ty) {
+            const size_t base = Store::tileBase(t);
+            for (size_t k = 0; k < Store::kTileSlots; k++)
+                if (store.slotHoldsBins(base + k)) {
+                    add(tx * Store::kTileCells, ty * Store::kTileCells);
+                    break;
+                }
+        });
+    } else {
+        store.forEachStoredBin([&](int ix, int iy, const multibin::Bin&) { add(ix, iy); });
+    }
     if (isDualGrid()) {  // local cells not yet written back, at the global cell of their centre
         const multibin::BinGrid& l = m_impl->local;
         l.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
@@ -493,6 +504,8 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
     if (insertionOptions.query.dem_return_filled)  // the filled cells, tile by tile
         m_impl->filled.forEachFilled(
             [&](int ix, int iy, const multibin::fill::FilledCell&) { add(ix, iy); });
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
     std::vector<multibin::CellWindow> tiles;
     tiles.reserve(corners.size());
     for (const auto& [iy0, ix0] : corners)
