@@ -3,10 +3,10 @@
 # not installed yet (sudo when not root). Sourced by setup.sh, sanitize.sh and check-structure.sh.
 
 # What any build of the project needs (compilers and tools, MRPT, Eigen, OpenCV, GoogleTest,
-# Google Benchmark, nlohmann-json, zlib, libtiff and libgeotiff).
+# Google Benchmark, nlohmann-json, zlib, libdeflate, libtiff and libgeotiff).
 multibin_build_packages=(g++ cmake ninja-build pkg-config libmrpt-dev mrpt-apps mrpt-common
                          libeigen3-dev libopencv-dev libgtest-dev libbenchmark-dev
-                         nlohmann-json3-dev zlib1g-dev libtiff-dev libgeotiff-dev)
+                         nlohmann-json3-dev zlib1g-dev libdeflate-dev libtiff-dev libgeotiff-dev)
 # What scripts/check-structure.sh needs (file and function sizes of the library).
 multibin_check_packages=(universal-ctags)
 install_missing_packages() {

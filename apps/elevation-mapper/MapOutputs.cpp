@@ -12,7 +12,6 @@
 
 #include <sys/stat.h>
 #include <unistd.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <opencv2/imgproc.hpp>
@@ -21,6 +20,7 @@
 
 #include "ProgressBar.h"
 #include "multibin/io/ErrorMessage.h"
+#include "multibin/io/Gzip.h"
 #include "multibin/io/MapLayerFiles.h"
 #include "multibin/io/NumberText.h"
 #include "multibin/io/OutputFile.h"
@@ -82,28 +82,15 @@ multibin::EsriAsciiGrid traversabilityLike(const CMultiBinElevationMap& map, int
     return out;
 }
 
-/** The serialized form of an object, gzip-compressed in memory (what CFileGZOutputStream writes
- * and CFileGZInputStream reads), so the file is written whole by writeFileAtomically(). MRPT's
- * compress_gz_data_block() goes through a temporary file whose write errors it ignores. */
+/** The serialized form of an object, gzip-compressed in memory (what CFileGZInputStream reads),
+ * so the file is written whole by writeFileAtomically(). MRPT's compress_gz_data_block() goes
+ * through a temporary file whose write errors it ignores. */
 std::vector<uint8_t> gzSerialized(const mrpt::serialization::CSerializable& object) {
     mrpt::io::CMemoryStream mem;
     auto arch = mrpt::serialization::archiveFrom(mem);
     arch << object;
-    z_stream z{};
-    // windowBits 15 + 16: a gzip header and trailer; level 1 as CFileGZOutputStream's default.
-    if (deflateInit2(&z, 1, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK)
-        throw std::runtime_error("gzip compression failed to start");
-    const auto n = static_cast<uLong>(mem.getTotalBytesCount());
-    std::vector<uint8_t> gz(deflateBound(&z, n));
-    z.next_in = static_cast<Bytef*>(const_cast<void*>(mem.getRawBufferData()));
-    z.avail_in = static_cast<uInt>(n);
-    z.next_out = gz.data();
-    z.avail_out = static_cast<uInt>(gz.size());
-    const int rc = deflate(&z, Z_FINISH);
-    gz.resize(z.total_out);
-    deflateEnd(&z);
-    if (rc != Z_STREAM_END) throw std::runtime_error("gzip compression failed");
-    return gz;
+    return multibin::gzipCompressed(static_cast<const uint8_t*>(mem.getRawBufferData()),
+                                    size_t(mem.getTotalBytesCount()));
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -90,6 +91,33 @@ void setTags(TIFF* tif, const TiledRaster& raster, const CellWindow& bounds,
 
 using TiffHandle = std::unique_ptr<TIFF, void (*)(TIFF*)>;
 
+/** The samples of `tile` into `buffer` (kGeoTiffTile rows from the north, west to east), NaN
+ * where unknown; false when none is known. A sparse raster's known samples only are visited. */
+bool tileSamples(const TiledRaster& raster, const CellWindow& tile, std::vector<float>& buffer) {
+    const auto at = [&](int ix, int iy) -> float& {  // north up
+        return buffer[size_t(kGeoTiffTile - 1 - (iy - tile.iy0)) * kGeoTiffTile +
+                      size_t(ix - tile.ix0)];
+    };
+    std::fill(buffer.begin(), buffer.end(), std::numeric_limits<float>::quiet_NaN());
+    bool any = false;
+    if (raster.knownSamples) {
+        raster.knownSamples(tile, tile, [&](int ix, int iy, float v) {
+            at(ix, iy) = v;
+            any = any || std::isfinite(v);
+        });
+        return any;
+    }
+    const EsriAsciiGrid g = raster.samples(tile);
+    for (int c = 0; c < kGeoTiffTile; c++)  // column-major: down the columns
+        for (int r = 0; r < kGeoTiffTile; r++) {
+            const float v = g.heights_m(r, c);
+            if (std::isnan(v)) continue;
+            at(tile.ix0 + c, tile.iy0 + r) = v;
+            any = any || std::isfinite(v);
+        }
+    return any;
+}
+
 /** Writes rasters[k] (all over the same tiles) to paths[k] (private temporaries) in one loop over
  * the tiles, so rasters that share a tile read (tiledLayers()) query the map once; one tile of
  * each in memory. Returns the tiles written of rasters[0]. */
@@ -112,16 +140,7 @@ size_t writeTiles(const std::vector<TiledRaster>& rasters, const std::vector<std
     size_t written = 0;
     for (const CellWindow& t : tiles)
         for (size_t k = 0; k < rasters.size(); k++) {
-            const EsriAsciiGrid g = rasters[k].samples(t);
-            bool any = false;
-            for (int r = 0; r < kGeoTiffTile; r++)
-                for (int c = 0; c < kGeoTiffTile; c++) {
-                    const float v = g.heights_m(r, c);
-                    any = any || std::isfinite(v);
-                    buffer[size_t(kGeoTiffTile - 1 - r) * kGeoTiffTile + size_t(c)] =
-                        v;  // north up
-                }
-            if (!any) continue;  // left sparse: nodata
+            if (!tileSamples(rasters[k], t, buffer)) continue;  // left sparse: nodata
             const TilePlace p = placeOf(t, bounds);
             TIFF* tif = tifs[k].get();
             const uint32_t i = TIFFComputeTile(tif, p.x_px, p.y_px, 0, 0);

@@ -181,6 +181,22 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
     // Each sample's colour once, row by row (the raster is column-major), then copied to its
     // pixels through the column of each pixel, found once: the panel is the preview's largest
     // part, and a row of samples drawn again (scale > 1) is a copy of the row above.
+    if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place,
+        // the unknown grey first (most of a sparse map's panel), then the known samples in the
+        // raster's memory order (column-major: a walk along a row would miss the cache per sample)
+        const cv::Vec3b unknown = colourOf(std::numeric_limits<float>::quiet_NaN());
+        for (int py = 0; py < panel.height; py++) {
+            cv::Vec3b* pixel = img.ptr<cv::Vec3b>(panel.y + py) + panel.x;
+            std::fill(pixel, pixel + cols, unknown);
+        }
+        for (int c = 0; c < cols; c++) {
+            const float* sample = raster.heights_m.data() + size_t(c) * size_t(rows);
+            for (int r = 0; r < rows; r++)
+                if (std::isfinite(sample[r]))  // north up
+                    img.ptr<cv::Vec3b>(panel.y + rows - 1 - r)[panel.x + c] = colourOf(sample[r]);
+        }
+        return;
+    }
     std::vector<int> columnOf(static_cast<size_t>(panel.width));
     for (int px = 0; px < panel.width; px++)
         columnOf[size_t(px)] = std::min(cols - 1, int(px / scale));
@@ -195,14 +211,6 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
             continue;
         }
         colouredRow = r;
-        if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place,
-            // the unknown grey first (most of a sparse map's panel), then the known samples
-            std::fill(pixel, pixel + cols, colourOf(std::numeric_limits<float>::quiet_NaN()));
-            const float* sample = raster.heights_m.data() + r;  // column-major: stride `rows`
-            for (int c = 0; c < cols; c++, sample += rows)
-                if (std::isfinite(*sample)) pixel[c] = colourOf(*sample);
-            continue;
-        }
         for (int c = 0; c < cols; c++) rowColours[size_t(c)] = colourOf(raster.heights_m(r, c));
         for (int px = 0; px < panel.width; px++)
             pixel[px] = rowColours[size_t(columnOf[size_t(px)])];

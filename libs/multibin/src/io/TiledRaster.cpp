@@ -122,11 +122,14 @@ std::vector<EsriAsciiGrid> blockReduced(const std::vector<TiledRaster>& rasters,
     // as if whole, so the lattice stays regular).
     blank.xllcenter_m = first.originX_m + window.ix0 * first.cellSize_m + 0.5 * blank.cellsize_m;
     blank.yllcenter_m = first.originY_m + window.iy0 * first.cellSize_m + 0.5 * blank.cellsize_m;
-    blank.heights_m.setConstant(rows, cols, std::numeric_limits<float>::quiet_NaN());
     std::vector<EsriAsciiGrid> out(rasters.size(), blank);
-    std::vector<Eigen::MatrixXf> counts(rasters.size());  // per mean raster: samples per block
+    for (EsriAsciiGrid& o : out)
+        o.heights_m.setConstant(rows, cols, std::numeric_limits<float>::quiet_NaN());
+    // Per mean raster of blocks larger than one cell: samples per block. A block of one cell
+    // takes its one sample: no counts (a raster's worth of memory, first touched here).
+    std::vector<Eigen::MatrixXf> counts(rasters.size());
     for (size_t k = 0; k < rasters.size(); k++)
-        if (how[k] == BlockReduce::Mean) counts[k].setZero(rows, cols);
+        if (how[k] == BlockReduce::Mean && factor > 1) counts[k].setZero(rows, cols);
     for (const CellWindow& t : first.tiles) {
         const CellWindow part = intersection(t, window);
         if (part.nx == 0 || part.ny == 0) continue;
@@ -138,6 +141,8 @@ std::vector<EsriAsciiGrid> blockReduced(const std::vector<TiledRaster>& rasters,
                 float& b = o.heights_m(br, bc);
                 if (how[k] == BlockReduce::Max) {
                     b = std::isfinite(b) ? std::max(b, v) : v;
+                } else if (factor == 1) {
+                    b = v;
                 } else {
                     const float n = ++counts[k](br, bc);  // running mean: one pass
                     b = n == 1 ? v : b + (v - b) / n;

@@ -1,6 +1,8 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: serialization, rasters, images and files. */
+#include <mrpt/config.h>
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/core/reverse_bytes.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
@@ -11,8 +13,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -42,31 +46,64 @@ void forEachMoment(Moments& m, Visit&& visit) {
         visit(*v);
 }
 
+/** Numbers written as CArchive's operator<< writes them (little-endian) into a buffer sized in
+ * advance: a CArchive write per field costs about a hundred instructions. */
+struct ByteCursor {
+    uint8_t* at;
+    template <typename T>
+    void put(T v) {
+        static_assert(std::is_arithmetic_v<T>, "a number");
+#if MRPT_IS_BIG_ENDIAN
+        mrpt::reverseBytesInPlace(v);
+#endif
+        std::memcpy(at, &v, sizeof v);
+        at += sizeof v;
+    }
+};
+
+/** Bytes of a stored cell's header (ix, iy, bin count) and of each of its bins. */
+constexpr size_t kCellHeaderBytes = 4 + 4 + 2;
+constexpr size_t kStoredBinBytes = 3 * 4 + 4 + 2 + 10 * 4 + 2;
+
 /** A grid: its window, then each non-empty cell with its bins (each with its plane moments and
  * its pose sigma codes). */
 void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid) {
     const multibin::CellWindow& w = grid.window();
     out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
-    // The non-empty cells, found tile by tile (not over the window: a route's window is mostly
-    // empty), written row by row as the reader expects.
-    std::vector<std::pair<int32_t, int32_t>> cells;  // (iy, ix)
-    int32_t lastIx = 0, lastIy = 0;
-    grid.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
-        if (cells.empty() || ix != lastIx || iy != lastIy) cells.emplace_back(iy, ix);
-        lastIx = ix, lastIy = iy;
+    // The bins' records made in one pass over the store, tile by tile (not over the window: a
+    // route's window is mostly empty; a cell's bins come together, in the order forEachBin gives
+    // them), then the cells written row by row as the reader expects.
+    struct StoredCell {
+        int32_t iy, ix;
+        size_t firstBin;
+        uint16_t bins;
+        bool operator<(const StoredCell& o) const { return iy != o.iy ? iy < o.iy : ix < o.ix; }
+    };
+    std::vector<StoredCell> cells;
+    std::vector<uint8_t> binBytes(grid.store().binCount() * kStoredBinBytes);
+    ByteCursor record{binBytes.data()};
+    size_t bins = 0;
+    grid.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin& b) {
+        if (cells.empty() || ix != cells.back().ix || iy != cells.back().iy)
+            cells.push_back({int32_t(iy), int32_t(ix), bins, 0});
+        cells.back().bins++;
+        bins++;
+        record.put(b.height_m), record.put(b.variance_m2), record.put(b.certainty);
+        record.put(b.pointCount), record.put(b.index);
+        forEachMoment(b.plane, [&](const float& v) { record.put(v); });
+        record.put(b.poseHeightSigmaCode), record.put(b.poseHorizontalSigmaCode);
     });
     std::sort(cells.begin(), cells.end());
     out << uint64_t(cells.size());
-    for (const auto& [iy, ix] : cells) {
-        uint16_t n = 0;
-        grid.forEachBin(ix, iy, [&](const multibin::Bin&) { n++; });
-        out << int32_t(ix) << int32_t(iy) << n;
-        grid.forEachBin(ix, iy, [&](const multibin::Bin& b) {
-            out << b.height_m << b.variance_m2 << b.certainty << b.pointCount << b.index;
-            forEachMoment(b.plane, [&](const float& v) { out << v; });
-            out << b.poseHeightSigmaCode << b.poseHorizontalSigmaCode;
-        });
+    std::vector<uint8_t> bytes(cells.size() * kCellHeaderBytes + bins * kStoredBinBytes);
+    ByteCursor to{bytes.data()};
+    for (const StoredCell& c : cells) {
+        to.put(c.ix), to.put(c.iy), to.put(c.bins);
+        std::memcpy(to.at, binBytes.data() + c.firstBin * kStoredBinBytes,
+                    c.bins * kStoredBinBytes);
+        to.at += c.bins * kStoredBinBytes;
     }
+    if (!bytes.empty()) out.WriteBuffer(bytes.data(), bytes.size());  // MRPT refuses null
 }
 
 /** `text` without its lines that start with `key` followed by a space or '='. */

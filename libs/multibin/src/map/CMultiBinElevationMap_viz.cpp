@@ -91,8 +91,8 @@ ViewRanges viewRanges(const EsriAsciiGrid& heights, const EsriAsciiGrid& values,
     ViewRanges r;
     r.zLo_m = std::numeric_limits<float>::infinity(), r.zHi_m = -r.zLo_m;
     std::vector<float> known;
-    for (int row = 0; row < heights.rows(); row++)
-        for (int c = 0; c < heights.cols(); c++) {
+    for (int c = 0; c < heights.cols(); c++)  // column-major: down the columns
+        for (int row = 0; row < heights.rows(); row++) {
             const float h = heights.heights_m(row, c), v = values.heights_m(row, c);
             if (!std::isfinite(h)) continue;
             r.zLo_m = std::min(r.zLo_m, h), r.zHi_m = std::max(r.zHi_m, h);
@@ -223,9 +223,9 @@ mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
     auto points = mrpt::opengl::CPointCloudColoured::Create();
     points->setName("cells outside the mesh");
     points->setPointSize(2);
-    for (int iy = 0; iy < ny; iy++) {
-        const float* h = heights.heights_m.data() + iy;  // column-major: stride ny
-        for (int ix = 0; ix < nx; ix++, h += ny) {
+    for (int ix = 0; ix < nx; ix++) {
+        const float* h = heights.heights_m.data() + size_t(ix) * size_t(ny);  // column-major
+        for (int iy = 0; iy < ny; iy++, h++) {
             if (!std::isfinite(*h) || inAQuad(ix, iy)) continue;  // most cells: unknown
             const float v = values.heights_m(iy, ix);
             const mrpt::img::TColor c = std::isfinite(v) ? cellColour(v, colouring, lut, r)
