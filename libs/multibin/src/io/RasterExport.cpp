@@ -240,10 +240,16 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     PngScanlines png(W + L + R, panelH + T + B);
     cv::Mat img = png.image();  // white
 
-    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (Eigen::Index i = 0; i < raster.heights_m.size(); i++) {
-        const float v = raster.heights_m.data()[i];
-        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    // The finite samples' range: in two vectorised passes (unknown samples are NaN), by a loop
+    // when an infinite one (or none) is there.
+    float lo = raster.heights_m.minCoeff<Eigen::PropagateNumbers>(),
+          hi = raster.heights_m.maxCoeff<Eigen::PropagateNumbers>();
+    if (!std::isfinite(lo) || !std::isfinite(hi)) {
+        lo = std::numeric_limits<float>::infinity(), hi = -lo;
+        for (Eigen::Index i = 0; i < raster.heights_m.size(); i++) {
+            const float v = raster.heights_m.data()[i];
+            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+        }
     }
     if (!(lo <= hi)) lo = hi = 0;
     const float span = hi > lo ? hi - lo : 1.f;

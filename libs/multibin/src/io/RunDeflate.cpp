@@ -46,14 +46,10 @@ int distCode(int dist) {
     return int(std::upper_bound(kDistBase, kDistBase + 30, dist) - kDistBase) - 1;
 }
 
-/** Adler-32 kept as its two sums, updated by bytes or, in O(period), by a periodic run. */
+/** Adler-32 kept as its two sums, updated by a span of bytes or, in O(period), by a periodic
+ * run. */
 struct Adler {
     uint64_t a = 1, b = 0;
-    void byte(uint8_t v) {
-        a += v, b += a;
-        if (a >= kAdlerMod) a -= kAdlerMod;
-        b %= kAdlerMod;
-    }
     void bytes(const uint8_t* p, size_t n) {
         const uLong v = adler32_z(uLong((b << 16) | a), p, n);
         a = v & 0xffff, b = v >> 16;
@@ -257,7 +253,10 @@ void deflateRuns(const uint8_t* data, size_t size, int period, size_t rowBytes, 
     Tokens t;
     t.list.reserve(size / 64 + 16);
     const size_t d = size_t(period);
-    size_t i = 0;
+    size_t i = 0, literalsFrom = 0;  // the literals since literalsFrom: checksummed together
+    const auto checksumLiterals = [&] {
+        if (adler && i > literalsFrom) adler->bytes(data + literalsFrom, i - literalsFrom);
+    };
     while (i < size) {
         const size_t byPeriod = i >= d ? runLength(data, i, d, size - i) : 0;
         const size_t byRow =
@@ -266,9 +265,11 @@ void deflateRuns(const uint8_t* data, size_t size, int period, size_t rowBytes, 
                 : 0;
         if (std::max(byPeriod, byRow) < size_t(kMinMatch)) {
             t.literal(data[i]);
-            if (adler) adler->byte(data[i]);
             i++;
-        } else if (byPeriod >= byRow) {  // the whole run at once, its checksum in O(period)
+            continue;
+        }
+        checksumLiterals();
+        if (byPeriod >= byRow) {  // the whole run at once, its checksum in O(period)
             t.run(byPeriod, period);
             if (adler) adler->periodic(data + i - d, period, byPeriod);
             i += byPeriod;
@@ -277,7 +278,9 @@ void deflateRuns(const uint8_t* data, size_t size, int period, size_t rowBytes, 
             if (adler) adler->bytes(data + i, byRow);
             i += byRow;
         }
+        literalsFrom = i;
     }
+    checksumLiterals();
     writeBlock(t, out);
 }
 
