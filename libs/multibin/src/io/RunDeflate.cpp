@@ -73,13 +73,7 @@ struct Adler {
 /** Bytes equal to the ones `d` before, from `i` on (at most `limit`). */
 size_t runLength(const uint8_t* p, size_t i, size_t d, size_t limit) {
     size_t k = 0;
-    for (; k + 32 <= limit; k += 32) {  // 32 at a time while all agree (one branch)
-        uint64_t x[4], y[4];
-        std::memcpy(x, p + i + k, 32);
-        std::memcpy(y, p + i + k - d, 32);
-        if (((x[0] ^ y[0]) | (x[1] ^ y[1]) | (x[2] ^ y[2]) | (x[3] ^ y[3])) != 0) break;
-    }
-    for (uint64_t x, y; k + 8 <= limit; k += 8) {  // then eight at a time
+    for (uint64_t x, y; k + 8 <= limit; k += 8) {  // eight at a time while all agree
         std::memcpy(&x, p + i + k, 8);
         std::memcpy(&y, p + i + k - d, 8);
         if (x != y) break;
