@@ -5,6 +5,9 @@
 #include <array>
 #include <climits>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -23,60 +26,102 @@ bool measuredCell(const MeasuredCell& c) {
            c.sigma_m > 0;
 }
 
-/** Reads cells of a TiledCells, keeping the last tile found: a flood stays in one tile mostly.
- * The pointer kept stays valid: only this cursor adds tiles, and only when it moves to one. */
-template <typename Cells, typename TilePtr>
-class Cursor {
+/** The numbers of the tiles of a TiledCells by cell, through a small cache of the tiles found
+ * last: a flood stays in a few tiles (along a tile border it steps between two at every cell),
+ * where a hash lookup per step would cost much of the flood. Tile numbers never change, so the
+ * cache holds while tiles are added. */
+template <typename Lookup>
+class TileNumbers {
 public:
-    explicit Cursor(Cells& c) : m_c(c) {}
-    /** Cell (ix, iy)'s tile, allocated if `Cells` is writable; nullptr if absent (read only). */
-    TilePtr tileOf(int ix, int iy) {
+    explicit TileNumbers(Lookup lookup) : m_lookup(std::move(lookup)) {}
+    /** The number of cell (ix, iy)'s tile: what Lookup(tx, ty) answers (-1: none). */
+    long of(int ix, int iy) {
         const int tx = ix >> TiledCells<int>::kShift, ty = iy >> TiledCells<int>::kShift;
-        if (tx != m_tx || ty != m_ty || !m_valid) {
-            m_tx = tx, m_ty = ty, m_valid = true;
-            if constexpr (std::is_const_v<Cells>)
-                m_tile = m_c.findTile(tx, ty);
-            else
-                m_tile = m_c.tile(tx, ty);
-        }
-        return m_tile;
+        Entry& e = m_cache[(unsigned(tx) * 3u + unsigned(ty)) & (kEntries - 1)];
+        if (!e.valid || e.tx != tx || e.ty != ty) e = {tx, ty, m_lookup(tx, ty), true};
+        return e.number;
     }
 
 private:
-    Cells& m_c;
-    int m_tx = 0, m_ty = 0;
-    bool m_valid = false;
-    TilePtr m_tile = nullptr;
+    static constexpr unsigned kEntries = 16;
+    struct Entry {
+        int tx = 0, ty = 0;
+        long number = -1;
+        bool valid = false;
+    };
+    Lookup m_lookup;
+    std::array<Entry, kEntries> m_cache{};
 };
 
-constexpr int kUnvisited = -1, kLarge = -2, kFlooding = -3;
+/** Which cells of a tile are measured, a bit a cell (row iy % kSide, bit ix % kSide). */
+using TileBits = std::array<uint64_t, TiledCells<int>::kSide>;
+
+/** The measured cells of in's tiles, by tile number: read once (512 B a tile against the cells'
+ * 48 kB) for the count and the floods, which test every neighbour they reach. */
+std::vector<TileBits> measuredBits(const SparseHeights& in) {
+    constexpr size_t kSide = TiledCells<int>::kSide;
+    std::vector<TileBits> bits(in.cells.tileCount());
+    size_t number = 0;
+    in.cells.forEachTile([&](int, int, const MeasuredCell* t) {
+        TileBits& b = bits[number++];
+        for (size_t k = 0; k < TiledCells<MeasuredCell>::kTileCells; k++)
+            b[k / kSide] |= uint64_t(measuredCell(t[k])) << (k % kSide);
+    });
+    return bits;
+}
+
+/** The measured cells inside in's window. */
+size_t measuredInWindow(const SparseHeights& in, const std::vector<TileBits>& bits) {
+    constexpr int kSide = TiledCells<int>::kSide;
+    const CellWindow& w = in.lattice.window;
+    size_t measured = 0, number = 0;
+    in.cells.forEachTile([&](int tx, int ty, const MeasuredCell*) {
+        const TileBits& b = bits[number++];
+        const int x0 = tx * kSide, y0 = ty * kSide;
+        const bool inside = w.contains(x0, y0) && w.contains(x0 + kSide - 1, y0 + kSide - 1);
+        for (int r = 0; r < kSide; r++)
+            if (inside)
+                measured += size_t(__builtin_popcountll(b[size_t(r)]));
+            else
+                for (uint64_t row = b[size_t(r)]; row != 0; row &= row - 1)
+                    measured += w.contains(x0 + __builtin_ctzll(row), y0 + r);
+    });
+    return measured;
+}
+
+/** What the floods know of an unmeasured cell, a byte a cell (a tile of labels is 4 kB). */
+enum class Label : int8_t { Unvisited, Flooding, Large, InAGap };
 
 /** One gap: its cells (absolute), row by row. */
 using GapCells = std::vector<std::array<int, 2>>;  // (iy, ix): sorts row-major
 
 /** The gaps of at most o.maxGapCells cells, in the whole-window path's label order (by first
  * cell, row-major), each sorted row-major. Counts the floods' cells and the larger regions. */
-std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
-                               FillResult::Stats& s) {
+std::vector<GapCells> findGaps(const SparseHeights& in, const std::vector<TileBits>& measuredBits,
+                               const FillOptions& o, FillResult::Stats& s) {
     const CellWindow& w = in.lattice.window;
-    TiledCells<int> label(kUnvisited);
-    label.reserve(in.cells.tileCount());  // the floods stay in the data's tiles, mostly
-    Cursor<const TiledCells<MeasuredCell>, const MeasuredCell*> data(in.cells);
-    Cursor<TiledCells<int>, int*> labels(label);
-    auto measured = [&](int ix, int iy) {
-        const auto* t = data.tileOf(ix, iy);
-        return t && measuredCell(t[TiledCells<int>::inTile(ix, iy)]);
+    constexpr int kSide = TiledCells<int>::kSide;
+    TiledCells<Label> label(Label::Unvisited);
+    // Room for the data's tiles and as many around them (reserved, not touched: a tile added
+    // beyond it would copy every label tile into fresh pages).
+    label.reserve(2 * in.cells.tileCount() + 16);
+    TileNumbers dataTiles([&](int tx, int ty) { return in.cells.findTileNumber(tx, ty); });
+    TileNumbers labelTiles([&](int tx, int ty) { return long(label.tileNumber(tx, ty)); });
+    // Cell (ix, iy), in the data's tile number n (-1: none), is measured.
+    auto measuredIn = [&](long n, int ix, int iy) {
+        return n >= 0 &&
+               (measuredBits[size_t(n)][size_t(iy & (kSide - 1))] >> (ix & (kSide - 1)) & 1) != 0;
     };
-    auto labelOf = [&](int ix, int iy) -> int& {
-        return labels.tileOf(ix, iy)[TiledCells<int>::inTile(ix, iy)];
+    auto measured = [&](int ix, int iy) { return measuredIn(dataTiles.of(ix, iy), ix, iy); };
+    auto labelOf = [&](int ix, int iy) -> Label& {
+        return label.tileCells(size_t(labelTiles.of(ix, iy)))[TiledCells<Label>::inTile(ix, iy)];
     };
     // A tile without data whole inside the window is kTileCells connected unmeasured cells: a
     // flood that enters one is in a region larger than maxGapCells when kTileCells is, and stops
     // there instead of flooding maxGapCells cells first (the open sides of a wall).
     const bool emptyTileIsLarge = TiledCells<int>::kTileCells > size_t(o.maxGapCells);
-    constexpr int kSide = TiledCells<int>::kSide;
     auto inEmptyWholeTile = [&](int ix, int iy) {
-        if (!emptyTileIsLarge || data.tileOf(ix, iy)) return false;
+        if (!emptyTileIsLarge || dataTiles.of(ix, iy) >= 0) return false;
         const int x0 = (ix >> TiledCells<int>::kShift) * kSide,
                   y0 = (iy >> TiledCells<int>::kShift) * kSide;
         return w.contains(x0, y0) && w.contains(x0 + kSide - 1, y0 + kSide - 1);
@@ -87,48 +132,58 @@ std::vector<GapCells> findGaps(const SparseHeights& in, const FillOptions& o,
         // Breadth first: a region too large is marked as a compact blob around the seed, which
         // the floods from the next seeds along the same rim meet at once.
         members.assign(1, {y0, x0});
-        labelOf(x0, y0) = kFlooding;
+        labelOf(x0, y0) = Label::Flooding;
         bool large = false;
         for (size_t head = 0; head < members.size() && !large; head++) {
             const auto [y, x] = members[head];
+            // A neighbour in the cell's own tile (most) reuses what was found of the tile.
+            const long dataNumber = dataTiles.of(x, y);
+            const size_t labelNumber = size_t(labelTiles.of(x, y));
+            const bool ownTileEmptyWhole = inEmptyWholeTile(x, y);
+            const int cx = x & (kSide - 1), cy = y & (kSide - 1);
             const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
-            for (const auto& p : nb) {
-                if (!w.contains(p[0], p[1]) || measured(p[0], p[1])) continue;
-                if (inEmptyWholeTile(p[0], p[1])) {  // no label: its tile is not allocated
-                    large = true;
+            const bool ownTile[4] = {(cx > 0), (cx < kSide - 1), (cy > 0), (cy < kSide - 1)};
+            for (int k = 0; k < 4; k++) {
+                const int px = nb[k][0], py = nb[k][1];
+                if (!w.contains(px, py)) continue;
+                if (measuredIn(ownTile[k] ? dataNumber : dataTiles.of(px, py), px, py)) continue;
+                if (ownTile[k] ? ownTileEmptyWhole : inEmptyWholeTile(px, py)) {
+                    large = true;  // no label: its tile is not allocated
                     continue;
                 }
-                int& l = labelOf(p[0], p[1]);
-                if (l == kLarge) large = true;  // part of a region already found too large
-                if (l != kUnvisited) continue;
-                l = kFlooding;
-                members.push_back({p[1], p[0]});
+                const size_t n = ownTile[k] ? labelNumber : size_t(labelTiles.of(px, py));
+                Label& l = label.tileCells(n)[TiledCells<Label>::inTile(px, py)];
+                if (l == Label::Large) large = true;  // part of a region already found too large
+                if (l != Label::Unvisited) continue;
+                l = Label::Flooding;
+                members.push_back({py, px});
             }
             large |= members.size() > size_t(o.maxGapCells);
         }
         s.cellsVisited += members.size();
         s.gapComponents++;
         if (large) {  // stays Unknown; its cells stop the floods that reach them
-            for (const auto& m : members) labelOf(m[1], m[0]) = kLarge;
+            for (const auto& m : members) labelOf(m[1], m[0]) = Label::Large;
             return;
         }
-        for (const auto& m : members) labelOf(m[1], m[0]) = int(gaps.size());
+        for (const auto& m : members) labelOf(m[1], m[0]) = Label::InAGap;
         std::sort(members.begin(), members.end());
         gaps.push_back(members);
     };
     // Every gap touches a measured cell (the window is connected): seed from their neighbours.
-    in.cells.forEachTile([&](int tx, int ty, const MeasuredCell* t) {
-        for (size_t k = 0; k < TiledCells<MeasuredCell>::kTileCells; k++) {
-            if (!measuredCell(t[k])) continue;
-            const int x = tx * TiledCells<int>::kSide + int(k % TiledCells<int>::kSide);
-            const int y = ty * TiledCells<int>::kSide + int(k / TiledCells<int>::kSide);
-            if (!w.contains(x, y)) continue;
-            const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
-            for (const auto& p : nb)
-                if (w.contains(p[0], p[1]) && !measured(p[0], p[1]) &&
-                    labelOf(p[0], p[1]) == kUnvisited)
-                    flood(p[0], p[1]);
-        }
+    size_t number = 0;
+    in.cells.forEachTile([&](int tx, int ty, const MeasuredCell*) {
+        const std::array<uint64_t, kSide>& bits = measuredBits[number++];
+        for (int r = 0; r < kSide; r++)  // the measured cells row by row, west to east
+            for (uint64_t row = bits[size_t(r)]; row != 0; row &= row - 1) {
+                const int x = tx * kSide + __builtin_ctzll(row), y = ty * kSide + r;
+                if (!w.contains(x, y)) continue;
+                const int nb[4][2] = {{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}};
+                for (const auto& p : nb)
+                    if (w.contains(p[0], p[1]) && !measured(p[0], p[1]) &&
+                        labelOf(p[0], p[1]) == Label::Unvisited)
+                        flood(p[0], p[1]);
+            }
     });
     std::sort(gaps.begin(), gaps.end(),
               [](const GapCells& a, const GapCells& b) { return a.front() < b.front(); });
@@ -250,16 +305,11 @@ FilledCells fillSparse(const SparseHeights& in, const FillOptions& o) {
     FilledCells out;
     out.lattice = in.lattice;
     const CellWindow& w = in.lattice.window;
-    size_t measured = 0;
-    constexpr int kSide = TiledCells<MeasuredCell>::kSide;
-    in.cells.forEachTile([&](int tx, int ty, const MeasuredCell* t) {
-        for (size_t k = 0; k < TiledCells<MeasuredCell>::kTileCells; k++)
-            measured += measuredCell(t[k]) &&
-                        w.contains(tx * kSide + int(k) % kSide, ty * kSide + int(k) / kSide);
-    });
+    const std::vector<TileBits> bits = measuredBits(in);
+    const size_t measured = measuredInWindow(in, bits);
     size_t filled[5] = {};  // per HeightSource
     if (o.enabled)
-        for (const GapCells& g : findGaps(in, o, out.stats)) {
+        for (const GapCells& g : findGaps(in, bits, o, out.stats)) {
             // The median's small raster first; the surface's larger one if the median does not
             // reach the whole gap.
             CellWindow rw = gapRaster(g, w, o, false);

@@ -32,14 +32,7 @@ public:
     T& at(int ix, int iy) { return tile(ix >> kShift, iy >> kShift)[inTile(ix, iy)]; }
     /** The kTileCells cells of tile (tx, ty), row-major, the tile added (all `empty`) if missing.
      */
-    T* tile(int tx, int ty) {
-        const auto [it, added] = m_index.try_emplace(key(tx, ty), uint32_t(m_xy.size()));
-        if (added) {
-            m_cells.resize(m_cells.size() + kTileCells, m_empty);
-            m_xy.push_back({tx, ty});
-        }
-        return m_cells.data() + size_t(it->second) * kTileCells;
-    }
+    T* tile(int tx, int ty) { return tileCells(tileNumber(tx, ty)); }
     /** Room for `tiles` tiles in all: adding them then copies no tile (the tiles' array grows by
      * reallocation otherwise, each copy touching fresh pages). */
     void reserve(size_t tiles) {
@@ -47,12 +40,31 @@ public:
         m_xy.reserve(tiles);
         m_index.reserve(tiles);
     }
+    /** Tile (tx, ty)'s number (the order of addition; it never changes), the tile added (all
+     * `empty`) if missing. */
+    size_t tileNumber(int tx, int ty) {
+        const auto [it, added] = m_index.try_emplace(key(tx, ty), uint32_t(m_xy.size()));
+        if (added) {
+            m_cells.resize(m_cells.size() + kTileCells, m_empty);
+            m_xy.push_back({tx, ty});
+        }
+        return it->second;
+    }
+    /** Tile (tx, ty)'s number, or -1 if it was never written. */
+    long findTileNumber(int tx, int ty) const {
+        const auto it = m_index.find(key(tx, ty));
+        return it == m_index.end() ? -1 : long(it->second);
+    }
+    /** The kTileCells cells of tile number `n` (< tileCount()), row-major. */
+    T* tileCells(size_t n) { return m_cells.data() + n * kTileCells; }
+    const T* tileCells(size_t n) const { return m_cells.data() + n * kTileCells; }
     /** The cells of tile (tx, ty), or nullptr if it was never written. */
     const T* findTile(int tx, int ty) const {
-        const auto it = m_index.find(key(tx, ty));
-        return it == m_index.end() ? nullptr : m_cells.data() + size_t(it->second) * kTileCells;
+        const long n = findTileNumber(tx, ty);
+        return n < 0 ? nullptr : tileCells(size_t(n));
     }
-    /** Calls f(tx, ty, const T* cells) for every tile (kTileCells cells), in order of addition. */
+    /** Calls f(tx, ty, const T* cells) for every tile (kTileCells cells), in order of addition
+     * (tile number 0, 1, ...). */
     template <typename F>
     void forEachTile(F&& f) const {
         for (size_t t = 0; t < m_xy.size(); t++)
