@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "multibin/grid/BinStore.h"
+#include "multibin/io/FiniteSamples.h"
 #include "multibin/map/TerrainView.h"
 
 namespace multibin {
@@ -76,19 +77,6 @@ std::vector<TiledRaster> tiledLayers(const CMultiBinElevationMap& map,
 }
 
 namespace {
-
-/** Whether any of v[0, n) is finite: the bits of std::isfinite, in one loop without a branch
- * (a column of a sparse route's tile is mostly unknown, NaN). */
-bool anyFinite(const float* v, size_t n) {
-    constexpr uint32_t kExponent = 0x7f800000u;  // all ones: infinite or NaN
-    bool any = false;
-    for (size_t i = 0; i < n; i++) {
-        uint32_t bits;
-        std::memcpy(&bits, v + i, sizeof bits);
-        any |= (bits & kExponent) != kExponent;
-    }
-    return any;
-}
 
 /** Known cells grouped by raster tile (in the order of the tiles), each tile's row by row. */
 struct SparseCells {

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "multibin/io/FiniteSamples.h"
 #include "multibin/io/OutputFile.h"
 #include "multibin/io/RunDeflate.h"
 
@@ -184,16 +185,16 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
     if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place,
         // the unknown grey first (most of a sparse map's panel), then the known samples in the
         // raster's memory order (column-major: a walk along a row would miss the cache per sample)
-        const cv::Vec3b unknown = colourOf(std::numeric_limits<float>::quiet_NaN());
-        for (int py = 0; py < panel.height; py++) {
-            cv::Vec3b* pixel = img.ptr<cv::Vec3b>(panel.y + py) + panel.x;
-            std::fill(pixel, pixel + cols, unknown);
-        }
+        cv::Vec3b* first = img.ptr<cv::Vec3b>(panel.y) + panel.x;
+        std::fill(first, first + cols, colourOf(std::numeric_limits<float>::quiet_NaN()));
+        for (int py = 1; py < panel.height; py++)  // the other rows copied from the first
+            std::memcpy(img.ptr<cv::Vec3b>(panel.y + py) + panel.x, first,
+                        size_t(cols) * sizeof(cv::Vec3b));
         for (int c = 0; c < cols; c++) {
             const float* sample = raster.heights_m.data() + size_t(c) * size_t(rows);
-            for (int r = 0; r < rows; r++)
-                if (std::isfinite(sample[r]))  // north up
-                    img.ptr<cv::Vec3b>(panel.y + rows - 1 - r)[panel.x + c] = colourOf(sample[r]);
+            forEachFinite(sample, size_t(rows), [&](size_t r) {  // north up
+                img.ptr<cv::Vec3b>(panel.y + rows - 1 - int(r))[panel.x + c] = colourOf(sample[r]);
+            });
         }
         return;
     }
@@ -240,17 +241,12 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     PngScanlines png(W + L + R, panelH + T + B);
     cv::Mat img = png.image();  // white
 
-    // The finite samples' range: in two vectorised passes (unknown samples are NaN), by a loop
-    // when an infinite one (or none) is there.
-    float lo = raster.heights_m.minCoeff<Eigen::PropagateNumbers>(),
-          hi = raster.heights_m.maxCoeff<Eigen::PropagateNumbers>();
-    if (!std::isfinite(lo) || !std::isfinite(hi)) {
-        lo = std::numeric_limits<float>::infinity(), hi = -lo;
-        for (Eigen::Index i = 0; i < raster.heights_m.size(); i++) {
-            const float v = raster.heights_m.data()[i];
-            if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-        }
-    }
+    // The finite samples' range (a sparse map's raster is mostly NaN: skipped by blocks).
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    forEachFinite(raster.heights_m.data(), size_t(raster.heights_m.size()), [&](size_t i) {
+        const float v = raster.heights_m.data()[i];
+        lo = std::min(lo, v), hi = std::max(hi, v);
+    });
     if (!(lo <= hi)) lo = hi = 0;
     const float span = hi > lo ? hi - lo : 1.f;
     const ColourLut lut = colourLut(style.colormap);

@@ -165,20 +165,23 @@ std::array<uint16_t, N> canonicalCodes(const std::array<uint8_t, N>& bits) {
     return codes;
 }
 
+/** DEFLATE's bit stream (least significant bit first), written four bytes at a time. */
 class BitWriter {
 public:
     explicit BitWriter(std::vector<uint8_t>& out) : m_out(out) {}
-    void put(uint32_t value, int bits) {
+    void put(uint32_t value, int bits) {  // bits <= 16: the buffer holds at most 47 bits
         m_buffer |= uint64_t(value) << m_count;
         m_count += bits;
-        while (m_count >= 8) {
-            m_out.push_back(uint8_t(m_buffer));
-            m_buffer >>= 8;
-            m_count -= 8;
+        if (m_count >= 32) {
+            const uint8_t bytes[4] = {uint8_t(m_buffer), uint8_t(m_buffer >> 8),
+                                      uint8_t(m_buffer >> 16), uint8_t(m_buffer >> 24)};
+            m_out.insert(m_out.end(), bytes, bytes + 4);
+            m_buffer >>= 32;
+            m_count -= 32;
         }
     }
     void flush() {
-        if (m_count > 0) m_out.push_back(uint8_t(m_buffer));
+        for (; m_count > 0; m_count -= 8, m_buffer >>= 8) m_out.push_back(uint8_t(m_buffer));
         m_buffer = 0, m_count = 0;
     }
 
@@ -204,6 +207,7 @@ void writeBlock(Tokens& t, std::vector<uint8_t>& out) {
     while (nLit > 257 && litBits[size_t(nLit) - 1] == 0) nLit--;
     while (nDist > 1 && distBits[size_t(nDist) - 1] == 0) nDist--;
 
+    out.reserve(out.size() + t.list.size() * 6 + 320);  // 48 bits a token at most, the codes
     BitWriter w(out);
     w.put(1, 1);  // final block
     w.put(2, 2);  // dynamic Huffman codes

@@ -23,6 +23,7 @@
 #include "multibin/map/TerrainView.h"
 
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/io/FiniteSamples.h"
 
 using namespace mrpt::maps;
 
@@ -91,13 +92,12 @@ ViewRanges viewRanges(const EsriAsciiGrid& heights, const EsriAsciiGrid& values,
     ViewRanges r;
     r.zLo_m = std::numeric_limits<float>::infinity(), r.zHi_m = -r.zLo_m;
     std::vector<float> known;
-    for (int c = 0; c < heights.cols(); c++)  // column-major: down the columns
-        for (int row = 0; row < heights.rows(); row++) {
-            const float h = heights.heights_m(row, c), v = values.heights_m(row, c);
-            if (!std::isfinite(h)) continue;
-            r.zLo_m = std::min(r.zLo_m, h), r.zHi_m = std::max(r.zHi_m, h);
-            if (std::isfinite(v)) known.push_back(v);
-        }
+    // The known cells in memory order (the rasters are column-major, mostly NaN).
+    forEachFinite(heights.heights_m.data(), size_t(heights.heights_m.size()), [&](size_t i) {
+        const float h = heights.heights_m.data()[i], v = values.heights_m.data()[i];
+        r.zLo_m = std::min(r.zLo_m, h), r.zHi_m = std::max(r.zHi_m, h);
+        if (std::isfinite(v)) known.push_back(v);
+    });
     if (known.empty()) return r;
     r.lo = *std::min_element(known.begin(), known.end());
     // Heights span their whole range (as the previews); sigma and certainty are skewed (a few
@@ -136,10 +136,10 @@ Box knownBox(const EsriAsciiGrid& heights, int x0, int y0, int x1, int y1) {
     Box b{x1 + 1, y1 + 1, x0 - 1, y0 - 1};
     for (int ix = x0; ix <= x1; ix++) {
         const float* h = heights.heights_m.data() + size_t(ix) * size_t(heights.rows());
-        for (int iy = y0; iy <= y1; iy++)
-            if (std::isfinite(h[iy]))
-                b = {std::min(b.x0, ix), std::min(b.y0, iy), std::max(b.x1, ix),
-                     std::max(b.y1, iy)};
+        forEachFinite(h + y0, size_t(y1 - y0 + 1), [&](size_t k) {
+            const int iy = y0 + int(k);
+            b = {std::min(b.x0, ix), std::min(b.y0, iy), std::max(b.x1, ix), std::max(b.y1, iy)};
+        });
     }
     if (b.x1 < b.x0) return b;
     // A side of one vertex grows by one within the range (which has two at least).
@@ -223,18 +223,17 @@ mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
     auto points = mrpt::opengl::CPointCloudColoured::Create();
     points->setName("cells outside the mesh");
     points->setPointSize(2);
-    for (int ix = 0; ix < nx; ix++) {
-        const float* h = heights.heights_m.data() + size_t(ix) * size_t(ny);  // column-major
-        for (int iy = 0; iy < ny; iy++, h++) {
-            if (!std::isfinite(*h) || inAQuad(ix, iy)) continue;  // most cells: unknown
-            const float v = values.heights_m(iy, ix);
-            const mrpt::img::TColor c = std::isfinite(v) ? cellColour(v, colouring, lut, r)
-                                                         : mrpt::img::TColor(128, 128, 128);
-            points->push_back(float(heights.xllcenter_m + ix * heights.cellsize_m),
-                              float(heights.yllcenter_m + iy * heights.cellsize_m),
-                              heights.heights_m(iy, ix), c.R / 255.f, c.G / 255.f, c.B / 255.f);
-        }
-    }
+    // The known cells in memory order (column-major, mostly NaN).
+    forEachFinite(heights.heights_m.data(), size_t(heights.heights_m.size()), [&](size_t i) {
+        const int ix = int(i / size_t(ny)), iy = int(i % size_t(ny));
+        if (inAQuad(ix, iy)) return;
+        const float v = values.heights_m(iy, ix);
+        const mrpt::img::TColor c =
+            std::isfinite(v) ? cellColour(v, colouring, lut, r) : mrpt::img::TColor(128, 128, 128);
+        points->push_back(float(heights.xllcenter_m + ix * heights.cellsize_m),
+                          float(heights.yllcenter_m + iy * heights.cellsize_m),
+                          heights.heights_m(iy, ix), c.R / 255.f, c.G / 255.f, c.B / 255.f);
+    });
     return points;
 }
 
