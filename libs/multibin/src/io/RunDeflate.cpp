@@ -2,7 +2,7 @@
  * previews, GeoTIFF tiles). */
 #include "multibin/io/RunDeflate.h"
 
-#include <zlib.h>
+#include <libdeflate.h>
 
 #include <opencv2/core.hpp>
 
@@ -51,7 +51,7 @@ int distCode(int dist) {
 struct Adler {
     uint64_t a = 1, b = 0;
     void bytes(const uint8_t* p, size_t n) {
-        const uLong v = adler32_z(uLong((b << 16) | a), p, n);
+        const uint32_t v = libdeflate_adler32(uint32_t((b << 16) | a), p, n);  // vectorised
         a = v & 0xffff, b = v >> 16;
     }
     /** `len` bytes continuing the pattern q[0..d-1] periodically: byte t is q[t mod d]. */
@@ -302,7 +302,7 @@ std::vector<uint8_t> runDeflateGzip(const uint8_t* data, size_t size, int period
     // RFC 1952: magic, deflate, no flags, no time, fastest, unknown OS.
     std::vector<uint8_t> out{0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 4, 0xff};
     deflateRuns(data, size, period, 0, nullptr, out);
-    const uint32_t crc = uint32_t(crc32_z(0, data, size)), n = uint32_t(size);
+    const uint32_t crc = libdeflate_crc32(0, data, size), n = uint32_t(size);
     for (const uint32_t v : {crc, n})
         for (int shift = 0; shift < 32; shift += 8) out.push_back(uint8_t(v >> shift));
     return out;
@@ -330,7 +330,7 @@ std::vector<uint8_t> PngScanlines::encode() const {
         const size_t start = png.size();
         png.insert(png.end(), type, type + 4);
         png.insert(png.end(), body, body + n);
-        put32be(png, uint32_t(crc32_z(0, png.data() + start, n + 4)));
+        put32be(png, libdeflate_crc32(0, png.data() + start, n + 4));
     };
     std::vector<uint8_t> header;
     put32be(header, uint32_t(m_cols));

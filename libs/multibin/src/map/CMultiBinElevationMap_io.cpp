@@ -1,11 +1,11 @@
 /* Part of the multibin elevation-mapping library.
  * CMultiBinElevationMap: serialization. */
+#include <libdeflate.h>
 #include <mrpt/config.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/core/reverse_bytes.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/serialization/CArchive.h>
-#include <zlib.h>
 
 #include "CMultiBinElevationMap_impl.h"
 
@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -74,8 +75,11 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
         bool operator<(const StoredCell& o) const { return iy != o.iy ? iy < o.iy : ix < o.ix; }
     };
     std::vector<StoredCell> cells;
-    std::vector<uint8_t> binBytes(grid.store().binCount() * kStoredBinBytes);
-    ByteCursor record{binBytes.data()};
+    // Buffers left uninitialised (every byte is written): a value-initialised vector would clear
+    // them first.
+    const std::unique_ptr<uint8_t[]> binBytes(
+        new uint8_t[grid.store().binCount() * kStoredBinBytes]);
+    ByteCursor record{binBytes.get()};
     size_t bins = 0;
     grid.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin& b) {
         if (cells.empty() || ix != cells.back().ix || iy != cells.back().iy)
@@ -89,15 +93,15 @@ void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid
     });
     std::sort(cells.begin(), cells.end());
     out << uint64_t(cells.size());
-    std::vector<uint8_t> bytes(cells.size() * kCellHeaderBytes + bins * kStoredBinBytes);
-    ByteCursor to{bytes.data()};
+    const size_t size = cells.size() * kCellHeaderBytes + bins * kStoredBinBytes;
+    const std::unique_ptr<uint8_t[]> bytes(new uint8_t[size]);
+    ByteCursor to{bytes.get()};
     for (const StoredCell& c : cells) {
         to.put(c.ix), to.put(c.iy), to.put(c.bins);
-        std::memcpy(to.at, binBytes.data() + c.firstBin * kStoredBinBytes,
-                    c.bins * kStoredBinBytes);
+        std::memcpy(to.at, binBytes.get() + c.firstBin * kStoredBinBytes, c.bins * kStoredBinBytes);
         to.at += c.bins * kStoredBinBytes;
     }
-    if (!bytes.empty()) out.WriteBuffer(bytes.data(), bytes.size());  // MRPT refuses null
+    if (size > 0) out.WriteBuffer(bytes.get(), size);  // MRPT refuses a null buffer
 }
 
 /** `text` without its lines that start with `key` followed by a space or '='. */
@@ -316,11 +320,11 @@ constexpr size_t kPayloadChunkBytes = size_t(1) << 20;
 
 /** The payload's checksum as MRPT's compute_CRC32 defines it (CRC-32's reflected polynomial
  * 0xEDB88320, the register starting at 0, no final inversion), so every file written before reads
- * back, computed by zlib's table-driven crc32_z instead of MRPT's bit by bit: zlib inverts the
- * register on entry and on exit, so it starts from ~0 and its result is inverted back. */
+ * back, computed by libdeflate's vectorised CRC-32 instead of MRPT's bit by bit: it inverts the
+ * register on entry and on exit (as zlib's), so it starts from ~0 and its result is inverted
+ * back. */
 uint32_t payloadCrc32(const uint8_t* data, uint64_t n) {
-    if (n == 0) return 0;
-    return ~uint32_t(crc32_z(0xFFFFFFFFUL, data, size_t(n)));
+    return ~libdeflate_crc32(0xFFFFFFFFu, data, size_t(n));
 }
 }  // namespace
 

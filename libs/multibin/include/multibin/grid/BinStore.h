@@ -379,10 +379,15 @@ void BinStore::forEachStoredBin(F&& f) const {
         if (!m_tileXY[t].allocated) continue;
         const int cx0 = m_tileXY[t].tx * kTileCells, cy0 = m_tileXY[t].ty * kTileCells;
         const BinId* heads = m_heads.data() + tileBase(uint32_t(t));
-        for (int r = 0; r < kTileCells; r++)
+        for (int r = 0; r < kTileCells; r++) {
+            const BinId* row = heads + r * kTileCells;
+            BinId all = kNoBin;  // stays kNoBin (all ones) on a row without a bin: one AND a slot
+            for (int c = 0; c < kTileCells; c++) all &= row[c];
+            if (all == kNoBin) continue;
             for (int c = 0; c < kTileCells; c++)
-                for (BinId b = heads[r * kTileCells + c]; b != kNoBin; b = m_pool[b].next)
+                for (BinId b = row[c]; b != kNoBin; b = m_pool[b].next)
                     f(cx0 + c, cy0 + r, m_pool[b]);
+        }
     }
 }
 
