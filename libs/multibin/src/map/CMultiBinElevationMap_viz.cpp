@@ -69,16 +69,21 @@ const char* sceneColouringName(SceneColouring c) { return mapLayerName(layerShow
 
 namespace {
 
-/** The rasters a view is drawn from: the heights and the colouring layer, block-reduced to at
- * most kPreviewMaxSide_px a side, relative to the map origin. */
+/** The rasters a view is drawn from: the heights and the colouring layer (one raster when they
+ * are the same), block-reduced to at most kPreviewMaxSide_px a side, relative to the map
+ * origin. */
 std::vector<EsriAsciiGrid> viewRasters(const TiledRaster& heights, const TiledRaster& values,
                                        Layer shown) {
     // Read tile by tile, one vertex per cell up to kPreviewMaxSide_px a side, else per block.
-    std::vector<TiledRaster> layers{heights, values};
+    // Coloured by height (the default), the two rasters are one: reduced once.
+    const bool one = &heights == &values && layerBlockReduce(shown) == BlockReduce::Mean;
+    std::vector<TiledRaster> layers{heights};
+    if (!one) layers.push_back(values);
     for (TiledRaster& t : layers) t.originX_m = t.originY_m = 0;
     const CellWindow box = knownWindow(layers[0], 1);
-    return blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px),
-                        {BlockReduce::Mean, layerBlockReduce(shown)});
+    std::vector<BlockReduce> how{BlockReduce::Mean};
+    if (!one) how.push_back(layerBlockReduce(shown));
+    return blockReduced(layers, box, blockFactorFor(box, kPreviewMaxSide_px), how);
 }
 
 /** The height range of the known cells and the range the colours span. */
@@ -385,7 +390,7 @@ void buildTerrainView(const TiledRaster& heightLayer, const TiledRaster& shownLa
                       mrpt::opengl::CSetOfObjects& out) {
     const std::vector<EsriAsciiGrid> rasters =
         viewRasters(heightLayer, shownLayer, layerShownBy(colouring));
-    const EsriAsciiGrid &heights = rasters[0], &values = rasters[1];
+    const EsriAsciiGrid &heights = rasters.front(), &values = rasters.back();
     if (heights.cols() < 2 || heights.rows() < 2) return;
     // Built relative to the map origin and placed at it, so the view's floats stay small at
     // georeferenced coordinates.
