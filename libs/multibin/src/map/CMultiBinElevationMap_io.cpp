@@ -14,7 +14,6 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
-#include <memory>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -65,43 +64,46 @@ constexpr size_t kStoredBinBytes = 3 * 4 + 4 + 2 + 10 * 4 + 2;
 void writeGrid(mrpt::serialization::CArchive& out, const multibin::BinGrid& grid) {
     const multibin::CellWindow& w = grid.window();
     out << int32_t(w.ix0) << int32_t(w.iy0) << int32_t(w.nx) << int32_t(w.ny);
-    // The bins' records made in one pass over the store, tile by tile (not over the window: a
-    // route's window is mostly empty; a cell's bins come together, in the order forEachBin gives
-    // them), then the cells written row by row as the reader expects.
+    // The non-empty cells found tile by tile (not over the window: a route's window is mostly
+    // empty), then written row by row as the reader expects, their records gathered in chunks:
+    // a CArchive write per field costs about a hundred instructions, a copy of the whole grid's
+    // records as much memory as the serialized map.
     struct StoredCell {
         int32_t iy, ix;
-        size_t firstBin;
         uint16_t bins;
         bool operator<(const StoredCell& o) const { return iy != o.iy ? iy < o.iy : ix < o.ix; }
     };
     std::vector<StoredCell> cells;
-    // Buffers left uninitialised (every byte is written): a value-initialised vector would clear
-    // them first.
-    const std::unique_ptr<uint8_t[]> binBytes(
-        new uint8_t[grid.store().binCount() * kStoredBinBytes]);
-    ByteCursor record{binBytes.get()};
-    size_t bins = 0;
-    grid.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin& b) {
+    grid.store().forEachStoredBin([&](int ix, int iy, const multibin::Bin&) {
         if (cells.empty() || ix != cells.back().ix || iy != cells.back().iy)
-            cells.push_back({int32_t(iy), int32_t(ix), bins, 0});
+            cells.push_back({int32_t(iy), int32_t(ix), 0});
         cells.back().bins++;
-        bins++;
-        record.put(b.height_m), record.put(b.variance_m2), record.put(b.certainty);
-        record.put(b.pointCount), record.put(b.index);
-        forEachMoment(b.plane, [&](const float& v) { record.put(v); });
-        record.put(b.poseHeightSigmaCode), record.put(b.poseHorizontalSigmaCode);
     });
     std::sort(cells.begin(), cells.end());
     out << uint64_t(cells.size());
-    const size_t size = cells.size() * kCellHeaderBytes + bins * kStoredBinBytes;
-    const std::unique_ptr<uint8_t[]> bytes(new uint8_t[size]);
-    ByteCursor to{bytes.get()};
+    constexpr size_t kChunkBytes = size_t(1) << 20;
+    std::vector<uint8_t> chunk(kChunkBytes);
+    ByteCursor to{chunk.data()};
+    const auto flush = [&] {
+        if (to.at != chunk.data()) out.WriteBuffer(chunk.data(), size_t(to.at - chunk.data()));
+        to.at = chunk.data();
+    };
     for (const StoredCell& c : cells) {
+        const size_t need = kCellHeaderBytes + c.bins * kStoredBinBytes;
+        if (size_t(to.at - chunk.data()) + need > chunk.size()) flush();
+        if (need > chunk.size()) {  // a cell of more than 17 k bins
+            chunk.resize(need);
+            to.at = chunk.data();
+        }
         to.put(c.ix), to.put(c.iy), to.put(c.bins);
-        std::memcpy(to.at, binBytes.get() + c.firstBin * kStoredBinBytes, c.bins * kStoredBinBytes);
-        to.at += c.bins * kStoredBinBytes;
+        grid.forEachBin(c.ix, c.iy, [&](const multibin::Bin& b) {
+            to.put(b.height_m), to.put(b.variance_m2), to.put(b.certainty), to.put(b.pointCount);
+            to.put(b.index);
+            forEachMoment(b.plane, [&](const float& v) { to.put(v); });
+            to.put(b.poseHeightSigmaCode), to.put(b.poseHorizontalSigmaCode);
+        });
     }
-    if (size > 0) out.WriteBuffer(bytes.get(), size);  // MRPT refuses a null buffer
+    flush();
 }
 
 /** `text` without its lines that start with `key` followed by a space or '='. */
