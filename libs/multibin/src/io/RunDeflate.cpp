@@ -42,7 +42,15 @@ int lengthCode(int len) {  // index into kLengthBase, by a table made once
     }();
     return table[size_t(len)];
 }
-int distCode(int dist) {
+int distCode(int dist) {  // a table up to a row of 1024 floats (GeoTIFF tiles), else a search
+    constexpr int kTabled = 4096;
+    static const std::array<uint8_t, kTabled + 1> table = [] {
+        std::array<uint8_t, kTabled + 1> t{};
+        for (int d = 1; d <= kTabled; d++)
+            t[size_t(d)] = uint8_t(std::upper_bound(kDistBase, kDistBase + 30, d) - kDistBase - 1);
+        return t;
+    }();
+    if (dist <= kTabled) return table[size_t(dist)];
     return int(std::upper_bound(kDistBase, kDistBase + 30, dist) - kDistBase) - 1;
 }
 
