@@ -2,39 +2,17 @@
  * (Gzip.h), read back by zlib's gzip decoder and by MRPT's CFileGZInputStream. */
 #include <gtest/gtest.h>
 #include <mrpt/io/CFileGZInputStream.h>
-#include <zlib.h>
 
-#include <unistd.h>
-
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "../common/byte_streams.h"
+#include "../common/test_files.h"
 #include "multibin/io/Gzip.h"
 
 namespace {
-
-/** zlib's inflate of a gzip stream (windowBits 31: it checks the CRC-32 and the length). */
-std::vector<uint8_t> gunzipped(const std::vector<uint8_t>& in, size_t expected) {
-    z_stream z{};
-    if (inflateInit2(&z, 31) != Z_OK) throw std::runtime_error("inflateInit2");
-    std::vector<uint8_t> out(expected + 16);
-    z.next_in = const_cast<Bytef*>(in.data());
-    z.avail_in = uInt(in.size());
-    z.next_out = out.data();
-    z.avail_out = uInt(out.size());
-    const int rc = inflate(&z, Z_FINISH);
-    const size_t n = z.total_out, left = z.avail_in;
-    inflateEnd(&z);
-    if (rc != Z_STREAM_END) throw std::runtime_error("inflate: " + std::to_string(rc));
-    if (left != 0) throw std::runtime_error("bytes after the stream");
-    out.resize(n);
-    return out;
-}
 
 /** Bytes like a serialized map's: records of floats with zeros, random bytes, runs. */
 std::vector<uint8_t> mapLikeBytes(size_t size, uint32_t seed) {
@@ -64,7 +42,7 @@ TEST(Gzip, ZlibReadsBackEveryByte) {
         ASSERT_GE(gz.size(), 18u) << "a gzip header and trailer at least";
         EXPECT_EQ(gz[0], 0x1f);
         EXPECT_EQ(gz[1], 0x8b);
-        EXPECT_EQ(gunzipped(gz, size), data) << size << " bytes";
+        EXPECT_EQ(test_bytes::inflated(gz, size, 15 + 16), data) << size << " bytes";
         if (size >= 1000) EXPECT_LT(gz.size(), size) << "map-like bytes shrink";
     }
 }
@@ -73,15 +51,12 @@ TEST(Gzip, ZlibReadsBackEveryByte) {
 TEST(Gzip, MrptGzInputStreamReadsTheFile) {
     const std::vector<uint8_t> data = mapLikeBytes(100000, 3);
     const std::vector<uint8_t> gz = multibin::gzipCompressed(data.data(), data.size());
-    const std::filesystem::path path =
-        std::filesystem::temp_directory_path() / ("multibin_gzip_" + std::to_string(::getpid()));
-    std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(gz.data()),
-                                                std::streamsize(gz.size()));
+    const std::filesystem::path path = test_files::scratchDir("io", "gzip") / "map.gz";
+    test_files::writeAll(path, std::string(gz.begin(), gz.end()));
     mrpt::io::CFileGZInputStream in(path.string());
     std::vector<uint8_t> back(data.size() + 10);
     const size_t n = in.Read(back.data(), back.size());
     in.close();
-    std::filesystem::remove(path);
     back.resize(n);
     EXPECT_EQ(back, data);
 }

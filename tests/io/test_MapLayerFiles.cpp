@@ -7,13 +7,12 @@
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include <zlib.h>
-
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <vector>
 
+#include "../common/byte_streams.h"
 #include "multibin/io/MapLayerFiles.h"
 #include "multibin/io/OutputFile.h"
 #include "multibin/io/RunDeflate.h"
@@ -38,33 +37,6 @@ void expectSameSamples(const EsriAsciiGrid& a, const EsriAsciiGrid& b, const std
         differing += !(std::isnan(x) && std::isnan(y)) && std::memcmp(&x, &y, 4) != 0;
     }
     EXPECT_EQ(differing, 0u) << what << " (" << known << " known)";
-}
-
-std::vector<uint8_t> serialized(const mrpt::serialization::CSerializable& o) {
-    mrpt::io::CMemoryStream mem;
-    auto arch = mrpt::serialization::archiveFrom(mem);
-    arch << o;
-    const auto* p = static_cast<const uint8_t*>(mem.getRawBufferData());
-    return {p, p + mem.getTotalBytesCount()};
-}
-
-/** zlib's gzip decoder (windowBits 31) of `gz`. */
-std::vector<uint8_t> inflatedGzip(const std::vector<uint8_t>& gz) {
-    z_stream z{};
-    EXPECT_EQ(inflateInit2(&z, 15 + 16), Z_OK);
-    std::vector<uint8_t> out, chunk(1 << 16);
-    z.next_in = const_cast<Bytef*>(gz.data());
-    z.avail_in = uInt(gz.size());
-    int rc = Z_OK;
-    while (rc == Z_OK) {
-        z.next_out = chunk.data();
-        z.avail_out = uInt(chunk.size());
-        rc = inflate(&z, Z_NO_FLUSH);
-        out.insert(out.end(), chunk.data(), z.next_out);
-    }
-    inflateEnd(&z);
-    EXPECT_EQ(rc, Z_STREAM_END);
-    return out;
 }
 
 const std::vector<MapLayer> kLayers{MapLayer::Height, MapLayer::Sigma, MapLayer::Source};
@@ -115,12 +87,14 @@ TEST(KnownLayers, TheSceneCodedByRunsLoadsIntoTheSameObjects) {
     ASSERT_GT(view->size(), 3u);
     scene.insert(view);
     fromMap.insert(own);
-    const std::vector<uint8_t> bytes = serialized(scene);
-    EXPECT_EQ(serialized(fromMap), bytes);
+    const std::vector<uint8_t> bytes = test_bytes::serialized(scene);
+    EXPECT_EQ(test_bytes::serialized(fromMap), bytes);
 
     // Loaded with MRPT's reader, the file gives what MRPT's own file of the scene
     // (COpenGLScene::saveToFile) gives: the same objects, serialized again to the same bytes.
-    EXPECT_EQ(inflatedGzip(multibin::runDeflateGzip(bytes.data(), bytes.size(), 4)), bytes);
+    EXPECT_EQ(test_bytes::inflated(multibin::runDeflateGzip(bytes.data(), bytes.size(), 4),
+                                   bytes.size(), 15 + 16),
+              bytes);
     const std::filesystem::path dir(MULTIBIN_BINARY_DIR);
     const std::string ours = (dir / "test_map_layer_files_runs.3Dscene").string(),
                       mrpts = (dir / "test_map_layer_files_mrpt.3Dscene").string();
@@ -135,5 +109,5 @@ TEST(KnownLayers, TheSceneCodedByRunsLoadsIntoTheSameObjects) {
     };
     const auto back = load(ours), reference = load(mrpts);
     EXPECT_EQ(back->getViewport()->size(), scene.getViewport()->size());
-    EXPECT_EQ(serialized(*back), serialized(*reference));
+    EXPECT_EQ(test_bytes::serialized(*back), test_bytes::serialized(*reference));
 }

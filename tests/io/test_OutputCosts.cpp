@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "../common/byte_streams.h"
 #include "multibin/fill/GapFilling.h"
 #include "multibin/fill/SparseFill.h"
 #include "multibin/grid/BinGrid.h"
@@ -26,24 +27,15 @@ using multibin::CellWindow;
 using multibin::fill::FillOptions;
 using multibin::fill::SparseHeights;
 
-/** The bytes `arch << map` writes. */
-std::vector<uint8_t> serialized(const mrpt::maps::CMultiBinElevationMap& map) {
-    mrpt::io::CMemoryStream mem;
-    auto arch = mrpt::serialization::archiveFrom(mem);
-    arch << map;
-    const auto* p = static_cast<const uint8_t*>(mem.getRawBufferData());
-    return {p, p + mem.getTotalBytesCount()};
-}
-
 }  // namespace
 
 // The file wraps its payload as uint64 length, payload, uint32 CRC-32, then MRPT's end marker
-// byte. The CRC must be the value MRPT's compute_CRC32 gives (files written before the zlib
-// checksum must load, and files written now must load in older builds): zlib's own crc32()
-// (register inverted on entry and exit) would differ on every payload.
+// byte. The CRC must be the value MRPT's compute_CRC32 gives (files written by older builds must
+// load, and files written now must load in older builds): a plain CRC-32 (zlib's or libdeflate's,
+// register inverted on entry and exit) would differ on every payload.
 TEST(SerializedMapFile, TheChecksumIsMrptsCrc32OfThePayload) {
     const auto map = route_map::routeMap(10.0);
-    const std::vector<uint8_t> bytes = serialized(*map);
+    const std::vector<uint8_t> bytes = test_bytes::serialized(*map);
     ASSERT_GT(bytes.size(), 64u);
     const size_t end = bytes.size() - 1 - 4;  // the payload's end: before the CRC and the marker
     // The length field: 8 bytes that give the distance to `end` (found from the front).

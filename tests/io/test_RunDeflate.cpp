@@ -1,7 +1,6 @@
 /* Part of the multibin elevation-mapping library's tests: the DEFLATE coder of runs
  * (RunDeflate.h) against zlib's decoder, and its PNG against OpenCV's. */
 #include <gtest/gtest.h>
-#include <zlib.h>
 
 #include <cstring>
 #include <opencv2/imgcodecs.hpp>
@@ -10,28 +9,10 @@
 #include <stdexcept>
 #include <vector>
 
+#include "../common/byte_streams.h"
 #include "multibin/io/RunDeflate.h"
 
 namespace {
-
-/** zlib's inflate of a zlib (windowBits 15) or gzip (31) stream; throws on any error (a bad
- * code, a wrong Adler-32 or CRC-32, a wrong length). */
-std::vector<uint8_t> inflated(const std::vector<uint8_t>& in, size_t expected, int windowBits) {
-    z_stream z{};
-    if (inflateInit2(&z, windowBits) != Z_OK) throw std::runtime_error("inflateInit2");
-    std::vector<uint8_t> out(expected + 16);
-    z.next_in = const_cast<Bytef*>(in.data());
-    z.avail_in = uInt(in.size());
-    z.next_out = out.data();
-    z.avail_out = uInt(out.size());
-    const int rc = inflate(&z, Z_FINISH);
-    const size_t n = z.total_out, left = z.avail_in;
-    inflateEnd(&z);
-    if (rc != Z_STREAM_END) throw std::runtime_error("inflate: " + std::to_string(rc));
-    if (left != 0) throw std::runtime_error("bytes after the stream");
-    out.resize(n);
-    return out;
-}
 
 /** Runs of random pixels of `period` bytes (lengths 1 to 700 pixels, so matches of 3 to 258
  * bytes and their remainders), random literals, and rows repeated. */
@@ -72,17 +53,18 @@ TEST(RunDeflate, ZlibReadsBackEveryByte) {
     for (const auto& d : cases)
         for (const int period : {1, 3, 4}) {
             const auto z = multibin::runDeflateZlib(d.data(), d.size(), period);
-            EXPECT_EQ(inflated(z, d.size(), 15), d) << d.size() << " bytes, period " << period;
+            EXPECT_EQ(test_bytes::inflated(z, d.size(), 15), d)
+                << d.size() << " bytes, period " << period;
         }
     for (uint32_t seed = 1; seed <= 40; seed++) {
         const int period = 1 + int(seed % 8);
         const size_t row = seed % 3 == 0 ? 0 : 300 + 97 * seed;
         const auto d = runsOf(20000 + 3000 * seed, period, row, seed);
         const auto z = multibin::runDeflateZlib(d.data(), d.size(), period, row);
-        EXPECT_EQ(inflated(z, d.size(), 15), d) << "seed " << seed;
+        EXPECT_EQ(test_bytes::inflated(z, d.size(), 15), d) << "seed " << seed;
         EXPECT_LT(z.size(), d.size() / 2) << "runs are coded as matches";
         const auto gz = multibin::runDeflateGzip(d.data(), d.size(), period);
-        EXPECT_EQ(inflated(gz, d.size(), 15 + 16), d) << "gzip, seed " << seed;
+        EXPECT_EQ(test_bytes::inflated(gz, d.size(), 15 + 16), d) << "gzip, seed " << seed;
     }
     EXPECT_THROW(multibin::runDeflateZlib(noise.data(), noise.size(), 9), std::invalid_argument);
 }
