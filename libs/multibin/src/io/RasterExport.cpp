@@ -179,17 +179,14 @@ template <typename ColourOf>
 void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv::Rect& panel,
                const ColourOf& colourOf) {
     const int rows = raster.rows(), cols = raster.cols();
-    // Each sample's colour once, row by row (the raster is column-major), then copied to its
-    // pixels through the column of each pixel, found once: the panel is the preview's largest
-    // part, and a row of samples drawn again (scale > 1) is a copy of the row above.
     if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place,
         // the unknown grey first (most of a sparse map's panel), then the known samples in the
         // raster's memory order (column-major: a walk along a row would miss the cache per sample)
         cv::Vec3b* first = img.ptr<cv::Vec3b>(panel.y) + panel.x;
         std::fill(first, first + cols, colourOf(std::numeric_limits<float>::quiet_NaN()));
+        const uint8_t* firstBytes = img.ptr<uint8_t>(panel.y) + 3 * panel.x;
         for (int py = 1; py < panel.height; py++)  // the other rows copied from the first
-            std::memcpy(img.ptr<cv::Vec3b>(panel.y + py) + panel.x, first,
-                        size_t(cols) * sizeof(cv::Vec3b));
+            std::memcpy(img.ptr<uint8_t>(panel.y + py) + 3 * panel.x, firstBytes, 3 * size_t(cols));
         for (int c = 0; c < cols; c++) {
             const float* sample = raster.heights_m.data() + size_t(c) * size_t(rows);
             forEachFinite(sample, size_t(rows), [&](size_t r) {  // north up
@@ -198,6 +195,9 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
         }
         return;
     }
+    // Enlarged (scale > 1): each sample's colour once, row by row (the raster is column-major),
+    // then copied to its pixels through the column of each pixel, found once: the panel is the
+    // preview's largest part, and a row of samples drawn again is a copy of the row above.
     std::vector<int> columnOf(static_cast<size_t>(panel.width));
     for (int px = 0; px < panel.width; px++)
         columnOf[size_t(px)] = std::min(cols - 1, int(px / scale));

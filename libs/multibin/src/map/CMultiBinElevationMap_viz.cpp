@@ -232,12 +232,12 @@ mrpt::opengl::CPointCloudColoured::Ptr loneCells(const EsriAsciiGrid& heights,
     forEachFinite(heights.heights_m.data(), size_t(heights.heights_m.size()), [&](size_t i) {
         const int ix = int(i / size_t(ny)), iy = int(i % size_t(ny));
         if (inAQuad(ix, iy)) return;
-        const float v = values.heights_m(iy, ix);
+        const float v = values.heights_m.data()[i];
         const mrpt::img::TColor c =
             std::isfinite(v) ? cellColour(v, colouring, lut, r) : mrpt::img::TColor(128, 128, 128);
         points->push_back(float(heights.xllcenter_m + ix * heights.cellsize_m),
                           float(heights.yllcenter_m + iy * heights.cellsize_m),
-                          heights.heights_m(iy, ix), c.R / 255.f, c.G / 255.f, c.B / 255.f);
+                          heights.heights_m.data()[i], c.R / 255.f, c.G / 255.f, c.B / 255.f);
     });
     return points;
 }
@@ -380,9 +380,12 @@ mrpt::math::TVector3D TerrainViewDirection::up() const {
 
 void buildTerrainView(const CMultiBinElevationMap& map, SceneColouring colouring,
                       mrpt::opengl::CSetOfObjects& out) {
+    // Coloured by height, the heights are read once and serve as both rasters (viewRasters()).
+    const Layer shown = layerShownBy(colouring);
     const std::vector<TiledRaster> layers =
-        knownLayers(map, {Layer::Height, layerShownBy(colouring)});
-    buildTerrainView(layers[0], layers[1], map.mapOrigin(), colouring, out);
+        knownLayers(map, shown == Layer::Height ? std::vector<Layer>{Layer::Height}
+                                                : std::vector<Layer>{Layer::Height, shown});
+    buildTerrainView(layers.front(), layers.back(), map.mapOrigin(), colouring, out);
 }
 
 void buildTerrainView(const TiledRaster& heightLayer, const TiledRaster& shownLayer,
