@@ -112,23 +112,11 @@ std::shared_ptr<const SparseCells> readSparseCells(const CMultiBinElevationMap& 
     };
     std::vector<Cell> found;
     std::vector<float> values;
-    std::vector<const float*> layer(layers.size());
-    for (const CellWindow& w : storeTiles) {
-        const std::vector<EsriAsciiGrid> g = map.toRasters(layers, w);
-        for (size_t k = 0; k < g.size(); k++) layer[k] = g[k].heights_m.data();
-        // Column-major: sample (r, c) at r + c ny. toRasters() writes every layer of a known
-        // cell or none, so the first layer tells which cells are known.
-        for (int c = 0; c < w.nx; c++) {
-            if (!anyFinite(layer[0] + size_t(c) * size_t(w.ny), size_t(w.ny))) continue;
-            for (int r = 0; r < w.ny; r++) {
-                const size_t at = size_t(r) + size_t(c) * size_t(w.ny);
-                if (!std::isfinite(layer[0][at])) continue;
-                found.push_back({tileOfCell(w.ix0 + c, w.iy0 + r, tileCells), w.ix0 + c, w.iy0 + r,
-                                 values.size()});
-                for (const float* l : layer) values.push_back(l[at]);
-            }
-        }
-    }
+    for (const CellWindow& w : storeTiles)
+        map.forEachKnownCell(layers, w, [&](int ix, int iy, const float* v) {
+            found.push_back({tileOfCell(ix, iy, tileCells), ix, iy, values.size()});
+            values.insert(values.end(), v, v + layers.size());
+        });
     // By raster tile (south to north, west to east, as occupiedTiles() lists them), then row by
     // row: the order of a dense read of each tile.
     std::sort(found.begin(), found.end(), [](const Cell& a, const Cell& b) {

@@ -174,10 +174,11 @@ int textWidth(const std::string& s, double size = 0.4) {
 }
 
 /** The map panel of a preview: pixel (px, py) of rectangle `panel` shows sample
- * (rows - 1 - py / scale, px / scale) (north up) in colourOf(value). */
+ * (rows - 1 - py / scale, px / scale) (north up) in colourOf(value). `known`: the indices of the
+ * raster's finite samples, ascending. */
 template <typename ColourOf>
-void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv::Rect& panel,
-               const ColourOf& colourOf) {
+void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, const std::vector<uint32_t>& known,
+               double scale, const cv::Rect& panel, const ColourOf& colourOf) {
     const int rows = raster.rows(), cols = raster.cols();
     if (panel.width == cols) {  // one pixel per sample (large rasters): coloured in place,
         // the unknown grey first (most of a sparse map's panel), then the known samples in the
@@ -187,11 +188,10 @@ void drawPanel(cv::Mat& img, const EsriAsciiGrid& raster, double scale, const cv
         const uint8_t* firstBytes = img.ptr<uint8_t>(panel.y) + 3 * panel.x;
         for (int py = 1; py < panel.height; py++)  // the other rows copied from the first
             std::memcpy(img.ptr<uint8_t>(panel.y + py) + 3 * panel.x, firstBytes, 3 * size_t(cols));
-        for (int c = 0; c < cols; c++) {
-            const float* sample = raster.heights_m.data() + size_t(c) * size_t(rows);
-            forEachFinite(sample, size_t(rows), [&](size_t r) {  // north up
-                img.ptr<cv::Vec3b>(panel.y + rows - 1 - int(r))[panel.x + c] = colourOf(sample[r]);
-            });
+        for (const uint32_t i : known) {
+            const int c = int(i / uint32_t(rows)), r = int(i % uint32_t(rows));
+            img.ptr<cv::Vec3b>(panel.y + rows - 1 - r)[panel.x + c] =  // north up
+                colourOf(raster.heights_m.data()[i]);
         }
         return;
     }
@@ -241,11 +241,14 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
     PngScanlines png(W + L + R, panelH + T + B);
     cv::Mat img = png.image();  // white
 
-    // The finite samples' range (a sparse map's raster is mostly NaN: skipped by blocks).
+    // The finite samples and their range, in one pass (a sparse map's raster is mostly NaN:
+    // skipped by blocks).
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    std::vector<uint32_t> known;
     forEachFinite(raster.heights_m.data(), size_t(raster.heights_m.size()), [&](size_t i) {
         const float v = raster.heights_m.data()[i];
         lo = std::min(lo, v), hi = std::max(hi, v);
+        known.push_back(uint32_t(i));
     });
     if (!(lo <= hi)) lo = hi = 0;
     const float span = hi > lo ? hi - lo : 1.f;
@@ -261,7 +264,7 @@ std::vector<uint8_t> encodePreviewPng(const EsriAsciiGrid& raster, const Preview
         const auto& rgb = colourAt(lut, (v - lo) / span);
         return {rgb[0], rgb[1], rgb[2]};
     };
-    drawPanel(img, raster, scale, {L, T, W, H}, colourOf);
+    drawPanel(img, raster, known, scale, {L, T, W, H}, colourOf);
     cv::rectangle(img, {L - 1, T - 1}, {L + W, T + H}, kBlack);
 
     // Axes in metres: ticks at cell edges' coordinates, nice steps.

@@ -32,25 +32,26 @@ constexpr int kDistBase[30] = {1,    2,    3,    4,    5,    7,    9,    13,    
 constexpr int kDistExtra[30] = {0, 0, 0, 0, 1, 1, 2, 2,  3,  3,  4,  4,  5,  5,  6,
                                 6, 7, 7, 8, 8, 9, 9, 10, 10, 11, 11, 12, 12, 13, 13};
 
-int lengthCode(int len) {  // index into kLengthBase, by a table made once
-    static const std::array<uint8_t, kMaxMatch + 1> table = [] {
-        std::array<uint8_t, kMaxMatch + 1> t{};
-        for (int l = kMinMatch; l <= kMaxMatch; l++)
-            t[size_t(l)] =
-                uint8_t(std::upper_bound(kLengthBase, kLengthBase + 29, l) - kLengthBase - 1);
-        return t;
-    }();
-    return table[size_t(len)];
+/** The index into kLengthBase of each match length, and into kDistBase of each distance up to
+ * a row of 1024 floats (GeoTIFF tiles): tables built by the compiler. */
+constexpr int kTabledDistance = 4096;
+template <size_t N, size_t Codes>
+constexpr std::array<uint8_t, N> codeTable(const int (&base)[Codes], int first) {
+    std::array<uint8_t, N> t{};
+    for (size_t v = size_t(first), c = 0; v < N; v++) {
+        while (c + 1 < Codes && size_t(base[c + 1]) <= v) c++;
+        t[v] = uint8_t(c);
+    }
+    return t;
 }
-int distCode(int dist) {  // a table up to a row of 1024 floats (GeoTIFF tiles), else a search
-    constexpr int kTabled = 4096;
-    static const std::array<uint8_t, kTabled + 1> table = [] {
-        std::array<uint8_t, kTabled + 1> t{};
-        for (int d = 1; d <= kTabled; d++)
-            t[size_t(d)] = uint8_t(std::upper_bound(kDistBase, kDistBase + 30, d) - kDistBase - 1);
-        return t;
-    }();
-    if (dist <= kTabled) return table[size_t(dist)];
+constexpr std::array<uint8_t, kMaxMatch + 1> kLengthCodeOf =
+    codeTable<kMaxMatch + 1>(kLengthBase, kMinMatch);
+constexpr std::array<uint8_t, kTabledDistance + 1> kDistCodeOf =
+    codeTable<kTabledDistance + 1>(kDistBase, 1);
+
+int lengthCode(int len) { return kLengthCodeOf[size_t(len)]; }
+int distCode(int dist) {  // farther: a search
+    if (dist <= kTabledDistance) return kDistCodeOf[size_t(dist)];
     return int(std::upper_bound(kDistBase, kDistBase + 30, dist) - kDistBase) - 1;
 }
 
@@ -173,28 +174,32 @@ std::array<uint16_t, N> canonicalCodes(const std::array<uint8_t, N>& bits) {
     return codes;
 }
 
-/** DEFLATE's bit stream (least significant bit first), written four bytes at a time. */
+/** DEFLATE's bit stream (least significant bit first) appended to `out`, four bytes at a time
+ * into room made for `maxBits`; finish() writes the last bits and gives back the room unused. */
 class BitWriter {
 public:
-    explicit BitWriter(std::vector<uint8_t>& out) : m_out(out) {}
+    BitWriter(std::vector<uint8_t>& out, size_t maxBits) : m_out(out), m_used(out.size()) {
+        m_out.resize(m_used + maxBits / 8 + 8);
+    }
     void put(uint32_t value, int bits) {  // bits <= 16: the buffer holds at most 47 bits
         m_buffer |= uint64_t(value) << m_count;
         m_count += bits;
         if (m_count >= 32) {
-            const uint8_t bytes[4] = {uint8_t(m_buffer), uint8_t(m_buffer >> 8),
-                                      uint8_t(m_buffer >> 16), uint8_t(m_buffer >> 24)};
-            m_out.insert(m_out.end(), bytes, bytes + 4);
+            uint8_t* at = m_out.data() + m_used;
+            for (int k = 0; k < 4; k++) at[k] = uint8_t(m_buffer >> (8 * k));
+            m_used += 4;
             m_buffer >>= 32;
             m_count -= 32;
         }
     }
-    void flush() {
-        for (; m_count > 0; m_count -= 8, m_buffer >>= 8) m_out.push_back(uint8_t(m_buffer));
-        m_buffer = 0, m_count = 0;
+    void finish() {
+        for (; m_count > 0; m_count -= 8, m_buffer >>= 8) m_out[m_used++] = uint8_t(m_buffer);
+        m_out.resize(m_used);
     }
 
 private:
     std::vector<uint8_t>& m_out;
+    size_t m_used;  // bytes of m_out written
     uint64_t m_buffer = 0;
     int m_count = 0;
 };
@@ -215,8 +220,8 @@ void writeBlock(Tokens& t, std::vector<uint8_t>& out) {
     while (nLit > 257 && litBits[size_t(nLit) - 1] == 0) nLit--;
     while (nDist > 1 && distBits[size_t(nDist) - 1] == 0) nDist--;
 
-    out.reserve(out.size() + t.list.size() * 6 + 320);  // 48 bits a token at most, the codes
-    BitWriter w(out);
+    // 48 bits a token at most (and the end of block), 1 400 bits of header and code lengths.
+    BitWriter w(out, (t.list.size() + 1) * 48 + 1400);
     w.put(1, 1);  // final block
     w.put(2, 2);  // dynamic Huffman codes
     w.put(uint32_t(nLit - 257), 5);
@@ -248,7 +253,7 @@ void writeBlock(Tokens& t, std::vector<uint8_t>& out) {
         w.put(uint32_t(dist - kDistBase[dc]), kDistExtra[dc]);
     }
     w.put(litCodes[256], litBits[256]);
-    w.flush();
+    w.finish();
 }
 
 void put32be(std::vector<uint8_t>& out, uint32_t v) {

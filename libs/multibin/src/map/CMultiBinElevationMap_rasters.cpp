@@ -28,15 +28,25 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer,
 
 std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     const std::vector<RasterLayer>& layers, const multibin::CellWindow& w) const {
+    multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(
+        multibin::Lattice{m_impl->grid.cellSize_m(), w});  // NaN: unknown
+    g.xllcenter_m += m_impl->origin_m.x();                 // the raster is in the pose frame
+    g.yllcenter_m += m_impl->origin_m.y();
+    std::vector<multibin::EsriAsciiGrid> out(layers.size(), g);
+    forEachKnownCell(layers, w, [&](int ix, int iy, const float* values) {
+        for (size_t k = 0; k < layers.size(); k++)
+            out[k].heights_m(iy - w.iy0, ix - w.ix0) = values[k];
+    });
+    return out;
+}
+
+void CMultiBinElevationMap::forEachKnownCell(
+    const std::vector<RasterLayer>& layers, const multibin::CellWindow& w,
+    const std::function<void(int ix, int iy, const float* values)>& visit) const {
     prepareForReading();  // a loaded map's rasters hold its filled cells, as the writer's did
     const multibin::MapLock::Shared lock(m_impl->lock);
     const multibin::BinGrid& grid = m_impl->grid;
-    multibin::EsriAsciiGrid g =
-        multibin::EsriAsciiGrid::onLattice(multibin::Lattice{grid.cellSize_m(), w});
-    const Eigen::Vector2d& o = m_impl->origin_m;  // the raster is in the pose frame
-    g.xllcenter_m += o.x();
-    g.yllcenter_m += o.y();
-    std::vector<multibin::EsriAsciiGrid> out(layers.size(), g);
+    const Eigen::Vector2d& o = m_impl->origin_m;
     // A cell without a bin in either grid and without a filled value is unknown: most cells of
     // a sparse route's tiles, skipped without a query; and a tile of the grid's store with
     // neither (most of a long route's window) skipped whole, so the cost follows the tiles that
@@ -47,6 +57,7 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     using Store = multibin::BinStore;
     static_assert(Store::kTileCells == multibin::fill::TiledCells<int>::kSide,
                   "the filled cells' tiles are the store's");
+    std::vector<float> values(layers.size());
     const auto readCell = [&](int ix, int iy) {
         // cellElevation() without its per-cell preparation and lock, held here for the raster.
         double h, s;
@@ -56,7 +67,7 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
             src = withFill ? filledQuery(x_m, y_m, h, s) : HeightSource::Unknown;
         if (src == HeightSource::Unknown) return;
         for (size_t k = 0; k < layers.size(); k++) {
-            float& v = out[k].heights_m(iy - w.iy0, ix - w.ix0);
+            float& v = values[k];
             switch (layers[k]) {
                 case RasterLayer::Height:
                     v = float(h);
@@ -80,6 +91,7 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
                 } break;
             }
         }
+        visit(ix, iy, values.data());
     };
     for (int ty = Store::tileOf(w.iy0); w.nx > 0 && ty <= Store::tileOf(w.iy0 + w.ny - 1); ty++)
         for (int tx = Store::tileOf(w.ix0); tx <= Store::tileOf(w.ix0 + w.nx - 1); tx++) {
@@ -102,7 +114,6 @@ std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
             multibin::rasterReadCounters().cellsVisited += size_t(xb - xa) * size_t(yb - ya);
             bins.forEachHeld(xa, xb, ya, yb, filledTile != nullptr, filledAt, readCell);
         }
-    return out;
 }
 
 std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileCells) const {

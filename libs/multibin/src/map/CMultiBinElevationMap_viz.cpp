@@ -133,23 +133,26 @@ struct Box {
     int x0, y0, x1, y1;
 };
 
-/** The known vertices' box within [x0, x1] x [y0, y1] (empty: x1 < x0), at least two vertices
- * a side within it (a CMesh's grid spacing divides by the side minus one). Every quad of four
- * known vertices of the range lies inside: a mesh over the box draws what one over the range
- * draws, with fewer masked vertices to build, serialize and compress. */
-Box knownBox(const EsriAsciiGrid& heights, int x0, int y0, int x1, int y1) {
+/** The box of the quads of four known vertices with their lower corner in [x0, x1) x [y0, y1)
+ * (empty: x1 < x0). A mesh draws a quad only between four known vertices: a mesh over this box
+ * draws what one over the range draws, with fewer masked vertices to build, serialize and
+ * compress (on a 2D laser's map, most known cells lie on thin walls, in no quad: loneCells()
+ * draws them). */
+Box quadBox(const EsriAsciiGrid& heights, int x0, int y0, int x1, int y1) {
     Box b{x1 + 1, y1 + 1, x0 - 1, y0 - 1};
-    for (int ix = x0; ix <= x1; ix++) {
-        const float* h = heights.heights_m.data() + size_t(ix) * size_t(heights.rows());
-        forEachFinite(h + y0, size_t(y1 - y0 + 1), [&](size_t k) {
-            const int iy = y0 + int(k);
-            b = {std::min(b.x0, ix), std::min(b.y0, iy), std::max(b.x1, ix), std::max(b.y1, iy)};
+    const size_t rows = size_t(heights.rows());
+    for (int ix = x0; ix < x1; ix++) {
+        const float* h = heights.heights_m.data() + size_t(ix) * rows;  // column ix
+        const float* right = h + rows;                                  // column ix + 1
+        forEachFinite(h + y0, size_t(y1 - y0), [&](size_t k) {
+            const size_t iy = size_t(y0) + k;
+            if (!std::isfinite(h[iy + 1]) || !std::isfinite(right[iy]) ||
+                !std::isfinite(right[iy + 1]))
+                return;
+            b = {std::min(b.x0, ix), std::min(b.y0, int(iy)), std::max(b.x1, ix + 1),
+                 std::max(b.y1, int(iy) + 1)};
         });
     }
-    if (b.x1 < b.x0) return b;
-    // A side of one vertex grows by one within the range (which has two at least).
-    if (b.x1 == b.x0) (b.x1 < x1 ? b.x1 : b.x0) += b.x1 < x1 ? 1 : -1;
-    if (b.y1 == b.y0) (b.y1 < y1 ? b.y1 : b.y0) += b.y1 < y1 ? 1 : -1;
     return b;
 }
 
@@ -158,8 +161,9 @@ Box knownBox(const EsriAsciiGrid& heights, int x0, int y0, int x1, int y1) {
 constexpr int kSceneTile_cells = 64;
 
 /** The terrain: CMeshes over tiles of kSceneTile_cells x kSceneTile_cells cells of the raster,
- * those holding a known cell; each has one row and column of vertices more where the raster goes
- * on, so the quads between tiles are drawn. Z(i, j) with i along x and j along y, vertices at cell
+ * those holding a quad of four known cells, each over its quads' box (quadBox()); a tile has one
+ * row and column of vertices more where the raster goes on, so the quads between tiles are
+ * drawn. Z(i, j) with i along x and j along y, vertices at cell
  * centres; the texture has one texel per vertex (the image's rows follow i, its columns j). A
  * raster of at most kSceneTile_cells + 1 vertices a side is one mesh. */
 std::vector<mrpt::opengl::CMesh::Ptr> terrainMeshes(const EsriAsciiGrid& heights,
@@ -173,7 +177,7 @@ std::vector<mrpt::opengl::CMesh::Ptr> terrainMeshes(const EsriAsciiGrid& heights
         for (int x0 = 0; x0 < nx - 1; x0 += kSceneTile_cells) {
             const int tx1 = x0 + std::min(kSceneTile_cells, nx - 1 - x0);
             const int ty1 = y0 + std::min(kSceneTile_cells, ny - 1 - y0);
-            const Box b = knownBox(heights, x0, y0, tx1, ty1);
+            const Box b = quadBox(heights, x0, y0, tx1, ty1);
             if (b.x1 < b.x0) continue;
             const int mx = b.x1 - b.x0 + 1, my = b.y1 - b.y0 + 1;
             mrpt::math::CMatrixDynamic<float> Z(mx, my), mask(mx, my);

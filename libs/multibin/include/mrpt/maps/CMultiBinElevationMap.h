@@ -376,6 +376,12 @@ public:
     /** Several layers over a window, one query per cell: toRaster(layers[i], cells) each. */
     std::vector<multibin::EsriAsciiGrid> toRasters(const std::vector<RasterLayer>& layers,
                                                    const multibin::CellWindow& cells) const;
+    /** What toRasters() writes at its known cells, without a raster: visit(ix, iy, values) for
+     * each known cell of the window (values[i] of layers[i]), tile by tile of the store, each
+     * tile's cells row by row. A sparse map's outputs read it: the unknown cells cost nothing. */
+    void forEachKnownCell(
+        const std::vector<RasterLayer>& layers, const multibin::CellWindow& cells,
+        const std::function<void(int ix, int iy, const float* values)>& visit) const;
     /** The aligned windows of tileCells x tileCells cells of grid() (multibin::tileOfCell,
      * multibin/io/TiledRaster.h) that may hold a known cell (a bin of either grid, or a filled
      * cell), row by row from the south: where the data is, whatever the window's extent. */
