@@ -15,6 +15,7 @@
 
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/grid/BinGrid.h"
+#include "multibin/grid/TileStoreFile.h"
 #include "multibin/map/MapInternals.h"
 #include "multibin/map/MapStatistics.h"
 #include "multibin/sensors/SensorDispatch.h"
@@ -657,4 +658,76 @@ TEST(BinGrid, TwoPlacesAContinentApartCostTwoTiles) {
         EXPECT_FLOAT_EQ(b->height_m, float(0.2 + 1e-8 * at_m));
     }
     EXPECT_EQ(g.winningBin(g.cellIndex(1.0), g.cellIndex(1.0)), nullptr);
+}
+
+// The store's row bits (which cells of a tile's row hold bins: what the sparse readers walk)
+// agree with the cells' chains after every kind of write: bins added (found or appended),
+// removed one by one, cells cleared, the window moved, tiles written to disk and read back.
+TEST(BinStore, RowBitsFollowTheCellsThroughEveryWrite) {
+    BinStore s(0.05);
+    s.reset(0.05, CellWindow{-200, -200, 400, 400});
+    const auto file = std::make_shared<TileStoreFile>("");
+    std::mt19937 rng(11);
+    const auto inWindow = [&](int first, int n) { return first + int(rng() % uint32_t(n)); };
+    const auto check = [&](const char* after) {
+        size_t held = 0, bitsSet = 0, chained = 0;
+        s.forEachTileNumber([&](uint32_t t, int tx, int ty) {
+            for (int r = 0; r < BinStore::kTileCells; r++) {
+                const uint64_t bits = s.rowHoldingBins(t, r);
+                for (int c = 0; c < BinStore::kTileCells; c++) {
+                    const bool holds = s.slotHoldsBins(BinStore::tileBase(t) +
+                                                       size_t(r * BinStore::kTileCells + c));
+                    ASSERT_EQ(((bits >> c) & 1) != 0, holds)
+                        << after << ", row " << r << " col " << c;
+                    held += holds;
+                    bitsSet += (bits >> c) & 1;
+                    s.forEachBin(tx * BinStore::kTileCells + c, ty * BinStore::kTileCells + r,
+                                 [&](const Bin&) { chained++; });
+                }
+            }
+        });
+        EXPECT_EQ(held, bitsSet) << after;
+        size_t visited = 0;
+        s.forEachStoredBin([&](int, int, const Bin&) { visited++; });
+        EXPECT_EQ(visited, chained) << after << ": every bin in memory, from the bits";
+    };
+    for (int round = 0; round < 6; round++) {
+        const CellWindow w = s.window();
+        const auto cell = [&](bool x) { return x ? inWindow(w.ix0, w.nx) : inWindow(w.iy0, w.ny); };
+        for (int k = 0; k < 3000; k++) {  // bins found or added, and appended
+            bool added = false;
+            const int ix = cell(true), iy = cell(false);
+            const size_t slot = s.writableSlot(ix, iy, added);
+            if (rng() % 2)
+                s.findOrAddBin(slot, int16_t(rng() % 5));
+            else
+                s.appendBin(slot, BinEstimate{});
+        }
+        check("adding");
+        for (int k = 0; k < 1500; k++)  // some bins removed, some cells emptied
+            s.editBins(cell(true), cell(false), [&](const Bin&) { return rng() % 3 != 0; });
+        for (int k = 0; k < 300; k++) s.clearCell(cell(true), cell(false));
+        check("removing");
+        s.moveWindowTo(
+            w.ix0 + int(rng() % 60) - 30, w.iy0 + int(rng() % 60) - 30, [](int, int) {},
+            [](size_t) {});
+        check("moving the window");
+        std::vector<uint32_t> tiles;
+        s.forEachTileNumber([&](uint32_t t, int, int) { tiles.push_back(t); });
+        const size_t before = s.binCount();
+        for (size_t k = 0; k < tiles.size(); k += 2) s.spillTile(tiles[k], file);
+        check("tiles written to disk");
+        std::vector<std::pair<int, int>> spilled;
+        s.forEachSpilledTile([&](int tx, int ty) { spilled.emplace_back(tx, ty); });
+        for (const auto& [tx, ty] : spilled) {
+            bool added = false;
+            const size_t slot =
+                s.writableSlot(tx * BinStore::kTileCells, ty * BinStore::kTileCells, added);
+            ASSERT_TRUE(added);
+            s.reloadTile(uint32_t(slot >> (2 * BinStore::kTileShift)),
+                         [](size_t, int, int, const Bin&) {});
+        }
+        EXPECT_EQ(s.binCount(), before);
+        check("tiles read back");
+    }
 }

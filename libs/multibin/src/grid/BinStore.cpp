@@ -1,6 +1,7 @@
 /* Part of the multibin elevation-mapping library. */
 #include "multibin/grid/BinStore.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -20,6 +21,7 @@ void BinStore::reset(double cellSize_m, const CellWindow& window) {
     m_invCellSize = 1.0 / cellSize_m;
     m_window = window;
     m_heads.assign(kTileSlots, kNoBin);  // the empty tile
+    m_rowBits.assign(kTileCells, 0);
     m_tileXY.assign(1, TileKey{});
     m_freeTiles.clear();
     m_groupTable.assign(16, GroupKey{});
@@ -79,6 +81,7 @@ uint32_t BinStore::addTile(int tx, int ty) {
         t = static_cast<uint32_t>(m_tileXY.size());
         m_tileXY.emplace_back();
         m_heads.resize(m_heads.size() + kTileSlots, kNoBin);
+        m_rowBits.resize(m_rowBits.size() + kTileCells, 0);
     }
     m_tileXY[t] = TileKey{tx, ty, true};
     tileEntry(tx, ty) = t;
@@ -120,9 +123,11 @@ void BinStore::releaseChain(BinId head) {
 
 void BinStore::clearCell(int ix, int iy) {
     if (!m_window.contains(ix, iy)) return;
-    BinId& head = m_heads[slot(ix, iy)];  // the empty tile's heads are all kNoBin already
-    releaseChain(head);
-    head = kNoBin;
+    const size_t s = slot(ix, iy);
+    if (m_heads[s] == kNoBin) return;  // the empty tile's heads among them
+    releaseChain(m_heads[s]);
+    m_heads[s] = kNoBin;
+    markEmpty(s);
 }
 
 BinStore::BinId BinStore::appendBin(size_t s, const BinEstimate& estimate) {
@@ -132,6 +137,7 @@ BinStore::BinId BinStore::appendBin(size_t s, const BinEstimate& estimate) {
     BinId last = m_heads[s];
     if (last == kNoBin) {
         m_heads[s] = b;
+        markHolding(s);
         return b;
     }
     while (m_pool[last].next != kNoBin) last = m_pool[last].next;
@@ -160,6 +166,7 @@ size_t BinStore::spillTile(uint32_t t, const std::shared_ptr<TileStoreFile>& fil
         releaseChain(heads[place]);
         heads[place] = kNoBin;
     }
+    std::fill_n(m_rowBits.begin() + std::ptrdiff_t(size_t(t) << kTileShift), kTileCells, 0);
     const TileKey k = m_tileXY[t];
     m_spilled[tileKey(k.tx, k.ty)] = SpilledTile{offset, uint32_t(bins.size())};
     m_spilledBins += bins.size();

@@ -99,10 +99,9 @@ struct CMultiBinElevationMap::Impl {
         }
         /** Calls f(ix, iy), row by row, for the cells of [xa, xb) x [ya, yb) (within this tile)
          * that hold bins (holds()) or for which also(ix, iy) is true; also() is asked only if
-         * `alsoAny` (it may hold somewhere in the tile). Without the dual grid a row whose slots'
-         * chain heads are all empty is passed by one loop with no branch, about an instruction a
-         * cell, and the others' cells are picked before f is called: most cells of a sparse
-         * route's tiles are empty. */
+         * `alsoAny` (it may hold somewhere in the tile). Without the dual grid the cells holding
+         * bins come from the store's row bits (BinStore::rowHoldingBins()), a word per row, and
+         * are picked before f is called: most cells of a sparse route's tiles are empty. */
         template <typename Also, typename F>
         void forEachHeld(int xa, int xb, int ya, int yb, bool alsoAny, Also&& also, F&& f) const {
             if (m_dual || !m_inside) {
@@ -117,16 +116,19 @@ struct CMultiBinElevationMap::Impl {
             size_t n = 0;
             const multibin::BinStore& s = m_impl.grid.store();
             const int x0 = xa & ~(kSide - 1), y0 = ya & ~(kSide - 1);  // the tile's first cell
+            const int width = xb - xa;  // the columns [xa, xb) as bits
+            const uint64_t columns =
+                (width >= 64 ? ~uint64_t(0) : (uint64_t(1) << width) - 1) << (xa - x0);
             for (int iy = ya; iy < yb; iy++) {
-                const size_t row = m_base + multibin::BinStore::slotInTile(0, iy);
-                bool any = alsoAny;
-                if (m_tile != 0)
-                    for (int ix = xa; ix < xb; ix++) any |= s.slotHoldsBins(row + size_t(ix - x0));
-                if (!any) continue;
+                uint64_t held = m_tile != 0 ? s.rowHoldingBins(m_tile, iy - y0) & columns : 0;
+                if (!alsoAny) {  // the row's cells holding bins, from its bits
+                    for (; held != 0; held &= held - 1)
+                        picked[n++] = uint16_t((iy - y0) * kSide + __builtin_ctzll(held));
+                    continue;
+                }
                 for (int ix = xa; ix < xb; ix++) {
                     picked[n] = uint16_t((iy - y0) * kSide + (ix - x0));
-                    n += (m_tile != 0 && s.slotHoldsBins(row + size_t(ix - x0))) ||
-                         (alsoAny && also(ix, iy));
+                    n += ((held >> (ix - x0)) & 1) != 0 || also(ix, iy);
                 }
             }
             for (size_t i = 0; i < n; i++) f(x0 + picked[i] % kSide, y0 + picked[i] / kSide);

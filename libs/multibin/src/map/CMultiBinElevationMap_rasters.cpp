@@ -136,9 +136,8 @@ std::vector<multibin::CellWindow> CMultiBinElevationMap::occupiedTiles(int tileC
     if (tileCells % Store::kTileCells == 0) {
         // A store tile lies in one of these tiles: its first slot holding a bin adds it.
         store.forEachTileNumber([&](uint32_t t, int tx, int ty) {
-            const size_t base = Store::tileBase(t);
-            for (size_t k = 0; k < Store::kTileSlots; k++)
-                if (store.slotHoldsBins(base + k)) {
+            for (int r = 0; r < Store::kTileCells; r++)
+                if (store.rowHoldingBins(t, r) != 0) {
                     add(tx * Store::kTileCells, ty * Store::kTileCells);
                     break;
                 }

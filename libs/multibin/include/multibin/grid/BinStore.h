@@ -174,7 +174,7 @@ public:
     /** Memory the allocated tiles and the bins in use take [bytes]: what a memory budget
      * bounds (the pool keeps its capacity, reused by the next bins). */
     size_t residentBytes() const {
-        return tileCount() * kTileSlots * sizeof(BinId) +
+        return tileCount() * (kTileSlots * sizeof(BinId) + kTileCells * sizeof(uint64_t)) +
                (binCount() - m_spilledBins) * sizeof(Bin) + m_groups.size() * sizeof(TileGroup);
     }
     /** @} */
@@ -196,6 +196,12 @@ public:
      * (tileBase(tileNumber(tx, ty)) + slotInTile(ix, iy)) that skip empty cells; the window is
      * the caller's to check, as forEachBin does. */
     bool slotHoldsBins(size_t slot) const { return m_heads[slot] != kNoBin; }
+    /** The cells of row r (0 .. kTileCells - 1, from the tile's first cell) of tile number t
+     * that hold a bin: bit c for column c. A sparse tile's cells are found by its rows' bits,
+     * 64 cells a word, instead of their slots. */
+    uint64_t rowHoldingBins(uint32_t t, int r) const {
+        return m_rowBits[(size_t(t) << kTileShift) + size_t(r)];
+    }
     /** Calls f(const Bin&) for every bin of the cell, in chain order; nothing outside the
      * window. */
     template <typename F>
@@ -218,7 +224,8 @@ public:
     /** Memory held [bytes]: the tiles' cell heads, the directory and the bin pool with its spare
      * capacity. */
     size_t memoryBytes() const {
-        return m_heads.capacity() * sizeof(BinId) + m_groupTable.capacity() * sizeof(GroupKey) +
+        return m_heads.capacity() * sizeof(BinId) + m_rowBits.capacity() * sizeof(uint64_t) +
+               m_groupTable.capacity() * sizeof(GroupKey) +
                m_groups.capacity() * sizeof(TileGroup) + m_tileXY.capacity() * sizeof(TileKey) +
                m_pool.capacity() * sizeof(Bin);
     }
@@ -275,6 +282,12 @@ private:
     double m_invCellSize = 1.0;  //!< 1 / cell size [1/m]
     CellWindow m_window;
     std::vector<BinId> m_heads;          //!< per slot: the cell's first bin, or kNoBin
+    /** Per tile row (slot >> kTileShift): bit c set when the row's slot c holds a bin (its
+     * head is not kNoBin), kept by every write of a head. */
+    std::vector<uint64_t> m_rowBits;
+    static_assert(kTileCells == 64, "a tile row's cells are the bits of one word");
+    void markHolding(size_t s) { m_rowBits[s >> kTileShift] |= uint64_t(1) << (s & 63); }
+    void markEmpty(size_t s) { m_rowBits[s >> kTileShift] &= ~(uint64_t(1) << (s & 63)); }
     std::vector<TileKey> m_tileXY;       //!< per tile number: its tile coordinates (0: empty tile)
     std::vector<uint32_t> m_freeTiles;   //!< tile numbers freed, reused first
     std::vector<GroupKey> m_groupTable;  //!< open addressing, a power of two in size
@@ -334,6 +347,7 @@ inline BinStore::BinId BinStore::findOrAddBin(size_t s, int16_t n, bool& added) 
         m_pool[b].index = n;
         m_pool[b].next = kNoBin;
         (prev == kNoBin ? m_heads[s] : m_pool[prev].next) = b;
+        if (prev == kNoBin) markHolding(s);
     }
     return b;
 }
@@ -365,6 +379,7 @@ void BinStore::moveWindowTo(int ix0, int iy0, OnLeave&& onLeave, OnCleared&& onC
                     onLeave(ix, iy);
                     releaseChain(m_heads[s]);
                     m_heads[s] = kNoBin;
+                    markEmpty(s);
                 }
                 onCleared(s);
             }
@@ -379,15 +394,13 @@ void BinStore::forEachStoredBin(F&& f) const {
         if (!m_tileXY[t].allocated) continue;
         const int cx0 = m_tileXY[t].tx * kTileCells, cy0 = m_tileXY[t].ty * kTileCells;
         const BinId* heads = m_heads.data() + tileBase(uint32_t(t));
-        for (int r = 0; r < kTileCells; r++) {
-            const BinId* row = heads + r * kTileCells;
-            BinId all = kNoBin;  // stays kNoBin (all ones) on a row without a bin: one AND a slot
-            for (int c = 0; c < kTileCells; c++) all &= row[c];
-            if (all == kNoBin) continue;
-            for (int c = 0; c < kTileCells; c++)
-                for (BinId b = row[c]; b != kNoBin; b = m_pool[b].next)
+        for (int r = 0; r < kTileCells; r++)
+            for (uint64_t cells = rowHoldingBins(uint32_t(t), r); cells != 0;
+                 cells &= cells - 1) {  // the row's cells holding bins, west to east
+                const int c = __builtin_ctzll(cells);
+                for (BinId b = heads[r * kTileCells + c]; b != kNoBin; b = m_pool[b].next)
                     f(cx0 + c, cy0 + r, m_pool[b]);
-        }
+            }
     }
 }
 
@@ -408,6 +421,7 @@ size_t BinStore::editBins(int ix, int iy, F&& f) {
         }
         b = next;
     }
+    if (m_heads[s] == kNoBin) markEmpty(s);
     return removed;
 }
 
