@@ -123,10 +123,7 @@ void BinGrid::fuseBin(int ix, int iy, const BinEstimate& other, const BinUpdateP
 const Bin* BinGrid::winningBin(int ix, int iy) const {
     const Bin* best = nullptr;
     forEachBin(ix, iy, [&](const Bin& bin) {
-        if (!(bin.certainty > 0)) return;
-        if (!best || bin.certainty > best->certainty ||
-            (bin.certainty == best->certainty && bin.variance_m2 < best->variance_m2))
-            best = &bin;
+        if (winsOver(bin, best)) best = &bin;
     });
     return best;
 }

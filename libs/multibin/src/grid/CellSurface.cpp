@@ -14,8 +14,25 @@
 namespace multibin {
 
 bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, CellSurface& out) {
-    const Bin* win = grid.winningBin(ix, iy);
+    // The cell's bins gathered by one walk of its chain (one look-up of its slot) and the winner
+    // found on the way (winningBin()'s rule); the bins next to it are then looked for here.
+    constexpr size_t kInline = 16;
+    const Bin* inlineBins[kInline];
+    std::vector<const Bin*> more;  // a cell of more than kInline bins
+    size_t n = 0;
+    const Bin* win = nullptr;
+    grid.forEachBin(ix, iy, [&](const Bin& b) {
+        if (n < kInline) {
+            inlineBins[n] = &b;
+        } else {
+            if (more.empty()) more.assign(inlineBins, inlineBins + kInline);
+            more.push_back(&b);
+        }
+        n++;
+        if (BinGrid::winsOver(b, win)) win = &b;
+    });
     if (!win) return false;
+    const Bin* const* bins = n <= kInline ? inlineBins : more.data();
     const double floor_m2 = p.varianceFloor_m2;
     HeightInformation surface;
     surface.add(win->height_m, std::max<double>(win->variance_m2, floor_m2));
@@ -23,11 +40,10 @@ bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, 
     out.certainty = win->certainty;
     out.firstBin = out.lastBin = win->index;
     for (const int dir : {-1, 1}) {
-        for (int n = win->index + dir;; n += dir) {
+        for (int index = win->index + dir;; index += dir) {
             const Bin* next = nullptr;
-            grid.forEachBin(ix, iy, [&](const Bin& b) {
-                if (b.index == n && b.certainty > 0) next = &b;
-            });
+            for (size_t k = 0; k < n; k++)
+                if (bins[k]->index == index && bins[k]->certainty > 0) next = bins[k];
             if (!next) break;
             const double v = std::max<double>(next->variance_m2, floor_m2);
             const double h = surface.height_m(), vNow = surface.variance_m2();
@@ -35,7 +51,7 @@ bool cellSurface(const BinGrid& grid, int ix, int iy, const BinUpdateParams& p, 
             surface.add(next->height_m, v);
             out.certainty += next->certainty;
             poseHeightCode = leastPoseSigmaCode(poseHeightCode, next->poseHeightSigmaCode);
-            (dir < 0 ? out.firstBin : out.lastBin) = n;
+            (dir < 0 ? out.firstBin : out.lastBin) = index;
         }
     }
     out.height_m = surface.height_m();

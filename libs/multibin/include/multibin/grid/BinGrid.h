@@ -149,6 +149,12 @@ public:
     /** The cell's winning bin: most certain, ties broken by the lower variance; nullptr if the cell
      * has no bin with certainty > 0 or is outside the window. */
     const Bin* winningBin(int ix, int iy) const;
+    /** Whether bin b wins over `best` (nullptr: none yet) by winningBin()'s rule. */
+    static bool winsOver(const Bin& b, const Bin* best) {
+        return b.certainty > 0 &&
+               (!best || b.certainty > best->certainty ||
+                (b.certainty == best->certainty && b.variance_m2 < best->variance_m2));
+    }
 
     /** @name The visibility index (VisibilityIndex)
      * @{ */
