@@ -82,17 +82,6 @@ multibin::EsriAsciiGrid traversabilityLike(const CMultiBinElevationMap& map, int
     return out;
 }
 
-/** The serialized form of an object, gzip-compressed in memory (what CFileGZInputStream reads),
- * so the file is written whole by writeFileAtomically(). MRPT's compress_gz_data_block() goes
- * through a temporary file whose write errors it ignores. */
-std::vector<uint8_t> gzSerialized(const mrpt::serialization::CSerializable& object) {
-    mrpt::io::CMemoryStream mem;
-    auto arch = mrpt::serialization::archiveFrom(mem);
-    arch << object;
-    return multibin::gzipCompressed(static_cast<const uint8_t*>(mem.getRawBufferData()),
-                                    size_t(mem.getTotalBytesCount()));
-}
-
 }  // namespace
 
 std::string OutputSelection::help() {
@@ -332,8 +321,9 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
     // Each step writes one or more files; the bar counts steps.
     std::vector<std::pair<std::string, std::function<void()>>> steps;
     if (sel.map)
-        steps.emplace_back("elevation_map.bin",
-                           [&] { folder.write("elevation_map.bin", gzSerialized(map)); });
+        steps.emplace_back("elevation_map.bin", [&] {
+            folder.write("elevation_map.bin", multibin::gzipSerialized(map));
+        });
     if (sel.tif || sel.tifLayers)
         steps.emplace_back("elevation_*.tif", [&] {
             // Every GeoTIFF asked for in one loop over the tiles (one query per cell).
@@ -404,7 +394,7 @@ std::vector<std::string> writeMapOutputs(const CMultiBinElevationMap& map, const
         steps.emplace_back("elevation_traversability.gridmap.gz", [&] {
             mrpt::maps::COccupancyGridMap2D grid;
             map.getAsOccupancyGrid(grid);
-            folder.write("elevation_traversability.gridmap.gz", gzSerialized(grid));
+            folder.write("elevation_traversability.gridmap.gz", multibin::gzipSerialized(grid));
             multibin::PreviewStyle u;
             u.title = "P(untraversable)";
             u.colormap = cv::COLORMAP_INFERNO;

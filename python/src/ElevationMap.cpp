@@ -3,7 +3,6 @@
 
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -20,6 +19,8 @@
 #include "multibin/geometry/PosePropagation.h"
 #include "multibin/io/ErrorMessage.h"
 #include "multibin/io/EsriAsciiGrid.h"
+#include "multibin/io/Gzip.h"
+#include "multibin/io/OutputFile.h"
 #include "multibin/map/MapStatistics.h"
 
 namespace py = pybind11;
@@ -156,19 +157,11 @@ ElevationMap ElevationMap::load(const std::string& path) {
 }
 
 void ElevationMap::save(const std::string& path) const {
-    const std::string tmp = path + ".tmp";
     try {
         py::gil_scoped_release nogil;
-        {
-            mrpt::io::CFileGZOutputStream out;
-            if (!out.open(tmp)) throw std::runtime_error("cannot write '" + tmp + "'");
-            auto arch = mrpt::serialization::archiveFrom(out);
-            arch << *m_map;
-        }
-        fs::rename(tmp, path);
+        // As elevation-mapper saves elevation_map.bin: a private temporary, synced, renamed.
+        multibin::writeFileAtomically(path, multibin::gzipSerialized(*m_map));
     } catch (const std::exception& e) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
         throw std::runtime_error("ElevationMap.save: '" + path + "': " + oneLineMessage(e));
     }
 }

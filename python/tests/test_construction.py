@@ -1,4 +1,6 @@
 """ElevationMap(): defaults, ini files, keyword options, load and save."""
+import gzip
+
 import numpy as np
 import pytest
 
@@ -60,6 +62,7 @@ def test_missing_ini_and_section_without_a_map_are_errors(tmp_path):
 def test_save_then_load_answers_the_same_heights_bit_for_bit(plane_map, tmp_path):
     path = tmp_path / "map.bin"
     plane_map.save(str(path))
+    assert [p.name for p in tmp_path.iterdir()] == ["map.bin"], "no temporary left"
     loaded = multibin.ElevationMap.load(str(path))
     x, y = np.meshgrid(np.linspace(-0.2, 1.2, 57), np.linspace(-0.2, 1.2, 61))
     for a, b in zip(plane_map.height(x, y), loaded.height(x, y)):
@@ -75,6 +78,18 @@ def test_load_refuses_missing_and_corrupt_files(tmp_path):
     junk.write_bytes(b"not a map" * 10)
     with pytest.raises(RuntimeError, match="ElevationMap.load: '.*junk.bin'"):
         multibin.ElevationMap.load(str(junk))
+
+
+def test_a_map_file_with_a_flipped_byte_is_an_error_naming_its_checksum(plane_map, tmp_path):
+    """The reader's reason (the payload's checksum) comes through MRPT's wrapper of it."""
+    path = tmp_path / "map.bin"
+    plane_map.save(str(path))
+    payload = bytearray(gzip.decompress(path.read_bytes()))
+    payload[len(payload) // 2] ^= 0xFF
+    bad = tmp_path / "flipped.bin"
+    bad.write_bytes(gzip.compress(bytes(payload)))
+    with pytest.raises(RuntimeError, match=r"ElevationMap.load: '.*flipped\.bin'.*checksum mismatch"):
+        multibin.ElevationMap.load(str(bad))
 
 
 def test_save_to_a_missing_folder_is_an_error_naming_the_path(plane_map, tmp_path):

@@ -37,3 +37,30 @@ TEST(Messages, UserTextIsEscapedWhenPrinted) {
               "cam\\xC2\\x9B31m");  // UTF-8 CSI
     EXPECT_EQ(multibin::printableText("Kamera \xc3\xa9t\xc3\xa9"), "Kamera \xc3\xa9t\xc3\xa9");
 }
+
+// MRPT's wrapper of an object reader's error ("Exception while parsing typed object ... for
+// file ...") keeps the reader's own message, which says what is wrong, after the wrapper's,
+// which says where: a corrupt map file's checksum is named in the one line shown.
+TEST(Messages, AnObjectReadersErrorKeepsItsReasonAfterMrptsWrapper) {
+    const std::runtime_error wrapped(
+        "==== MRPT exception ====\n"
+        "Message:  Exception while parsing typed object 'mrpt::maps::CMultiBinElevationMap' from "
+        "mrpt::io::CFileGZInputStream for file 'm.bin'\n"
+        "Original exception:\n"
+        "CMultiBinElevationMap: corrupt serialized map (checksum mismatch)\n"
+        "Location: ./libs/serialization/src/CArchive.cpp:475: [void ...]\n"
+        "Call stack backtrace:\n[0 ]     0x7fb3c175a90b \n");
+    EXPECT_EQ(multibin::oneLineMessage(wrapped),
+              "Exception while parsing typed object 'mrpt::maps::CMultiBinElevationMap' from "
+              "mrpt::io::CFileGZInputStream for file 'm.bin': CMultiBinElevationMap: corrupt "
+              "serialized map (checksum mismatch)");
+    const std::runtime_error nested(  // the reader's error itself an MRPT exception
+        "==== MRPT exception ====\nMessage:  Exception while parsing typed object 'X'\n"
+        "Original exception:\n==== MRPT exception ====\nMessage:  truncated at byte 12\n"
+        "Location: a.cpp:1\n");
+    EXPECT_EQ(multibin::oneLineMessage(nested),
+              "Exception while parsing typed object 'X': truncated at byte 12");
+    const std::runtime_error plain(  // no wrapper: the message alone
+        "==== MRPT exception ====\nMessage:  bad key 'k'\nLocation: a.cpp:1\n");
+    EXPECT_EQ(multibin::oneLineMessage(plain), "bad key 'k'");
+}

@@ -38,13 +38,28 @@ bool isLibraryInternal(const std::exception& e, const std::string& message) {
 std::string oneLineMessage(const std::exception& e) {
     std::istringstream lines(e.what());
     std::string line, first;
+    const auto trimmed = [](const std::string& s) {
+        const auto b = s.find_first_not_of(' ');
+        return b == std::string::npos ? std::string() : s.substr(b);
+    };
     while (std::getline(lines, line)) {
         if (first.empty() && line.find("====") == std::string::npos) first = line;
         const auto m = line.find("Message:");
         if (m != std::string::npos) {
-            line = line.substr(m + 8);
-            const auto b = line.find_first_not_of(' ');
-            return b == std::string::npos ? std::string() : line.substr(b);
+            std::string message = trimmed(line.substr(m + 8));
+            // MRPT wraps an error of an object's reader ("Exception while parsing typed
+            // object ...") with the reader's own message on the line after "Original
+            // exception:": that line says what is wrong, the wrapper where.
+            std::string next;
+            if (std::getline(lines, next) && next.find("Original exception:") == 0)
+                while (std::getline(lines, next)) {
+                    if (next.find("====") != std::string::npos) continue;
+                    const auto inner = next.find("Message:");
+                    next = trimmed(inner == std::string::npos ? next : next.substr(inner + 8));
+                    if (!next.empty()) message += (message.empty() ? "" : ": ") + next;
+                    break;
+                }
+            return message;
         }
     }
     if (std::string(e.what()).find("====") != std::string::npos) return first;

@@ -2,6 +2,8 @@
 #include "multibin/io/Gzip.h"
 
 #include <libdeflate.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <memory>
 #include <stdexcept>
@@ -17,6 +19,16 @@ std::vector<uint8_t> gzipCompressed(const uint8_t* data, size_t size) {
     gz.resize(libdeflate_gzip_compress(compressor.get(), data, size, gz.data(), gz.size()));
     if (gz.empty()) throw std::runtime_error("gzip compression failed");
     return gz;
+}
+
+std::vector<uint8_t> gzipSerialized(const mrpt::serialization::CSerializable& object) {
+    // In memory, so the file is written whole by writeFileAtomically(): MRPT's
+    // compress_gz_data_block() goes through a temporary file whose write errors it ignores.
+    mrpt::io::CMemoryStream mem;
+    auto arch = mrpt::serialization::archiveFrom(mem);
+    arch << object;
+    return gzipCompressed(static_cast<const uint8_t*>(mem.getRawBufferData()),
+                          size_t(mem.getTotalBytesCount()));
 }
 
 }  // namespace multibin

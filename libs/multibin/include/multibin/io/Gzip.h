@@ -5,6 +5,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace mrpt::serialization {
+class CSerializable;
+}
+
 namespace multibin {
 
 /** A gzip file (RFC 1952) of `size` bytes, coded by libdeflate at its fastest level: what zlib's
@@ -12,5 +16,10 @@ namespace multibin {
  * a serialized map, and a few per cent smaller. Throws std::runtime_error when libdeflate cannot
  * start (out of memory). */
 std::vector<uint8_t> gzipCompressed(const uint8_t* data, size_t size);
+
+/** `object` as MRPT serializes it (CArchive::WriteObject) in a gzip file (gzipCompressed()):
+ * what MRPT's CFileGZInputStream and CArchive::ReadObject read back, a map file as
+ * elevation-mapper and the Python module save it (with writeFileAtomically(), OutputFile.h). */
+std::vector<uint8_t> gzipSerialized(const mrpt::serialization::CSerializable& object);
 
 }  // namespace multibin
