@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -50,11 +51,12 @@ using OptionNames = std::vector<std::pair<std::string, T>>;
  * gets this one, so every key has a physical range (a 1e308 m cell or a 1e160 m sigma floor is
  * refused, not mapped into an empty raster). */
 inline double physicalLimit(const char* unit) {
-    const std::string u = unit;
-    if (u == "m") return 1e10;
-    if (u == "s") return 1e7;
-    if (u == "rad") return 1e3;
-    if (u == "px" || u == "cells" || u == "1/m") return 1e6;
+    // Compared in place: options are checked at every insertion (validate()).
+    const auto is = [unit](const char* u) { return std::strcmp(unit, u) == 0; };
+    if (is("m")) return 1e10;
+    if (is("s")) return 1e7;
+    if (is("rad")) return 1e3;
+    if (is("px") || is("cells") || is("1/m")) return 1e6;
     return 1e9;
 }
 
@@ -242,11 +244,10 @@ public:
     /** A choice set in code must still be one of its words' values. */
     template <class T>
     void operator()(const OptionKey& key, const T& value, const OptionNames<T>& names) const {
-        std::string words;
-        for (const auto& [word, v] : names) {
-            if (v == value) return;
-            words += (words.empty() ? "" : ", ") + word;
-        }
+        for (const auto& name : names)
+            if (name.second == value) return;
+        std::string words;  // the message only: options are checked at every insertion
+        for (const auto& name : names) words += (words.empty() ? "" : ", ") + name.first;
         fail(key.name, "not one of the accepted values (" + words + ")");
     }
     template <class Parse, class Format>
