@@ -59,12 +59,10 @@ void CMultiBinElevationMap::forEachKnownCell(
                   "the filled cells' tiles are the store's");
     std::vector<float> values(layers.size());
     const auto readCell = [&](int ix, int iy) {
-        // cellElevation() without its per-cell preparation and lock, held here for the raster.
+        // cellElevation() without its per-cell preparation (the lock is held here already).
         double h, s;
-        const double x_m = o.x() + grid.cellCenter_m(ix), y_m = o.y() + grid.cellCenter_m(iy);
-        HeightSource src = HeightSource::Measured;
-        if (!surfaceQuery(false, x_m, y_m, h, s))
-            src = withFill ? filledQuery(x_m, y_m, h, s) : HeightSource::Unknown;
+        const HeightSource src = elevationQuery(false, o.x() + grid.cellCenter_m(ix),
+                                                o.y() + grid.cellCenter_m(iy), h, s, withFill);
         if (src == HeightSource::Unknown) return;
         for (size_t k = 0; k < layers.size(); k++) {
             float& v = values[k];
