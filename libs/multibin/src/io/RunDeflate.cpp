@@ -67,8 +67,9 @@ struct Adler {
     void periodic(const uint8_t* q, int d, uint64_t len) {
         // b gains len * a plus sum over t of (len - t) q[t mod d]; a gains sum of q[t mod d].
         uint64_t sumA = 0, sumB = 0;
+        const uint64_t whole = len / uint64_t(d), rest = len % uint64_t(d);  // one division
         for (int j = 0; j < d && uint64_t(j) < len; j++) {
-            const uint64_t n = (len - uint64_t(j) + uint64_t(d) - 1) / uint64_t(d);
+            const uint64_t n = whole + (uint64_t(j) < rest);  // the bytes t = j mod d
             const uint64_t weight = n * (len - uint64_t(j)) - uint64_t(d) * (n * (n - 1) / 2);
             sumA += (n % kAdlerMod) * q[j];
             sumB += (weight % kAdlerMod) * q[j];
