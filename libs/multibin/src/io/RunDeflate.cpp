@@ -86,7 +86,11 @@ size_t runLength(const uint8_t* p, size_t i, size_t d, size_t limit) {
     for (uint64_t x, y; k + 8 <= limit; k += 8) {  // eight at a time while all agree
         std::memcpy(&x, p + i + k, 8);
         std::memcpy(&y, p + i + k - d, 8);
-        if (x != y) break;
+        if (x != y) {
+            if constexpr (__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
+                return k + size_t(__builtin_ctzll(x ^ y) >> 3);  // the first byte that differs
+            break;
+        }
     }
     while (k < limit && p[i + k] == p[i + k - d]) k++;
     return k;
