@@ -186,7 +186,7 @@ public:
     BitWriter(std::vector<uint8_t>& out, size_t maxBits) : m_out(out), m_used(out.size()) {
         m_out.resize(m_used + maxBits / 8 + 8);
     }
-    void put(uint32_t value, int bits) {  // bits <= 16: the buffer holds at most 47 bits
+    void put(uint32_t value, int bits) {  // bits <= 32: the buffer holds at most 63 bits
         m_buffer |= uint64_t(value) << m_count;
         m_count += bits;
         if (m_count >= 32) {
@@ -252,10 +252,11 @@ void writeBlock(Tokens& t, std::vector<uint8_t>& out) {
         }
         const int lc = lengthCode(int(len)), dist = int(token & 0xffff);
         const int dc = distCode(dist);
-        w.put(litCodes[size_t(257 + lc)], litBits[size_t(257 + lc)]);
-        w.put(uint32_t(int(len) - kLengthBase[lc]), kLengthExtra[lc]);
-        w.put(distCodes[size_t(dc)], distBits[size_t(dc)]);
-        w.put(uint32_t(dist - kDistBase[dc]), kDistExtra[dc]);
+        // Each code with its extra bits in one put (at most 15 + 13 bits).
+        const int lb = litBits[size_t(257 + lc)], db = distBits[size_t(dc)];
+        w.put(litCodes[size_t(257 + lc)] | uint32_t(int(len) - kLengthBase[lc]) << lb,
+              lb + kLengthExtra[lc]);
+        w.put(distCodes[size_t(dc)] | uint32_t(dist - kDistBase[dc]) << db, db + kDistExtra[dc]);
     }
     w.put(litCodes[256], litBits[256]);
     w.finish();
