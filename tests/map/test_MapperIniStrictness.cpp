@@ -39,7 +39,10 @@ std::string ini(const std::string& creation, const std::string& insertion = "",
 /** Builds the maps of ini file text `text` as observations2map and the mapper do (from a file:
  * MRPT's in-memory ini gives back its text with duplicates already merged). */
 void mapsOf(const std::string& text) {
-    const std::filesystem::path file = scratchDir("ini_strictness") / "maps.ini";
+    // A file per test: ctest runs this program's tests side by side.
+    const std::filesystem::path file =
+        scratchDir("ini_strictness") /
+        (std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + ".ini");
     std::ofstream(file) << text;
     mrpt::config::CConfigFile c(file.string());
     mrpt::maps::TSetOfMetricMapInitializers inits;
