@@ -117,8 +117,8 @@ struct CMultiBinElevationMap::Impl {
             const multibin::BinStore& s = m_impl.grid.store();
             const int x0 = xa & ~(kSide - 1), y0 = ya & ~(kSide - 1);  // the tile's first cell
             const int width = xb - xa;  // the columns [xa, xb) as bits
-            const uint64_t columns =
-                (width >= 64 ? ~uint64_t(0) : (uint64_t(1) << width) - 1) << (xa - x0);
+            const uint64_t columns = (width >= 64 ? ~uint64_t(0) : (uint64_t(1) << width) - 1)
+                                     << (xa - x0);
             for (int iy = ya; iy < yb; iy++) {
                 uint64_t held = m_tile != 0 ? s.rowHoldingBins(m_tile, iy - y0) & columns : 0;
                 if (!alsoAny) {  // the row's cells holding bins, from its bits

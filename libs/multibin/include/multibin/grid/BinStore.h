@@ -281,7 +281,7 @@ private:
     double m_cellSize_m;
     double m_invCellSize = 1.0;  //!< 1 / cell size [1/m]
     CellWindow m_window;
-    std::vector<BinId> m_heads;          //!< per slot: the cell's first bin, or kNoBin
+    std::vector<BinId> m_heads;  //!< per slot: the cell's first bin, or kNoBin
     /** Per tile row (slot >> kTileShift): bit c set when the row's slot c holds a bin (its
      * head is not kNoBin), kept by every write of a head. */
     std::vector<uint64_t> m_rowBits;
