@@ -28,6 +28,8 @@ multibin::EsriAsciiGrid CMultiBinElevationMap::toRaster(RasterLayer layer,
 
 std::vector<multibin::EsriAsciiGrid> CMultiBinElevationMap::toRasters(
     const std::vector<RasterLayer>& layers, const multibin::CellWindow& w) const {
+    prepareForReading();
+    const multibin::MapLock::Shared lock(m_impl->lock);  // a writer may grow or move the grid
     multibin::EsriAsciiGrid g = multibin::EsriAsciiGrid::onLattice(
         multibin::Lattice{m_impl->grid.cellSize_m(), w});  // NaN: unknown
     g.xllcenter_m += m_impl->origin_m.x();                 // the raster is in the pose frame
