@@ -14,7 +14,6 @@
 #include <unordered_map>
 
 #include "multibin/grid/BinStore.h"
-#include "multibin/io/FiniteSamples.h"
 #include "multibin/map/TerrainView.h"
 
 namespace multibin {
